@@ -1,0 +1,1 @@
+"""Physics shared by all creatures: fluid forces (pure functions) and MuJoCo plumbing."""

@@ -1,0 +1,141 @@
+"""Native access to MuJoCo's C structs for compiled (numba) callbacks and stepping loops.
+
+MuJoCo calls a passive-force callback as ``void cb(const mjModel* m, mjData* d)``. A numba
+``@cfunc`` receives those two raw pointers and must find ``d->qpos``, ``d->qfrc_passive`` ...
+by itself. We compute the byte offset of every ``mjtNum*`` field of ``mjData`` from the header
+that the installed ``mujoco`` wheel ships (``mujoco/include/mujoco/mjdata.h``): the pointer block
+follows ``time``, ``energy[2]``, ``buffer`` and ``arena`` in declaration order. The offset of
+``time`` is found in a live ``MjData``, and every offset we use is then verified against the
+addresses of the arrays that the Python bindings expose; a mismatch (a MuJoCo version whose
+layout we do not understand) raises instead of corrupting memory.
+
+The same module gives ctypes handles on ``libmujoco`` (the very library the bindings loaded), so
+compiled code can call ``mj_step``, ``mj_applyFT`` and ``mj_objectVelocity`` without Python.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import glob
+import os
+import re
+
+import mujoco
+import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.core import cgutils
+from numba.extending import intrinsic
+
+#: Fields of mjData that compiled code reads or writes.
+USED_FIELDS = ("qpos", "qvel", "qfrc_passive", "userdata", "xpos", "xmat", "xipos", "ctrl")
+
+
+@intrinsic
+def voidptr_from_int(typingctx, address):
+    """Numba intrinsic: integer address -> ``void*``."""
+    sig = types.voidptr(address)
+
+    def codegen(context, builder, signature, args):
+        return builder.inttoptr(args[0], cgutils.voidptr_t)
+
+    return sig, codegen
+
+
+@intrinsic
+def int_from_voidptr(typingctx, pointer):
+    """Numba intrinsic: ``void*`` -> integer address (int64)."""
+    sig = types.int64(pointer)
+
+    def codegen(context, builder, signature, args):
+        return builder.ptrtoint(args[0], ir.IntType(64))
+
+    return sig, codegen
+
+
+def _mujoco_dir() -> str:
+    return os.path.dirname(mujoco.__file__)
+
+
+@functools.lru_cache(maxsize=1)
+def libmujoco() -> ctypes.CDLL:
+    """The shared ``libmujoco`` shipped in the ``mujoco`` wheel (already loaded by the bindings)."""
+    candidates = sorted(glob.glob(os.path.join(_mujoco_dir(), "libmujoco.so*")))
+    candidates += sorted(glob.glob(os.path.join(_mujoco_dir(), "libmujoco*.dylib")))
+    candidates += sorted(glob.glob(os.path.join(_mujoco_dir(), "mujoco*.dll")))
+    if not candidates:
+        raise RuntimeError("could not find the libmujoco shared library inside the mujoco package")
+    lib = ctypes.CDLL(candidates[0])
+    vp, ci = ctypes.c_void_p, ctypes.c_int
+    lib.mj_step.argtypes = [vp, vp]
+    lib.mj_step.restype = None
+    lib.mj_forward.argtypes = [vp, vp]
+    lib.mj_forward.restype = None
+    lib.mj_applyFT.argtypes = [vp, vp, vp, vp, vp, ci, vp]
+    lib.mj_applyFT.restype = None
+    lib.mj_objectVelocity.argtypes = [vp, vp, ci, ci, vp, ci]
+    lib.mj_objectVelocity.restype = None
+    return lib
+
+
+@functools.lru_cache(maxsize=1)
+def _pointer_field_order() -> tuple[str, ...]:
+    header = os.path.join(_mujoco_dir(), "include", "mujoco", "mjdata.h")
+    with open(header, encoding="utf-8") as fh:
+        text = fh.read()
+    start = text.index("struct mjData_ {")
+    body = text[start : text.index("};", start)]
+    after_arena = body[body.index("void*   arena;") :]
+    names = []
+    for line in after_arena.splitlines()[1:]:
+        code = line.split("//")[0].strip()
+        if not code:
+            continue
+        match = re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*\s*\*\s*([A-Za-z_][A-Za-z0-9_]*)\s*;", code)
+        if match is None:
+            break  # first non-pointer field ends the block
+        names.append(match.group(1))
+    return tuple(names)
+
+
+@functools.lru_cache(maxsize=1)
+def _time_offset() -> int:
+    m = mujoco.MjModel.from_xml_string("<mujoco><worldbody/></mujoco>")
+    d = mujoco.MjData(m)
+    probe = 7.123456789012345e-3
+    d.time = probe
+    n = 4096
+    raw = np.frombuffer((ctypes.c_double * n).from_address(d._address), dtype=np.float64)
+    hits = np.nonzero(raw == probe)[0]
+    if len(hits) != 1:
+        raise RuntimeError("could not locate mjData.time in this MuJoCo build")
+    return int(hits[0]) * 8
+
+
+@functools.lru_cache(maxsize=1)
+def data_offsets() -> dict[str, int]:
+    """Byte offsets of ``time`` and the pointer fields of ``mjData`` (see module docstring)."""
+    offsets = {"time": _time_offset()}
+    first_pointer = offsets["time"] + 8 * 3 + 8 * 2  # time, energy[2], buffer, arena
+    for i, name in enumerate(_pointer_field_order()):
+        offsets[name] = first_pointer + 8 * i
+    return offsets
+
+
+def verify_offsets(d: mujoco.MjData, fields=USED_FIELDS) -> None:
+    """Raise ``RuntimeError`` unless each field's pointer in ``d`` equals the bound array's address."""
+    offsets = data_offsets()
+    for name in fields:
+        array = getattr(d, name)
+        if array.size == 0:
+            continue
+        stored = ctypes.c_uint64.from_address(d._address + offsets[name]).value
+        if stored != array.ctypes.data:
+            raise RuntimeError(f"mjData layout check failed for field {name!r}")
+    t = d.time
+    d.time = 0.0 if t else 1.0
+    ok = ctypes.c_double.from_address(d._address + offsets["time"]).value == d.time
+    d.time = t
+    if not ok:
+        raise RuntimeError("mjData layout check failed for field 'time'")
