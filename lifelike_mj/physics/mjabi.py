@@ -85,7 +85,7 @@ def _pointer_field_order() -> tuple[str, ...]:
     with open(header, encoding="utf-8") as fh:
         text = fh.read()
     start = text.index("struct mjData_ {")
-    body = text[start : text.index("};", start)]
+    body = text[start : text.index("} mjData;", start)]
     after_arena = body[body.index("void*   arena;") :]
     names = []
     for line in after_arena.splitlines()[1:]:
@@ -105,12 +105,13 @@ def _time_offset() -> int:
     d = mujoco.MjData(m)
     probe = 7.123456789012345e-3
     d.time = probe
-    n = 4096
-    raw = np.frombuffer((ctypes.c_double * n).from_address(d._address), dtype=np.float64)
-    hits = np.nonzero(raw == probe)[0]
-    if len(hits) != 1:
-        raise RuntimeError("could not locate mjData.time in this MuJoCo build")
-    return int(hits[0]) * 8
+    chunk = 4096  # doubles; mjData is ~160 kB in MuJoCo 3-4, the scan stops at the first hit
+    for start in range(0, 1 << 20, chunk):
+        raw = np.frombuffer((ctypes.c_double * chunk).from_address(d._address + 8 * start), dtype=np.float64)
+        hits = np.nonzero(raw == probe)[0]
+        if len(hits):
+            return (start + int(hits[0])) * 8
+    raise RuntimeError("could not locate mjData.time in this MuJoCo build")
 
 
 @functools.lru_cache(maxsize=1)

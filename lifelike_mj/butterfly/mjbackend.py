@@ -1,0 +1,576 @@
+"""The MuJoCo backend: ``models/butterfly.xml`` flown with a compiled wing-force callback.
+
+Forces (all in the passive callback, which MuJoCo calls at every RK4 stage):
+
+* **wing force**, per wing, in one of two modes:
+
+  - ``"tip"``: the paper's tip-speed formula. ``v' = L omega_i - v_x sin(phi)`` (Oe 2010 eq. 7,
+    with the wing's own hinge rate ``omega_i`` and the body's air-relative forward speed), force
+    ``K/2 v'|v'|`` per wing (eq. 8-9, ``K = rho C_d L W / 4`` for both wings) along the wing's
+    normal, applied at the planform-2 centre of pressure ``0.8 L`` from the hinge, so that the
+    hinge torque is eq. 6's ``tau_2``. In the paper-equivalent model the vertical and forward
+    components are exactly eq. 11's ``F_y cos(theta)`` and ``F_z cos(theta)``.
+  - ``"strip"``: eq. 1 on each strip ``dS = W x/L dx`` of the planform (eq. 3), with the strip's
+    full air-relative velocity (body translation and rotation, flap, wind) projected on the
+    wing normal; the paper's simplifications (vertical speed and theta ignored in ``v'``) dropped.
+
+* **body drag** (eq. 10) on each world axis at the thorax's centre of mass;
+* **flap servo**: a feed-forward plus PD torque on each flap hinge that makes the wing follow
+  ``theta(t)`` of the controller's flap pattern (evaluated at the stage time);
+* **attitude servo** (rich configuration only): a PD torque on the free thorax towards the
+  commanded pitch (roll and yaw held at 0).
+
+The pitch command itself comes from the controller once per step (Oe 2010 section 5.1): in the
+paper-equivalent model it is written into the pitch hinge (whose large armature keeps it fixed
+through the step); in the rich model it is the attitude servo's target.
+
+Each simulation's parameters live in its own ``mjData.userdata`` (layout below), so one
+compiled callback serves any number of models and threads. The stepping loop is compiled too:
+it runs the controller and calls ``mj_step`` from native code. :func:`python_passive` is a plain
+Python twin of the compiled callback, kept as the reference the compiled one is tested against.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import mujoco
+import numpy as np
+from numba import carray, cfunc, njit, types
+
+from lifelike_mj.butterfly.aero import strip_nodes
+from lifelike_mj.butterfly.controllers import ButterflyController
+from lifelike_mj.butterfly.paper import Condition, check_timing, pitch_command
+from lifelike_mj.butterfly.params import ButterflyParams
+from lifelike_mj.butterfly.trajectory import Trajectory
+from lifelike_mj.errors import UserError
+from lifelike_mj.paths import models_dir
+from lifelike_mj.physics import mjabi
+from lifelike_mj.physics.callbacks import passive_callback
+from lifelike_mj.physics.fluid import normal_drag_scalar
+
+CONFIGS = {"paper": "butterfly.xml", "rich": "butterfly_rich.xml"}
+FORCE_MODES = {"none": 0, "tip": 1, "strip": 2}
+#: Centre of pressure of planform 2 as a fraction of L: tau_2 / F_2 = (alpha L/10)/(alpha/8) (eq. 4, 6).
+CP_FRACTION = 0.8
+
+# ---- userdata layout (float64 slots) -------------------------------------------------------
+U_MODE, U_RICH = 0, 1
+U_AIR = 2  # 3: air velocity in world (m/s)
+U_KHALF, U_L, U_W, U_RHO, U_CD, U_AB = 5, 6, 7, 8, 9, 10
+U_FLAP = 11  # 3: theta_c (rad), theta_a (rad), 2 pi f (rad/s)
+U_DRIVE_A, U_DRIVE_WN = 14, 15  # flap servo: armature (kg m^2), natural frequency (rad/s)
+U_PHI_CMD, U_SERVO_I, U_SERVO_WN = 16, 17, 18  # attitude servo (rich)
+U_THORAX = 19
+U_WING = 20  # 2 body ids
+U_FLAP_Q = 22  # 2 qpos addresses
+U_FLAP_D = 24  # 2 dof addresses
+U_CP = 26  # centre-of-pressure distance from the hinge (m)
+U_NQ, U_NV, U_NBODY = 27, 28, 29
+U_SCR = 30  # scratch: force 30-32, torque 33-35, point 36-38, velocity 39-44
+U_NSTRIP = 60
+U_STRIP = 61  # n x positions (m), then n areas (m^2)
+MAX_STRIPS = 64
+N_USERDATA = U_STRIP + 2 * MAX_STRIPS
+
+_OFF = mjabi.data_offsets()
+_OFF_TIME = _OFF["time"]
+_OFF_QPOS = _OFF["qpos"]
+_OFF_QVEL = _OFF["qvel"]
+_OFF_QFRC = _OFF["qfrc_passive"]
+_OFF_UD = _OFF["userdata"]
+_OFF_XPOS = _OFF["xpos"]
+_OFF_XMAT = _OFF["xmat"]
+_OFF_XIPOS = _OFF["xipos"]
+
+_LIB = mjabi.libmujoco()
+_mj_step = _LIB.mj_step
+_mj_applyFT = _LIB.mj_applyFT
+_mj_objectVelocity = _LIB.mj_objectVelocity
+_OBJ_BODY = int(mujoco.mjtObj.mjOBJ_BODY)
+_OBJ_XBODY = int(mujoco.mjtObj.mjOBJ_XBODY)
+
+_vp = mjabi.voidptr_from_int
+_addr = mjabi.int_from_voidptr
+
+
+@njit(cache=False, inline="always")
+def _ptr_at(address):
+    return carray(_vp(address), (1,), np.uint64)[0]
+
+
+@njit(cache=False, inline="always")
+def _f64(address, n):
+    return carray(_vp(address), (n,), np.float64)
+
+
+@njit(cache=False)
+def _passive_kernel(m, d):
+    """Body of the passive callback (see module docstring); adds to ``qfrc_passive``."""
+    base = _addr(d)
+    uda = _ptr_at(base + _OFF_UD)
+    ud = _f64(uda, N_USERDATA)
+    mode = int(ud[U_MODE])
+    nq = int(ud[U_NQ])
+    nv = int(ud[U_NV])
+    qpos = _f64(_ptr_at(base + _OFF_QPOS), nq)
+    qvel = _f64(_ptr_at(base + _OFF_QVEL), nv)
+    qfrc_addr = _ptr_at(base + _OFF_QFRC)
+    qfrc = _f64(qfrc_addr, nv)
+    t = _f64(base + _OFF_TIME, 1)[0]
+    nbody = int(ud[U_NBODY])
+    xpos = _f64(_ptr_at(base + _OFF_XPOS), 3 * nbody)
+    xmat = _f64(_ptr_at(base + _OFF_XMAT), 9 * nbody)
+    xipos = _f64(_ptr_at(base + _OFF_XIPOS), 3 * nbody)
+    force = uda + 8 * U_SCR
+    torque = uda + 8 * (U_SCR + 3)
+    point = uda + 8 * (U_SCR + 6)
+    vel = uda + 8 * (U_SCR + 9)
+    ax = ud[U_AIR]
+    ay = ud[U_AIR + 1]
+    az = ud[U_AIR + 2]
+    thorax = int(ud[U_THORAX])
+
+    # flap servo: feed-forward + PD towards theta(t) (Oe 2010 section 4.3 flap pattern)
+    wt = ud[U_FLAP + 2] * t
+    th_ref = ud[U_FLAP] + ud[U_FLAP + 1] * math.cos(wt)
+    om_ref = -ud[U_FLAP + 1] * ud[U_FLAP + 2] * math.sin(wt)
+    al_ref = -ud[U_FLAP + 1] * ud[U_FLAP + 2] * ud[U_FLAP + 2] * math.cos(wt)
+    wn = ud[U_DRIVE_WN]
+    for i in range(2):
+        qa = int(ud[U_FLAP_Q + i])
+        da = int(ud[U_FLAP_D + i])
+        qfrc[da] += ud[U_DRIVE_A] * (al_ref + wn * wn * (th_ref - qpos[qa]) + 2.0 * wn * (om_ref - qvel[da]))
+
+    # thorax pitch (nose up) from its forward axis, and air-relative velocity at its COM
+    mb = 9 * thorax
+    phi = math.atan2(xmat[mb + 6], xmat[mb + 0])
+    _mj_objectVelocity(m, d, _OBJ_BODY, thorax, _vp(vel), 0)
+    v6 = _f64(vel, 6)
+    vbx = v6[3] - ax
+    vby = v6[4] - ay
+    vbz = v6[5] - az
+
+    if mode > 0:
+        # body drag, eq. 10, per world axis at the thorax COM
+        f = _f64(force, 3)
+        tq = _f64(torque, 3)
+        pt = _f64(point, 3)
+        f[0] = normal_drag_scalar(ud[U_AB], ud[U_RHO], ud[U_CD], vbx)
+        f[1] = normal_drag_scalar(ud[U_AB], ud[U_RHO], ud[U_CD], vby)
+        f[2] = normal_drag_scalar(ud[U_AB], ud[U_RHO], ud[U_CD], vbz)
+        tq[0] = 0.0
+        tq[1] = 0.0
+        tq[2] = 0.0
+        pt[0] = xipos[3 * thorax]
+        pt[1] = xipos[3 * thorax + 1]
+        pt[2] = xipos[3 * thorax + 2]
+        _mj_applyFT(m, d, _vp(force), _vp(torque), _vp(point), thorax, _vp(qfrc_addr))
+
+        sphi = math.sin(phi)
+        for i in range(2):
+            wing = int(ud[U_WING + i])
+            side = 1.0 if i == 0 else -1.0
+            mw = 9 * wing
+            nx = xmat[mw + 2]
+            ny = xmat[mw + 5]
+            nz = xmat[mw + 8]
+            ox = xpos[3 * wing]
+            oy = xpos[3 * wing + 1]
+            oz = xpos[3 * wing + 2]
+            if mode == 1:
+                # tip-speed formula, eq. 7-9, per wing, at the centre of pressure
+                vp = ud[U_L] * qvel[int(ud[U_FLAP_D + i])] - vbx * sphi
+                fn = -ud[U_KHALF] * vp * abs(vp)
+                r = side * ud[U_CP]
+                f[0] = fn * nx
+                f[1] = fn * ny
+                f[2] = fn * nz
+                pt[0] = ox + xmat[mw + 1] * r
+                pt[1] = oy + xmat[mw + 4] * r
+                pt[2] = oz + xmat[mw + 7] * r
+            else:
+                # strip integration of eq. 1 over dS = W x/L dx (eq. 3)
+                _mj_objectVelocity(m, d, _OBJ_XBODY, wing, _vp(vel), 0)
+                wx = v6[0]
+                wy = v6[1]
+                wz = v6[2]
+                lx = v6[3] - ax
+                ly = v6[4] - ay
+                lz = v6[5] - az
+                ns = int(ud[U_NSTRIP])
+                fsum = 0.0
+                msum = 0.0
+                for j in range(ns):
+                    r = side * ud[U_STRIP + j]
+                    rx = xmat[mw + 1] * r
+                    ry = xmat[mw + 4] * r
+                    rz = xmat[mw + 7] * r
+                    vx = lx + wy * rz - wz * ry
+                    vy = ly + wz * rx - wx * rz
+                    vz = lz + wx * ry - wy * rx
+                    vn = vx * nx + vy * ny + vz * nz
+                    dfn = normal_drag_scalar(ud[U_STRIP + ns + j], ud[U_RHO], ud[U_CD], vn)
+                    fsum += dfn
+                    msum += dfn * r
+                # all strips lie on the wing's span axis: the total acts at msum/fsum along it
+                f[0] = fsum * nx
+                f[1] = fsum * ny
+                f[2] = fsum * nz
+                # torque of the strip forces about the wing origin: (span axis) x n * msum
+                sx = xmat[mw + 1]
+                sy = xmat[mw + 4]
+                sz = xmat[mw + 7]
+                tq[0] = (sy * nz - sz * ny) * msum
+                tq[1] = (sz * nx - sx * nz) * msum
+                tq[2] = (sx * ny - sy * nx) * msum
+                pt[0] = ox
+                pt[1] = oy
+                pt[2] = oz
+            _mj_applyFT(m, d, _vp(force), _vp(torque), _vp(point), wing, _vp(qfrc_addr))
+            tq[0] = 0.0
+            tq[1] = 0.0
+            tq[2] = 0.0
+
+    if ud[U_RICH] > 0.5:
+        # attitude servo: PD torque towards pitch phi_cmd, roll = yaw = 0 (rich model)
+        pc = ud[U_PHI_CMD]
+        cp = math.cos(pc)
+        sp = math.sin(pc)
+        # desired axes: x_d = (cp, 0, sp), y_d = (0, 1, 0), z_d = (-sp, 0, cp)
+        bx0, bx1, bx2 = xmat[mb + 0], xmat[mb + 3], xmat[mb + 6]
+        by0, by1, by2 = xmat[mb + 1], xmat[mb + 4], xmat[mb + 7]
+        bz0, bz1, bz2 = xmat[mb + 2], xmat[mb + 5], xmat[mb + 8]
+        ex = 0.5 * ((bx1 * sp - bx2 * 0.0) + (by1 * 0.0 - by2 * 1.0) + (bz1 * cp - bz2 * 0.0))
+        ey = 0.5 * ((bx2 * cp - bx0 * sp) + (by2 * 0.0 - by0 * 0.0) + (bz2 * (-sp) - bz0 * cp))
+        ez = 0.5 * ((bx0 * 0.0 - bx1 * cp) + (by0 * 1.0 - by1 * 0.0) + (bz0 * 0.0 - bz1 * (-sp)))
+        _mj_objectVelocity(m, d, _OBJ_XBODY, thorax, _vp(vel), 0)
+        v6 = _f64(vel, 6)
+        sw = ud[U_SERVO_WN]
+        si = ud[U_SERVO_I]
+        f = _f64(force, 3)
+        tq = _f64(torque, 3)
+        pt = _f64(point, 3)
+        f[0] = 0.0
+        f[1] = 0.0
+        f[2] = 0.0
+        tq[0] = si * (sw * sw * ex - 2.0 * sw * v6[0])
+        tq[1] = si * (sw * sw * ey - 2.0 * sw * v6[1])
+        tq[2] = si * (sw * sw * ez - 2.0 * sw * v6[2])
+        pt[0] = xipos[3 * thorax]
+        pt[1] = xipos[3 * thorax + 1]
+        pt[2] = xipos[3 * thorax + 2]
+        _mj_applyFT(m, d, _vp(force), _vp(torque), _vp(point), thorax, _vp(qfrc_addr))
+
+
+@cfunc(types.void(types.voidptr, types.voidptr), cache=False)
+def _passive_cfunc(m, d):
+    _passive_kernel(m, d)
+
+
+#: The compiled passive callback (a ctypes function pointer MuJoCo accepts).
+COMPILED_PASSIVE = _passive_cfunc.ctypes
+
+
+def python_passive(m: mujoco.MjModel, d: mujoco.MjData) -> None:
+    """Plain Python twin of the compiled callback (same userdata, same formulas): the reference."""
+    ud = d.userdata
+    mode = int(ud[U_MODE])
+    air = ud[U_AIR : U_AIR + 3]
+    thorax = int(ud[U_THORAX])
+    t = d.time
+    th_c, th_a, w = ud[U_FLAP], ud[U_FLAP + 1], ud[U_FLAP + 2]
+    th_ref = th_c + th_a * math.cos(w * t)
+    om_ref = -th_a * w * math.sin(w * t)
+    al_ref = -th_a * w * w * math.cos(w * t)
+    wn = ud[U_DRIVE_WN]
+    for i in range(2):
+        qa, da = int(ud[U_FLAP_Q + i]), int(ud[U_FLAP_D + i])
+        d.qfrc_passive[da] += ud[U_DRIVE_A] * (al_ref + wn * wn * (th_ref - d.qpos[qa]) + 2.0 * wn * (om_ref - d.qvel[da]))
+    R = d.xmat[thorax].reshape(3, 3)
+    phi = math.atan2(R[2, 0], R[0, 0])
+    vel = np.zeros(6)
+    mujoco.mj_objectVelocity(m, d, _OBJ_BODY, thorax, vel, 0)
+    vb = vel[3:] - air
+    zero = np.zeros(3)
+    if mode > 0:
+        fb = np.array([normal_drag_scalar(ud[U_AB], ud[U_RHO], ud[U_CD], v) for v in vb])
+        mujoco.mj_applyFT(m, d, fb, zero, d.xipos[thorax].copy(), thorax, d.qfrc_passive)
+        for i, side in ((0, 1.0), (1, -1.0)):
+            wing = int(ud[U_WING + i])
+            Rw = d.xmat[wing].reshape(3, 3)
+            n, span, origin = Rw[:, 2].copy(), Rw[:, 1].copy(), d.xpos[wing].copy()
+            if mode == 1:
+                vp = ud[U_L] * d.qvel[int(ud[U_FLAP_D + i])] - vb[0] * math.sin(phi)
+                fn = -ud[U_KHALF] * vp * abs(vp)
+                mujoco.mj_applyFT(m, d, fn * n, zero, origin + span * (side * ud[U_CP]), wing, d.qfrc_passive)
+            else:
+                mujoco.mj_objectVelocity(m, d, _OBJ_XBODY, wing, vel, 0)
+                omega, lin = vel[:3], vel[3:] - air
+                ns = int(ud[U_NSTRIP])
+                r = side * ud[U_STRIP : U_STRIP + ns]
+                areas = ud[U_STRIP + ns : U_STRIP + 2 * ns]
+                v = lin[None, :] + np.cross(omega[None, :], r[:, None] * span[None, :])
+                dfn = np.array([normal_drag_scalar(a, ud[U_RHO], ud[U_CD], vn) for a, vn in zip(areas, v @ n)])
+                mujoco.mj_applyFT(m, d, dfn.sum() * n, np.cross(span, n) * float(np.dot(dfn, r)), origin, wing,
+                                  d.qfrc_passive)
+    if ud[U_RICH] > 0.5:
+        pc = ud[U_PHI_CMD]
+        Rd = np.array([[math.cos(pc), 0.0, -math.sin(pc)], [0.0, 1.0, 0.0], [math.sin(pc), 0.0, math.cos(pc)]])
+        e = 0.5 * sum(np.cross(R[:, k], Rd[:, k]) for k in range(3))
+        mujoco.mj_objectVelocity(m, d, _OBJ_XBODY, thorax, vel, 0)
+        sw, si = ud[U_SERVO_WN], ud[U_SERVO_I]
+        mujoco.mj_applyFT(m, d, zero, si * (sw * sw * e - 2.0 * sw * vel[:3]), d.xipos[thorax].copy(), thorax,
+                          d.qfrc_passive)
+
+
+# ---- model set-up ----------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Addresses the stepping loop needs (qpos/qvel indices), read by name from the model."""
+
+    rich: bool
+    q_forward: int
+    q_height: int
+    d_forward: int
+    d_height: int
+    q_pitch: int  # paper model: pitch hinge; rich: quaternion start
+    d_pitch: int
+    q_flap_left: int
+
+    def as_array(self) -> np.ndarray:
+        return np.array([int(self.rich), self.q_forward, self.q_height, self.d_forward, self.d_height,
+                         self.q_pitch, self.d_pitch, self.q_flap_left], dtype=np.int64)
+
+
+def check_config(config: str, force_mode: str) -> None:
+    if config not in CONFIGS:
+        raise UserError(f"unknown MuJoCo configuration {config!r}; choose one of: {', '.join(CONFIGS)}.")
+    if force_mode not in FORCE_MODES:
+        raise UserError(f"unknown wing-force mode {force_mode!r}; choose one of: {', '.join(FORCE_MODES)}.")
+
+
+def model_path(config: str = "paper") -> Path:
+    """Path of the MJCF file of a configuration ("paper" or "rich")."""
+    check_config(config, "tip")
+    return models_dir() / CONFIGS[config]
+
+
+def build_model(params: ButterflyParams | None = None, config: str = "paper") -> mujoco.MjModel:
+    """Compile the model with the physical constants of ``params`` (mass, L, W) applied via MjSpec.
+
+    The thorax takes the total mass ``m`` less the two wings; the wing meshes and their sites are
+    scaled to ``L`` and ``W``.
+    """
+    p = params or ButterflyParams()
+    spec = mujoco.MjSpec.from_file(str(model_path(config)))
+    wing_mass = spec.geom("wing_left").mass
+    if p.mass_kg <= 2.0 * wing_mass:
+        raise UserError(f"butterfly mass {p.mass_kg * 1e3:g} g is not more than its two wings ({2e3 * wing_mass:g} g).")
+    spec.geom("thorax").mass = p.mass_kg - 2.0 * wing_mass
+    for side, sign in (("left", 1.0), ("right", -1.0)):
+        spec.mesh(f"wing_{side}").scale = [p.width_m, p.span_m, 1.0]
+        spec.site(f"wing_{side}_cp").pos = [0.0, sign * CP_FRACTION * p.span_m, 0.0]
+        spec.site(f"wing_{side}_tip").pos = [0.0, sign * p.span_m, 0.0]
+    return spec.compile()
+
+
+def layout(m: mujoco.MjModel) -> Layout:
+    """Read joint addresses by name."""
+    def jq(name):
+        return int(m.jnt_qposadr[m.joint(name).id])
+
+    def jd(name):
+        return int(m.jnt_dofadr[m.joint(name).id])
+
+    if m.njnt and m.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE:
+        q0, d0 = jq("root"), jd("root")
+        return Layout(True, q0, q0 + 2, d0, d0 + 2, q0 + 3, d0 + 3, jq("flap_left"))
+    return Layout(False, jq("forward"), jq("height"), jd("forward"), jd("height"), jq("pitch"), jd("pitch"),
+                  jq("flap_left"))
+
+
+def setup_data(m: mujoco.MjModel, controller: ButterflyController, params: ButterflyParams | None = None,
+               condition: Condition | None = None, force_mode: str = "tip", n_strips: int = 16) -> mujoco.MjData:
+    """A fresh ``MjData`` at rest at the start altitude, its userdata filled for the callback."""
+    p = params or ButterflyParams()
+    cond = condition or Condition()
+    check_config("paper", force_mode)
+    if m.nuserdata < N_USERDATA:
+        raise ValueError(f"model needs <size nuserdata='{N_USERDATA}'/>")
+    d = mujoco.MjData(m)
+    mjabi.verify_offsets(d)
+    lay = layout(m)
+    ud = d.userdata
+    ud[:] = 0.0
+    ud[U_MODE] = FORCE_MODES[force_mode]
+    ud[U_RICH] = float(lay.rich)
+    air_fwd, air_up = cond.air_velocity()
+    ud[U_AIR : U_AIR + 3] = (air_fwd, 0.0, air_up)
+    ud[U_KHALF] = 0.5 * p.k_wings
+    ud[U_L], ud[U_W], ud[U_RHO], ud[U_CD], ud[U_AB] = p.span_m, p.width_m, p.rho, p.cd, p.body_area_m2
+    ud[U_FLAP : U_FLAP + 3] = controller.flap.as_array()
+    left, right = m.joint("flap_left"), m.joint("flap_right")
+    ud[U_DRIVE_A] = float(m.dof_armature[m.jnt_dofadr[left.id]])
+    ud[U_DRIVE_WN] = min(2.0 * math.pi * 50.0, 1.0 / m.opt.timestep)
+    ud[U_THORAX] = m.body("butterfly").id
+    ud[U_WING : U_WING + 2] = (m.body("wing_left").id, m.body("wing_right").id)
+    ud[U_FLAP_Q : U_FLAP_Q + 2] = (m.jnt_qposadr[left.id], m.jnt_qposadr[right.id])
+    ud[U_FLAP_D : U_FLAP_D + 2] = (m.jnt_dofadr[left.id], m.jnt_dofadr[right.id])
+    ud[U_CP] = CP_FRACTION * p.span_m
+    ud[U_NQ], ud[U_NV], ud[U_NBODY] = m.nq, m.nv, m.nbody
+    if not 1 <= n_strips <= MAX_STRIPS // 3:
+        raise UserError(f"number of strips must be between 1 and {MAX_STRIPS // 3}, got {n_strips}.")
+    x, dx = strip_nodes(p.span_m, n_strips, "gauss3")
+    ns = len(x)
+    ud[U_NSTRIP] = ns
+    ud[U_STRIP : U_STRIP + ns] = x
+    ud[U_STRIP + ns : U_STRIP + 2 * ns] = p.width_m * x / p.span_m * dx  # dS_2 (eq. 3)
+    # initial state: at rest at y0, wings at theta(0), pitch 0
+    d.qpos[lay.q_height] = cond.y0_m
+    th0 = controller.flap.theta(0.0)
+    d.qpos[left.id and m.jnt_qposadr[left.id]] = th0
+    d.qpos[m.jnt_qposadr[right.id]] = th0
+    d.qvel[m.jnt_dofadr[left.id]] = controller.flap.omega(0.0)
+    d.qvel[m.jnt_dofadr[right.id]] = controller.flap.omega(0.0)
+    if lay.rich:
+        mujoco.mj_forward(m, d)
+        M = np.zeros((m.nv, m.nv))
+        mujoco.mj_fullM(m, d, M)
+        ud[U_SERVO_I] = M[lay.d_pitch + 1, lay.d_pitch + 1]  # pitch inertia of the whole butterfly
+        ud[U_SERVO_WN] = min(2.0 * math.pi * 40.0, 0.5 / m.opt.timestep)
+    return d
+
+
+# ---- the compiled stepping loop -------------------------------------------------------------
+
+
+@njit(cache=False)
+def _run(mptr, dptr, qpos, qvel, ud, n_steps, record_every, kind, cp, flap, y0, lay, dt, out, diverged):
+    rich = lay[0] == 1
+    qf, qh, df, dh, qp, dp, ql = lay[1], lay[2], lay[3], lay[4], lay[5], lay[6], lay[7]
+    phi = 0.0
+    r = 1
+    countdown = record_every
+    for k in range(n_steps):
+        t = k * dt
+        theta = flap[0] + flap[1] * math.cos(flap[2] * t)
+        omega = -flap[1] * flap[2] * math.sin(flap[2] * t)
+        phi = pitch_command(kind, cp, t, theta, omega, qpos[qh] - y0, qpos[qf], qvel[dh], qvel[df], phi)
+        if rich:
+            ud[U_PHI_CMD] = phi
+        else:
+            qpos[qp] = phi
+            qvel[dp] = 0.0
+        _mj_step(mptr, dptr)
+        if not (abs(qvel[dh]) + abs(qvel[df]) < 1e4):
+            diverged[0] = k + 1
+            for rr in range(r, out.shape[0]):
+                for j in range(6):
+                    out[rr, j] = np.nan
+            return
+        countdown -= 1
+        if countdown == 0:
+            countdown = record_every
+            out[r, 0] = qpos[qh]
+            out[r, 1] = qpos[qf]
+            out[r, 2] = qvel[dh]
+            out[r, 3] = qvel[df]
+            if rich:
+                w, x, y, z = qpos[qp], qpos[qp + 1], qpos[qp + 2], qpos[qp + 3]
+                out[r, 4] = math.atan2(2.0 * (x * z - w * y), 1.0 - 2.0 * (y * y + z * z))
+            else:
+                out[r, 4] = qpos[qp]
+            out[r, 5] = qpos[ql]
+            r += 1
+
+
+def fly_one(m: mujoco.MjModel, controller: ButterflyController, params: ButterflyParams | None = None,
+            condition: Condition | None = None, duration_s: float = 20.0, record_every: int = 1,
+            force_mode: str = "tip", n_strips: int = 16, callback: str = "compiled") -> Trajectory:
+    """Fly one butterfly on model ``m`` (its timestep is the step). ``callback``: compiled|python."""
+    cond = condition or Condition()
+    dt = float(m.opt.timestep)
+    n_steps = check_timing(duration_s, dt, record_every)
+    d = setup_data(m, controller, params, cond, force_mode, n_strips)
+    lay = layout(m)
+    kind, cp = controller.compiled()
+    n_rec = n_steps // record_every + 1
+    out = np.empty((n_rec, 6))
+    out[0] = (d.qpos[lay.q_height], d.qpos[lay.q_forward], 0.0, 0.0, 0.0, d.qpos[lay.q_flap_left])
+    diverged = np.full(1, -1, dtype=np.int64)
+    if callback == "compiled":
+        with passive_callback(COMPILED_PASSIVE):
+            _run(m._address, d._address, d.qpos, d.qvel, d.userdata, n_steps, record_every, kind,
+                 np.ascontiguousarray(cp, dtype=float), controller.flap.as_array(), cond.y0_m, lay.as_array(), dt,
+                 out, diverged)
+    elif callback == "python":
+        _run_python(m, d, n_steps, record_every, controller, cond, lay, dt, out, diverged)
+    else:
+        raise UserError(f"unknown callback kind {callback!r}; choose compiled or python.")
+    t = np.arange(n_rec) * (record_every * dt)
+    return Trajectory(t=t, y=out[:, 0], z=out[:, 1], vy=out[:, 2], vz=out[:, 3], phi=out[:, 4], theta=out[:, 5],
+                      y0=cond.y0_m, flap_period_s=1.0 / controller.flap.frequency_hz, backend="mujoco",
+                      diverged_step=int(diverged[0]))
+
+
+def _run_python(m, d, n_steps, record_every, controller, cond, lay, dt, out, diverged):
+    """The stepping loop of :func:`_run` with the Python callback and controller (reference)."""
+    kind, cp = controller.compiled()
+    flap = controller.flap.as_array()
+    qpos, qvel = d.qpos, d.qvel
+    phi, r = 0.0, 1
+    with passive_callback(python_passive):
+        for k in range(n_steps):
+            t = k * dt
+            theta = flap[0] + flap[1] * math.cos(flap[2] * t)
+            omega = -flap[1] * flap[2] * math.sin(flap[2] * t)
+            phi = pitch_command.py_func(kind, cp, t, theta, omega, qpos[lay.q_height] - cond.y0_m,
+                                        qpos[lay.q_forward], qvel[lay.d_height], qvel[lay.d_forward], phi)
+            if lay.rich:
+                d.userdata[U_PHI_CMD] = phi
+            else:
+                qpos[lay.q_pitch] = phi
+                qvel[lay.d_pitch] = 0.0
+            mujoco.mj_step(m, d)
+            if not abs(qvel[lay.d_height]) + abs(qvel[lay.d_forward]) < 1e4:
+                diverged[0] = k + 1
+                out[r:] = np.nan
+                return
+            if (k + 1) % record_every == 0:
+                if lay.rich:
+                    w, x, y, z = qpos[lay.q_pitch : lay.q_pitch + 4]
+                    ph = math.atan2(2.0 * (x * z - w * y), 1.0 - 2.0 * (y * y + z * z))
+                else:
+                    ph = qpos[lay.q_pitch]
+                out[r] = (qpos[lay.q_height], qpos[lay.q_forward], qvel[lay.d_height], qvel[lay.d_forward], ph,
+                          qpos[lay.q_flap_left])
+                r += 1
+
+
+def simulate(controllers, params=None, conditions=None, duration_s: float = 20.0, dt_s: float = 1.0 / 1200.0,
+             record_every: int = 1, config: str = "paper", force_mode: str = "tip", n_strips: int = 16,
+             callback: str = "compiled") -> list[Trajectory]:
+    """Fly a batch (one after another) on the MuJoCo backend; same interface as ``paper.simulate``."""
+    check_config(config, force_mode)
+    ctrls = [controllers] if isinstance(controllers, ButterflyController) else list(controllers)
+    ps = [params] if params is None or isinstance(params, ButterflyParams) else list(params)
+    cs = [conditions] if conditions is None or isinstance(conditions, Condition) else list(conditions)
+    n = max(len(ctrls), len(ps), len(cs))
+    if any(len(x) not in (1, n) for x in (ctrls, ps, cs)):
+        raise UserError("batch sizes disagree between controllers, parameters and conditions.")
+    ctrls, ps, cs = (x * n if len(x) == 1 else x for x in (ctrls, ps, cs))
+    check_timing(duration_s, dt_s, record_every)
+    models: dict = {}
+    out = []
+    for c, p, cond in zip(ctrls, ps, cs):
+        key = p or ButterflyParams()
+        if key not in models:
+            models[key] = build_model(key, config)
+            models[key].opt.timestep = dt_s
+        out.append(fly_one(models[key], c, key, cond, duration_s, record_every, force_mode, n_strips, callback))
+    return out
