@@ -1,0 +1,1 @@
+"""Figures of the papers' experiments, side by side with the papers' numbers (matplotlib)."""
