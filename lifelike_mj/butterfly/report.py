@@ -10,15 +10,14 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import sys
-import tempfile
 import time
 from dataclasses import asdict
 from pathlib import Path
 
 from lifelike_mj.butterfly import experiments
 from lifelike_mj.butterfly.params import ButterflyParams
+from lifelike_mj.io import write_text
 from lifelike_mj.viz import figures
 
 FIGURES = {
@@ -27,24 +26,6 @@ FIGURES = {
     "fig4": "fig4_trim.png",
     "fig5": "fig5_timestep.png",
 }
-
-
-def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` through a temporary file in the same folder and
-    ``os.replace``, so readers never see a half-written file."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
 
 
 def _fmt(x: float, digits: int = 4) -> str:
@@ -206,7 +187,7 @@ def reproduce(
         "figures": dict(FIGURES),
         "elapsed_s": time.perf_counter() - t0,
     }
-    write_text_atomic(out / "results.json", json.dumps(results, indent=1, allow_nan=True) + "\n")
-    write_text_atomic(out / "report.md", _markdown(results, extra_sections))
+    write_text(out / "results.json", json.dumps(results, indent=1, allow_nan=True) + "\n")
+    write_text(out / "report.md", _markdown(results, extra_sections))
     say(f"wrote {out / 'report.md'} in {results['elapsed_s']:.1f} s")
     return results

@@ -1,0 +1,338 @@
+"""The ``lifelike-mj`` command.
+
+Every error a user can cause ends in one sentence on stderr and exit status 2; imports are lazy so
+that ``--help`` is instant and the GL backend can be chosen before MuJoCo is imported.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+from pathlib import Path
+
+from lifelike_mj.errors import UserError
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # one sentence, exit 2 (argparse prints usage otherwise)
+        raise UserError(f"{message} (see '{self.prog} --help').")
+
+
+def _wind(text: str) -> tuple[float, float]:
+    parts = text.split(",")
+    try:
+        a, b = (float(p) for p in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--wind needs two numbers A,B in m/s, got {text!r}") from None
+    if not (math.isfinite(a) and math.isfinite(b)):
+        raise argparse.ArgumentTypeError(f"--wind needs two finite numbers, got {text!r}")
+    return a, b
+
+
+def _add_physics(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("physical constants (defaults: Oe 2010, A_b = 1.0 cm^2)")
+    g.add_argument("--body-area-cm2", type=float, help="body projected area A_b (eq. 10), cm^2")
+    g.add_argument("--mass-g", type=float, help="butterfly mass m, g (paper: 0.319)")
+    g.add_argument("--span-cm", type=float, help="wing length L, cm (paper: 5.5)")
+    g.add_argument("--width-cm", type=float, help="wing width W, cm (paper: 5.0)")
+    g.add_argument("--rho", type=float, help="air density, kg/m^3 (paper: 1.28)")
+    g.add_argument("--cd", type=float, help="drag coefficient C_d (paper: 2.2)")
+
+
+def _params(args):
+    from lifelike_mj.butterfly.params import ButterflyParams
+
+    return ButterflyParams().with_overrides(
+        body_area_cm2=args.body_area_cm2, mass_g=args.mass_g, span_cm=args.span_cm, width_cm=args.width_cm,
+        rho=args.rho, cd=args.cd)
+
+
+def _add_controller(p: argparse.ArgumentParser, required: bool = True) -> None:
+    p.add_argument("--controller", required=required, default=None if required else "simple_rule",
+                   help="shipped controller name (e.g. simple_rule) or path to a controller JSON file")
+    p.add_argument("--phi-up-deg", type=float, help="override simple_rule's upstroke pitch, deg")
+    p.add_argument("--phi-down-deg", type=float, help="override simple_rule's downstroke pitch, deg")
+    p.add_argument("--phi-deg", type=float, help="override a constant controller's pitch, deg")
+
+
+def _controller(args):
+    from lifelike_mj.butterfly import controllers
+
+    ctrl = controllers.load(args.controller)
+    overrides = {"phi_up_deg": args.phi_up_deg, "phi_down_deg": args.phi_down_deg, "phi_deg": args.phi_deg}
+    return ctrl.with_parameters(**overrides)
+
+
+def _add_backend(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--backend", default="paper", help="paper (eq. 7-11, compiled) or mujoco (models/butterfly.xml)")
+    p.add_argument("--config", default="paper", help="MuJoCo configuration: paper (equivalent) or rich")
+    p.add_argument("--force-mode", default=None, help="MuJoCo wing force: tip (paper formula) or strip")
+
+
+def _backend_options(args) -> dict:
+    from lifelike_mj.butterfly.backends import check_backend
+    from lifelike_mj.butterfly.compare import DEFAULT_FORCE_MODE
+
+    check_backend(args.backend)
+    if args.backend != "mujoco":
+        return {}
+    if args.config not in DEFAULT_FORCE_MODE:
+        raise UserError(f"unknown configuration {args.config!r}; choose paper or rich.")
+    return {"config": args.config, "force_mode": args.force_mode or DEFAULT_FORCE_MODE[args.config]}
+
+
+def _positive(name: str, value: float) -> float:
+    if not (math.isfinite(value) and value > 0):
+        raise UserError(f"{name} must be a positive number, got {value}.")
+    return value
+
+
+def _emit(args, data: dict, human: str) -> None:
+    print(json.dumps(data, indent=2) if getattr(args, "json", False) else human)
+
+
+# ---- commands ---------------------------------------------------------------------------------
+
+
+def cmd_speed_limit(args) -> None:
+    from lifelike_mj.butterfly import aero
+
+    r = aero.speed_limit(_params(args))
+    _emit(args, r.to_dict(), f"speed limit: {r.speed_limit_cm_s} cm/s at A_b = {r.body_area_cm2:g} cm^2 "
+          f"(continuous solution {100 * r.closed_form_m_s:.1f} cm/s; paper: 380 cm/s)")
+
+
+def cmd_forces(args) -> None:
+    from lifelike_mj.butterfly import aero
+
+    r = aero.check_closed_forms(_params(args))
+    lines = [f"{q:6s} planform {k}: closed form {c:.6e}, strips {s:.6e}, rel. error {e:.1e}" for q, k, c, s, e in r.rows]
+    lines.append(f"largest relative error: {r.closed_form_max_rel_error:.2e}")
+    _emit(args, r.to_dict(), "\n".join(lines))
+
+
+def cmd_trim(args) -> None:
+    from lifelike_mj.butterfly import experiments
+
+    opts = _backend_options(args)
+    r = experiments.e4_trim(_params(args), backend=args.backend, dt_s=_positive("--dt", args.dt), **opts)
+    d = r.to_dict()
+    _emit(args, d, f"level flight at phi_up = {d['phi_up_level_deg']:.3f} deg (paper 12.77); settled forward speed "
+          f"{d['mean_forward_speed_cm_s']:.1f} cm/s (paper 340); ripple {d['ripple_cm']:.2f} cm (paper 5.3); "
+          f"initial drop {d['initial_drop_m']:.2f} m (paper about 3)")
+
+
+def cmd_timestep(args) -> None:
+    from lifelike_mj.butterfly import experiments
+
+    opts = _backend_options(args)
+    r = experiments.e5_timestep(_params(args), backend=args.backend, **opts)
+    d = r.to_dict()
+    rows = [f"dt {k:>8s}: altitude at 20 s {d['altitude_20s_m'][k]:8.3f} m, rel. error {d['rel_error'][k]:.2e}"
+            for k in d["altitude_20s_m"]]
+    _emit(args, d, "\n".join(rows))
+
+
+def cmd_fly(args) -> None:
+    from lifelike_mj.butterfly import backends
+    from lifelike_mj.butterfly.paper import Condition, check_timing
+
+    ctrl = _controller(args)
+    params = _params(args)
+    opts = _backend_options(args)
+    check_timing(args.duration, args.dt)
+    cond = Condition(args.y0, args.wind)
+    traj = backends.simulate(args.backend, ctrl, params, cond, args.duration, args.dt, 1, **opts)[0]
+    summary = {"controller": ctrl.name or args.controller, **traj.summary(), **({"config": opts} if opts else {})}
+    if traj.diverged_step >= 0:
+        raise UserError(f"the flight diverged (runaway speed) at step {traj.diverged_step}.")
+    if args.out:
+        from lifelike_mj.io import atomic_path, write_json, write_text
+        from lifelike_mj.viz.flight import fig_flight
+
+        out = Path(args.out)
+        import numpy as np
+
+        with atomic_path(out / "trajectory.npz") as tmp:
+            with open(tmp, "wb") as fh:
+                np.savez_compressed(fh, **traj.to_npz_dict())
+        write_text(out / "trajectory.csv", traj.to_csv())
+        fig_flight(traj, out / "flight.png", f"{summary['controller']} on the {args.backend} backend")
+        write_json(out / "summary.json", summary)
+    human = (f"final altitude {summary['final_altitude_m']:.3f} m, min {summary['min_altitude_m']:.3f} m, "
+             f"mean forward speed {summary['mean_forward_speed_cm_s']:.1f} cm/s; last 10 s: altitude in "
+             f"[{summary['settled_altitude_min_m']:.3f}, {summary['settled_altitude_max_m']:.3f}] m, "
+             f"speed {summary['settled_forward_speed_cm_s']:.1f} cm/s")
+    _emit(args, summary, human)
+
+
+def cmd_compare(args) -> None:
+    from lifelike_mj.butterfly.compare import compare
+
+    ctrl = _controller(args)
+    r = compare(ctrl, args.config, _params(args), duration_s=_positive("--duration", args.duration),
+                dt_s=_positive("--dt", args.dt), force_mode=args.force_mode)
+    d = r.to_dict()
+    _emit(args, d, f"{args.config} configuration ({r.force_mode} force): largest altitude difference "
+          f"{r.max_altitude_diff_m * 100:.2f} cm ({100 * r.altitude_diff_fraction:.2f} % of the "
+          f"{r.max_altitude_excursion_m:.2f} m excursion), largest forward difference {r.max_forward_diff_m * 100:.2f} cm")
+
+
+def cmd_reproduce(args) -> None:
+    if args.what != "butterfly":
+        raise UserError(f"nothing to reproduce for {args.what!r} yet; available: butterfly.")
+    from lifelike_mj.butterfly.reproduce import reproduce_all
+
+    out = Path(args.out)
+    reproduce_all(out, _params(args))
+    print(f"report written to {out / 'report.md'}")
+
+
+def cmd_bench(args) -> None:
+    if args.what != "butterfly":
+        raise UserError(f"no benchmark for {args.what!r} yet; available: butterfly.")
+    from lifelike_mj.butterfly import bench
+
+    r = bench.run(repeats=args.repeats)
+    if args.out:
+        from lifelike_mj.io import write_json
+
+        write_json(args.out, r)
+    human = (f"paper backend {r['paper_ns_per_step']:.1f} ns/step (naive Python {r['naive_ns_per_step']:.0f} ns/step, "
+             f"x{r['paper_speedup_vs_naive']:.0f}); MuJoCo bare {r['mujoco_bare_us_per_step']:.2f} us/step, with "
+             f"callback+controller {r['mujoco_us_per_step']:.2f} us/step (+{100 * r['mujoco_callback_overhead']:.0f} %)")
+    _emit(args, r, human)
+
+
+def cmd_view(args) -> None:
+    if args.what != "butterfly":
+        raise UserError(f"nothing to view for {args.what!r} yet; available: butterfly.")
+    from lifelike_mj.butterfly.paper import Condition
+    from lifelike_mj.viz.viewer import view_butterfly
+
+    view_butterfly(_controller(args), _params(args), Condition(args.y0, args.wind), config=args.config,
+                   force_mode=args.force_mode or ("strip" if args.config == "rich" else "tip"),
+                   duration_s=args.duration)
+
+
+def cmd_render(args) -> None:
+    if args.what != "butterfly":
+        raise UserError(f"nothing to render for {args.what!r} yet; available: butterfly.")
+    if Path(args.out).suffix.lower() not in (".mp4", ".gif"):
+        raise UserError(f"--out must end in .mp4 or .gif, got {args.out!r}.")
+    from lifelike_mj.butterfly.paper import Condition
+    from lifelike_mj.viz.video import render_butterfly
+
+    info = render_butterfly(args.out, _controller(args), _params(args), Condition(args.y0, args.wind),
+                            config=args.config, force_mode=args.force_mode or ("strip" if args.config == "rich" else "tip"),
+                            duration_s=_positive("--duration", args.duration), fps=args.fps, width=args.width,
+                            height=args.height)
+    _emit(args, info, f"wrote {info['frames']} frames to {args.out}")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from lifelike_mj import __version__
+
+    top = _Parser(prog="lifelike-mj", description="Creatures that move like living things, by physics on MuJoCo.")
+    top.add_argument("--version", action="version", version=f"lifelike-mj {__version__}")
+    sub = top.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    bf = sub.add_parser("butterfly", help="the butterfly of Oe et al. 2010").add_subparsers(
+        dest="sub", required=True, parser_class=_Parser)
+    p = bf.add_parser("speed-limit", help="E3: quasi-static forward-speed limit (section 4.3)")
+    _add_physics(p)
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_speed_limit)
+    p = bf.add_parser("forces", help="E1: closed forms (eq. 4, 6) against strip integration")
+    _add_physics(p)
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_forces)
+    p = bf.add_parser("trim", help="E4: level-flight upstroke pitch of the simple rule (section 5.1)")
+    _add_physics(p)
+    _add_backend(p)
+    p.add_argument("--dt", type=float, default=1.0 / 12000.0, help="time step, s (paper: 1/12000)")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_trim)
+    p = bf.add_parser("timestep", help="E5: time-step study at phi_up = 14 deg (section 5.2)")
+    _add_physics(p)
+    _add_backend(p)
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_timestep)
+    p = bf.add_parser("fly", help="fly a controller")
+    _add_controller(p)
+    _add_physics(p)
+    _add_backend(p)
+    p.add_argument("--y0", type=float, default=0.0, help="start altitude, m")
+    p.add_argument("--wind", type=_wind, default=(0.0, 0.0), help="wind A,B in m/s: where it comes from (forward, up)")
+    p.add_argument("--duration", type=float, default=20.0, help="seconds")
+    p.add_argument("--dt", type=float, default=1.0 / 1200.0, help="time step, s")
+    p.add_argument("--out", help="folder for trajectory.npz/.csv, flight.png, summary.json")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_fly)
+    p = bf.add_parser("compare", help="the same flight on both backends")
+    _add_controller(p)
+    _add_physics(p)
+    p.add_argument("--config", default="paper", help="paper (equivalent) or rich (free body, heavy wings, strips)")
+    p.add_argument("--force-mode", default=None, help="tip or strip (default: tip for paper, strip for rich)")
+    p.add_argument("--duration", type=float, default=20.0)
+    p.add_argument("--dt", type=float, default=1.0 / 1200.0)
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_compare)
+
+    p = sub.add_parser("reproduce", help="run a paper's experiments and write a report")
+    p.add_argument("what", help="butterfly")
+    p.add_argument("--out", default="reports/butterfly", help="output folder")
+    _add_physics(p)
+    p.set_defaults(func=cmd_reproduce)
+
+    p = sub.add_parser("bench", help="speed benchmark")
+    p.add_argument("what", help="butterfly")
+    p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--out", help="also write the JSON here")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_bench)
+
+    for name, func, helptext in (("view", cmd_view, "open the MuJoCo viewer"),
+                                 ("render", cmd_render, "render a video offscreen")):
+        p = sub.add_parser(name, help=helptext)
+        p.add_argument("what", help="butterfly")
+        _add_controller(p, required=False)
+        _add_physics(p)
+        p.add_argument("--config", default="paper", help="paper or rich")
+        p.add_argument("--force-mode", default=None, help="tip or strip")
+        p.add_argument("--y0", type=float, default=0.0)
+        p.add_argument("--wind", type=_wind, default=(0.0, 0.0))
+        if name == "view":
+            p.add_argument("--duration", type=float, default=None, help="stop after this many seconds")
+        else:
+            p.add_argument("--out", required=True, help="FILE.mp4 or FILE.gif")
+            p.add_argument("--duration", type=float, default=3.0)
+            p.add_argument("--fps", type=int, default=30)
+            p.add_argument("--width", type=int, default=640)
+            p.add_argument("--height", type=int, default=480)
+            p.add_argument("--json", action="store_true")
+        p.set_defaults(func=func)
+    return top
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] in (["render"], ["reproduce"]):
+        os.environ.setdefault("MUJOCO_GL", "egl")
+    try:
+        args = build_parser().parse_args(argv)
+        args.func(args)
+    except UserError as exc:
+        print(f"lifelike-mj: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("lifelike-mj: interrupted.", file=sys.stderr)
+        return 130
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,105 @@
+"""The command line: documented keys, and bad input as one sentence with exit status 2."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from lifelike_mj.cli import main
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_speed_limit_json(capsys):
+    code, out, _ = run(capsys, "butterfly", "speed-limit", "--body-area-cm2", "1.53", "--json")
+    assert code == 0 and json.loads(out)["speed_limit_cm_s"] == 380
+    code, out, _ = run(capsys, "butterfly", "speed-limit", "--json")
+    assert json.loads(out)["speed_limit_cm_s"] == 438
+
+
+def test_forces_json(capsys):
+    code, out, _ = run(capsys, "butterfly", "forces", "--json")
+    assert code == 0 and json.loads(out)["closed_form_max_rel_error"] < 1e-12
+
+
+def test_fly_json_and_out(capsys, tmp_path):
+    code, out, _ = run(capsys, "butterfly", "fly", "--controller", "simple_rule", "--duration", "12", "--json",
+                       "--out", str(tmp_path), "--phi-up-deg", "14")
+    assert code == 0
+    d = json.loads(out)
+    for key in ("final_altitude_m", "min_altitude_m", "mean_forward_speed_cm_s", "settled_altitude_min_m",
+                "settled_altitude_max_m", "settled_forward_speed_cm_s"):
+        assert key in d
+    assert d["settled_altitude_max_m"] > d["settled_altitude_min_m"]
+    for name in ("trajectory.npz", "trajectory.csv", "flight.png", "summary.json"):
+        assert (tmp_path / name).stat().st_size > 0
+    assert not list(tmp_path.glob(".*"))  # no temporary files left behind
+
+
+def test_fly_mujoco_backend(capsys):
+    code, out, _ = run(capsys, "butterfly", "fly", "--controller", "simple_rule", "--backend", "mujoco",
+                       "--duration", "2", "--json")
+    assert code == 0 and json.loads(out)["backend"] == "mujoco"
+
+
+def test_compare_json(capsys):
+    code, out, _ = run(capsys, "butterfly", "compare", "--controller", "simple_rule", "--duration", "5", "--json")
+    d = json.loads(out)
+    assert code == 0 and {"max_altitude_diff_m", "max_forward_diff_m"} <= d.keys()
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["butterfly", "fly", "--controller", "no_such_controller"],
+        ["butterfly", "fly", "--controller", "simple_rule", "--duration", "-1"],
+        ["butterfly", "fly", "--controller", "simple_rule", "--wind", "1"],
+        ["butterfly", "fly", "--controller", "simple_rule", "--wind", "a,b"],
+        ["butterfly", "fly", "--controller", "simple_rule", "--backend", "nope"],
+        ["butterfly", "fly", "--controller", "simple_rule", "--dt", "0"],
+        ["butterfly", "speed-limit", "--body-area-cm2", "-1"],
+        ["butterfly", "compare", "--controller", "simple_rule", "--config", "nope"],
+        ["butterfly", "fly", "--controller", "simple_rule", "--phi-deg", "3"],
+        ["butterfly", "nosuchcommand"],
+        ["render", "butterfly", "--out", "video.avi"],
+    ],
+)
+def test_bad_input_one_sentence_exit_2(capsys, argv):
+    code, out, err = run(capsys, *argv)
+    assert code == 2
+    lines = [line for line in err.strip().splitlines() if line]
+    assert len(lines) == 1 and lines[0].startswith("lifelike-mj: error:")
+    assert "Traceback" not in err
+
+
+def test_malformed_controller_files(capsys, tmp_path):
+    cases = {
+        "notjson.json": "{not json",
+        "list.json": "[1, 2]",
+        "noformat.json": json.dumps({"type": "simple_rule"}),
+        "badtype.json": json.dumps({"format": "lifelike-mj/butterfly-controller", "type": "warp",
+                                    "flap": {"theta_min_deg": -90, "theta_max_deg": 90}, "parameters": {}}),
+        "missing.json": json.dumps({"format": "lifelike-mj/butterfly-controller", "type": "simple_rule",
+                                    "flap": {"theta_min_deg": -90, "theta_max_deg": 90}, "parameters": {"phi_up_deg": 1}}),
+        "badflap.json": json.dumps({"format": "lifelike-mj/butterfly-controller", "type": "constant",
+                                    "flap": {"theta_min_deg": 90, "theta_max_deg": -90}, "parameters": {"phi_deg": 0}}),
+        "strparam.json": json.dumps({"format": "lifelike-mj/butterfly-controller", "type": "constant",
+                                     "flap": {"theta_min_deg": 0, "theta_max_deg": 0}, "parameters": {"phi_deg": "x"}}),
+    }
+    for name, text in cases.items():
+        path = tmp_path / name
+        path.write_text(text)
+        code, _, err = run(capsys, "butterfly", "fly", "--controller", str(path), "--duration", "1")
+        assert code == 2, name
+        assert len(err.strip().splitlines()) == 1, name
+
+
+def test_console_script_exit_code_without_traceback():
+    proc = subprocess.run([sys.executable, "-m", "lifelike_mj.cli", "butterfly", "fly", "--controller", "nope"],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
