@@ -9,7 +9,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
 import sys
 from pathlib import Path
 
@@ -321,7 +320,9 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if argv[:1] in (["render"], ["reproduce"]):
-        os.environ.setdefault("MUJOCO_GL", "egl")
+        from lifelike_mj.viz.video import ensure_gl_backend
+
+        ensure_gl_backend()  # before anything imports mujoco
     try:
         args = build_parser().parse_args(argv)
         args.func(args)

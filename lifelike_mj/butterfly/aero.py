@@ -149,7 +149,9 @@ class Fig3Curves:
         }
 
 
-def fig3_curves(p: ButterflyParams | None = None, omega: float = 20.0 * math.pi, speeds=(0.0, 2.0, 4.0), n: int = 361) -> Fig3Curves:
+def fig3_curves(
+    p: ButterflyParams | None = None, omega: float = 20.0 * math.pi, speeds=(0.0, 2.0, 4.0), n: int = 361
+) -> Fig3Curves:
     """E2 (Fig. 3): eq. 8-9 at ``theta = 0`` over ``phi`` in [-90, 90] deg."""
     p = p or ButterflyParams()
     phi_deg = np.linspace(-90.0, 90.0, n)
