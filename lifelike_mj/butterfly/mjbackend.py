@@ -450,13 +450,12 @@ def setup_data(m: mujoco.MjModel, controller: ButterflyController, params: Butte
 
 
 @njit(cache=False)
-def _run(mptr, dptr, qpos, qvel, ud, n_steps, record_every, kind, cp, flap, y0, lay, dt, out, diverged):
+def advance(mptr, dptr, qpos, qvel, ud, k0, n_steps, kind, cp, flap, y0, lay, dt, phi, diverged):
+    """Steps ``k0 .. k0 + n_steps - 1`` (time ``t = k dt``): the controller sets the pitch once per
+    step, then ``mj_step``. Returns the last pitch (rad); sets ``diverged[0]`` on a runaway."""
     rich = lay[0] == 1
-    qf, qh, df, dh, qp, dp, ql = lay[1], lay[2], lay[3], lay[4], lay[5], lay[6], lay[7]
-    phi = 0.0
-    r = 1
-    countdown = record_every
-    for k in range(n_steps):
+    qf, qh, df, dh, qp, dp = lay[1], lay[2], lay[3], lay[4], lay[5], lay[6]
+    for k in range(k0, k0 + n_steps):
         t = k * dt
         theta = flap[0] + flap[1] * math.cos(flap[2] * t)
         omega = -flap[1] * flap[2] * math.sin(flap[2] * t)
@@ -469,13 +468,28 @@ def _run(mptr, dptr, qpos, qvel, ud, n_steps, record_every, kind, cp, flap, y0, 
         _mj_step(mptr, dptr)
         if not (abs(qvel[dh]) + abs(qvel[df]) < 1e4):
             diverged[0] = k + 1
+            return phi
+    return phi
+
+
+@njit(cache=False)
+def _run(mptr, dptr, qpos, qvel, ud, n_steps, record_every, kind, cp, flap, y0, lay, dt, out, diverged):
+    """:func:`advance` over the whole flight, recording a row every ``record_every`` steps."""
+    rich = lay[0] == 1
+    qf, qh, df, dh, qp, ql = lay[1], lay[2], lay[3], lay[4], lay[5], lay[7]
+    phi = 0.0
+    r = 1
+    k = 0
+    while k < n_steps:
+        n = min(record_every, n_steps - k)
+        phi = advance(mptr, dptr, qpos, qvel, ud, k, n, kind, cp, flap, y0, lay, dt, phi, diverged)
+        k += n
+        if diverged[0] >= 0:
             for rr in range(r, out.shape[0]):
                 for j in range(6):
                     out[rr, j] = np.nan
             return
-        countdown -= 1
-        if countdown == 0:
-            countdown = record_every
+        if n == record_every:
             out[r, 0] = qpos[qh]
             out[r, 1] = qpos[qf]
             out[r, 2] = qvel[dh]

@@ -219,41 +219,13 @@ class _Offscreen:
 
 # ---- the stepping loop, resumable ------------------------------------------------------------
 
-_ADVANCE = None
 
 
 def _advance_fn():
-    """Compile (once) the resumable twin of ``mjbackend._run``."""
-    global _ADVANCE
-    if _ADVANCE is None:
-        from numba import njit
+    """The resumable stepping loop shared with ``fly_one``: ``mjbackend.advance``."""
+    from lifelike_mj.butterfly.mjbackend import advance
 
-        from lifelike_mj.butterfly.mjbackend import U_PHI_CMD, _mj_step
-        from lifelike_mj.butterfly.paper import pitch_command
-
-        @njit(cache=False)
-        def advance(mptr, dptr, qpos, qvel, ud, k0, n_steps, kind, cp, flap, y0, lay, dt, phi, diverged):
-            """Steps ``k0 .. k0 + n_steps - 1`` of ``_run`` (time ``t = k dt``); returns the last pitch."""
-            rich = lay[0] == 1
-            qf, qh, df, dh, qp, dp = lay[1], lay[2], lay[3], lay[4], lay[5], lay[6]
-            for k in range(k0, k0 + n_steps):
-                t = k * dt
-                theta = flap[0] + flap[1] * math.cos(flap[2] * t)
-                omega = -flap[1] * flap[2] * math.sin(flap[2] * t)
-                phi = pitch_command(kind, cp, t, theta, omega, qpos[qh] - y0, qpos[qf], qvel[dh], qvel[df], phi)
-                if rich:
-                    ud[U_PHI_CMD] = phi
-                else:
-                    qpos[qp] = phi
-                    qvel[dp] = 0.0
-                _mj_step(mptr, dptr)
-                if not (abs(qvel[dh]) + abs(qvel[df]) < 1e4):
-                    diverged[0] = k + 1
-                    return phi
-            return phi
-
-        _ADVANCE = advance
-    return _ADVANCE
+    return advance
 
 
 class _Flight:
