@@ -1,0 +1,248 @@
+"""Evaluate batches of candidates: in-process, on a pool of local processes, or on a ray cluster.
+
+Because :meth:`Problem.evaluate` is pure, every executor gives bit-identical fitness arrays; they differ
+only in speed. A batch ``X`` of ``n`` rows is split into contiguous chunks (one per worker) and the
+results are concatenated in order.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import multiprocessing
+import os
+import signal
+import time
+from typing import Any
+
+import numpy as np
+
+from lifelike_mj.errors import UserError
+from lifelike_mj.evolve.problem import check_problem
+
+#: Names accepted by :func:`make_evaluator`.
+EXECUTORS = ("serial", "process", "ray")
+
+
+def as_fitness(values: Any, n: int) -> np.ndarray:
+    """``values`` as an ``(n,)`` float64 array; ``ValueError`` if the problem returned a different number of values."""
+    f = np.asarray(values, dtype=np.float64)
+    if f.size != n:
+        raise ValueError(f"problem.evaluate returned shape {f.shape} for {n} candidates; expected ({n},)")
+    return f.reshape(n)
+
+
+def _limit_threads() -> None:
+    """One thread per worker for numba (when installed), so workers do not oversubscribe the cores."""
+    try:
+        import numba
+
+        numba.set_num_threads(1)
+    except Exception:  # numba missing, or its threading layer unavailable: nothing to limit
+        pass
+
+
+class Evaluator:
+    """Base of all evaluators: a context manager whose call maps ``X (n, dim)`` to fitness ``(n,)``.
+
+    Counters: ``calls`` (batches evaluated), ``evaluations`` (rows evaluated), ``busy_s`` (wall seconds
+    spent inside calls).
+    """
+
+    executor = "base"
+
+    def __init__(self, problem: Any, workers: int = 1) -> None:
+        dim, _, _ = check_problem(problem, needs_bounds=False)
+        self.problem = problem
+        self.dim = dim
+        self.workers = int(workers)
+        self.calls = 0
+        self.evaluations = 0
+        self.busy_s = 0.0
+        self.closed = False
+
+    def __call__(self, X: np.ndarray) -> np.ndarray:
+        """Fitness of each row of ``X`` (converted to a C-contiguous ``(n, dim)`` float64 array)."""
+        if self.closed:
+            raise RuntimeError(f"the {self.executor} evaluator is closed")
+        X = np.ascontiguousarray(X, dtype=np.float64)
+        if X.ndim != 2 or X.shape[1] != self.dim:
+            raise ValueError(f"expected candidates of shape (n, {self.dim}), got {X.shape}")
+        n = X.shape[0]
+        if n == 0:
+            return np.empty(0, dtype=np.float64)
+        t0 = time.perf_counter()
+        try:
+            f = self._evaluate(X)
+        finally:
+            self.busy_s += time.perf_counter() - t0
+        self.calls += 1
+        self.evaluations += n
+        return as_fitness(f, n)
+
+    def _chunks(self, X: np.ndarray) -> list[np.ndarray]:
+        """Split ``X`` into ``min(workers, n)`` contiguous chunks of near-equal size."""
+        return [np.ascontiguousarray(c) for c in np.array_split(X, min(self.workers, X.shape[0]))]
+
+    def _evaluate(self, X: np.ndarray) -> np.ndarray:  # pragma: no cover - overridden
+        raise NotImplementedError
+
+    def close(self) -> None:
+        """Release workers (idempotent)."""
+        self.closed = True
+
+    def __enter__(self) -> Evaluator:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} workers={self.workers} calls={self.calls} evaluations={self.evaluations}>"
+
+
+class SerialEvaluator(Evaluator):
+    """Evaluate in this process: one ``problem.evaluate(X)`` call per batch."""
+
+    executor = "serial"
+
+    def _evaluate(self, X: np.ndarray) -> np.ndarray:
+        return self.problem.evaluate(X)
+
+
+# --- process pool ----------------------------------------------------------------------------------
+
+_WORKER_PROBLEM: Any = None
+
+
+def _process_init(problem: Any) -> None:
+    """Pool initializer: keep the problem, ignore SIGINT (Ctrl-C is the parent's business), one numba thread."""
+    global _WORKER_PROBLEM
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _limit_threads()
+    _WORKER_PROBLEM = problem
+
+
+def _process_chunk(X: np.ndarray) -> np.ndarray:
+    return as_fitness(_WORKER_PROBLEM.evaluate(X), X.shape[0])
+
+
+class ProcessEvaluator(Evaluator):
+    """Evaluate on a local :class:`concurrent.futures.ProcessPoolExecutor` (``spawn`` start method).
+
+    The problem is sent once to each worker (pool initializer); each batch is split into one contiguous
+    chunk per worker. Workers ignore SIGINT, so a Ctrl-C in a terminal interrupts only the parent,
+    which then cancels the outstanding chunks. As with any ``spawn`` pool, a script that uses it needs the
+    usual ``if __name__ == "__main__":`` guard, and the problem's class must be importable by the workers.
+    """
+
+    executor = "process"
+
+    def __init__(self, problem: Any, workers: int) -> None:
+        super().__init__(problem, workers)
+        self._abandoned = False
+        self._pool = concurrent.futures.ProcessPoolExecutor(
+            max_workers=self.workers, mp_context=multiprocessing.get_context("spawn"),
+            initializer=_process_init, initargs=(problem,))
+
+    def _evaluate(self, X: np.ndarray) -> np.ndarray:
+        futures = [self._pool.submit(_process_chunk, c) for c in self._chunks(X)]
+        try:
+            return np.concatenate([fut.result() for fut in futures])
+        except BaseException:
+            for fut in futures:
+                fut.cancel()
+            self._abandoned = any(not fut.done() for fut in futures)
+            raise
+
+    def close(self) -> None:
+        """Shut the pool down: cancel queued chunks; wait for running ones, unless a call was interrupted
+        while chunks were still running (Ctrl-C): then the workers are terminated at once."""
+        if not self.closed:
+            self.closed = True
+            if getattr(self, "_abandoned", False):
+                for proc in list((getattr(self._pool, "_processes", None) or {}).values()):
+                    try:
+                        proc.terminate()
+                    except Exception:
+                        pass
+            self._pool.shutdown(wait=True, cancel_futures=True)
+
+
+# --- ray -----------------------------------------------------------------------------------------
+
+_RAY_THREADS_LIMITED = False
+
+
+def _ray_chunk(problem: Any, X: np.ndarray) -> np.ndarray:
+    global _RAY_THREADS_LIMITED
+    if not _RAY_THREADS_LIMITED:
+        _limit_threads()
+        _RAY_THREADS_LIMITED = True
+    return as_fitness(problem.evaluate(X), X.shape[0])
+
+
+class RayEvaluator(Evaluator):
+    """Evaluate on a ray cluster: the problem is put once in the object store, chunks run as remote tasks.
+
+    If ray is not initialised yet, ``ray.init(address=ray_address)`` is called (``None`` starts a local
+    cluster) and :meth:`close` shuts it down again; a cluster started by the caller is left running.
+    ``workers`` defaults to the cluster's CPU count.
+    """
+
+    executor = "ray"
+
+    def __init__(self, problem: Any, workers: int | None, ray_address: str | None) -> None:
+        try:
+            import ray
+        except ImportError as exc:
+            raise UserError("the ray executor needs ray, which is not installed (pip install 'lifelike-mj[ray]').") from exc
+        self._ray = ray
+        self._owns_ray = False
+        if not ray.is_initialized():
+            ray.init(address=ray_address)
+            self._owns_ray = True
+        if workers is None:
+            workers = max(1, int(ray.cluster_resources().get("CPU", 1)))
+        super().__init__(problem, workers)
+        self._problem_ref = ray.put(problem)
+        self._remote = ray.remote(_ray_chunk)
+
+    def _evaluate(self, X: np.ndarray) -> np.ndarray:
+        refs = [self._remote.remote(self._problem_ref, c) for c in self._chunks(X)]
+        try:
+            return np.concatenate(self._ray.get(refs))
+        except BaseException:
+            for ref in refs:
+                try:
+                    self._ray.cancel(ref)
+                except Exception:
+                    pass
+            raise
+
+    def close(self) -> None:
+        """Drop the problem reference; shut ray down if this evaluator started it."""
+        if not self.closed:
+            self.closed = True
+            self._problem_ref = None
+            if self._owns_ray and self._ray.is_initialized():
+                self._ray.shutdown()
+
+
+def make_evaluator(problem: Any, executor: str = "process", workers: int | None = None,
+                   ray_address: str | None = None) -> Evaluator:
+    """An evaluator of ``problem`` on ``executor``: ``"serial"``, ``"process"`` (default) or ``"ray"``.
+
+    ``workers``: number of processes (``process``: default ``os.cpu_count()``) or of chunks per batch
+    (``ray``: default the cluster's CPUs); ignored by ``serial``. ``ray_address``: cluster to join when ray
+    is not initialised yet (``None``: start a local one). Raises :class:`UserError` for an unknown
+    executor, ``workers < 1``, or ray missing.
+    """
+    if executor not in EXECUTORS:
+        raise UserError(f"unknown executor {executor!r}; known executors are {', '.join(EXECUTORS)}.")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1):
+        raise UserError(f"workers must be a positive integer, not {workers!r}.")
+    if executor == "serial":
+        return SerialEvaluator(problem, 1)
+    if executor == "process":
+        return ProcessEvaluator(problem, int(workers) if workers is not None else (os.cpu_count() or 1))
+    return RayEvaluator(problem, None if workers is None else int(workers), ray_address)
