@@ -52,7 +52,7 @@ def _time_mujoco(m, ctrl, mode: str | None, n: int) -> float:
     with passive_callback(mjbackend.COMPILED_PASSIVE):
         t0 = time.perf_counter()
         mjbackend._run(m._address, d._address, d.qpos, d.qvel, d.userdata, n, 1, kind, cp, ctrl.flap.as_array(),
-                       0.0, lay, float(m.opt.timestep), out, div)
+                       0.0, lay, float(m.opt.timestep), out, div, np.zeros(1))
         return (time.perf_counter() - t0) / n
 
 

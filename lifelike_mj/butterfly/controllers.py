@@ -12,7 +12,10 @@ Pitch laws (``type``), each set once per integration step (Oe 2010 section 5.1):
 
 * ``simple_rule``: ``phi = phi_up`` while ``omega > 0`` (upstroke, see ``OMEGA_EPS``) else ``phi_down`` (section 5.1);
 * ``constant``: ``phi = phi_deg`` at all times (used for the glide of section 7.1 with a fixed
-  flap angle).
+  flap angle);
+* ``ann``: the evolved neural network of section 6 (``butterfly/ann.py``): parameters ``inputs``
+  (``relative`` or ``ground``), ``input_scale`` (units in the key names), ``max_dphi_deg``,
+  ``phi_limit_deg`` and the 49 ``weights``.
 
 Compiled code sees a controller as ``(kind, params)``: an integer code and a float array.
 """
@@ -26,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lifelike_mj.butterfly import ann
 from lifelike_mj.butterfly.params import FlapPattern
 from lifelike_mj.errors import UserError
 from lifelike_mj.paths import controllers_dir
@@ -35,6 +39,7 @@ FORMAT = "lifelike-mj/butterfly-controller"
 #: Compiled pitch-law codes (must match ``pitch_command`` in ``paper.py`` and the MuJoCo loop).
 KIND_CONSTANT = 0
 KIND_SIMPLE_RULE = 1
+KIND_ANN = 2
 #: The simple rule's upstroke test is ``omega > OMEGA_EPS`` (rad/s): at a stroke reversal omega is
 #: zero up to rounding (+-1e-14), and a bare ``omega > 0`` would let rounding pick the pitch.
 OMEGA_EPS = 1e-9
@@ -43,6 +48,7 @@ OMEGA_EPS = 1e-9
 PITCH_LAWS: dict[str, tuple[int, tuple[str, ...]]] = {
     "constant": (KIND_CONSTANT, ("phi_deg",)),
     "simple_rule": (KIND_SIMPLE_RULE, ("phi_up_deg", "phi_down_deg")),
+    "ann": (KIND_ANN, ("weights",)),
 }
 
 
@@ -63,6 +69,9 @@ class ButterflyController:
         missing = [k for k in needed if k not in self.parameters]
         if missing:
             raise UserError(f"controller of type {self.type!r} lacks parameter(s) {', '.join(missing)}.")
+        if self.type == "ann":
+            _check_ann(self.parameters, where=f"controller {self.name}" if self.name else "controller")
+            return
         for k in needed:
             v = self.parameters[k]
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
@@ -71,7 +80,26 @@ class ButterflyController:
     def compiled(self) -> tuple[int, np.ndarray]:
         """``(kind, params)`` for compiled code; angles converted to rad."""
         kind, names = PITCH_LAWS[self.type]
+        if self.type == "ann":
+            p = self.parameters
+            return kind, ann.compile_params(p["inputs"], self.input_scale(), p["weights"], float(p["max_dphi_deg"]),
+                                            float(p["phi_limit_deg"]))
         return kind, np.radians([float(self.parameters[k]) for k in names])
+
+    def input_scale(self) -> dict:
+        """The network's input scales (ann only): the file's values over the flap's defaults."""
+        f = self.flap
+        scales = ann.default_scales(f.theta_c, f.theta_a, f.theta_a * 2.0 * math.pi * f.frequency_hz)
+        scales.update(self.parameters.get("input_scale", {}))
+        return scales
+
+    def with_inputs(self, inputs: str) -> ButterflyController:
+        """Copy of an ann controller fed ``relative`` (air) or ``ground`` velocities (section 7.2)."""
+        if self.type != "ann":
+            raise UserError(f"only ann controllers take velocity inputs; {self.name or 'this one'} is {self.type!r}.")
+        if inputs not in ann.INPUT_KINDS:
+            raise UserError(f"inputs must be one of {', '.join(ann.INPUT_KINDS)}, got {inputs!r}.")
+        return replace(self, parameters={**self.parameters, "inputs": inputs})
 
     def with_parameters(self, **overrides: float | None) -> ButterflyController:
         """Copy with some parameters replaced (``None`` values are ignored)."""
@@ -83,6 +111,11 @@ class ButterflyController:
                 raise UserError(f"controller type {self.type!r} has no parameter {k}.")
             params[k] = float(v)
         return replace(self, parameters=params)
+
+    @property
+    def weights(self) -> np.ndarray:
+        """The genome of an ann controller (49 floats)."""
+        return np.asarray(self.parameters["weights"], dtype=float)
 
     def to_dict(self) -> dict:
         return {
@@ -122,6 +155,48 @@ def from_dict(data: object, name: str = "") -> ButterflyController:
     if not isinstance(prov, dict):
         raise UserError(f"{where} has a 'provenance' entry that is not an object.")
     return ButterflyController(data["type"], pattern, dict(data["parameters"]), dict(prov), name)
+
+
+def _check_ann(p: dict, where: str) -> None:
+    w = p.get("weights")
+    if not isinstance(w, list) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in w):
+        raise UserError(f"{where} needs 'weights' as a list of numbers.")
+    if len(w) != ann.N_WEIGHTS:
+        raise UserError(f"{where} has {len(w)} weights; the network of section 6 needs {ann.N_WEIGHTS}.")
+    if not all(math.isfinite(x) for x in w):
+        raise UserError(f"{where} has weights that are not finite numbers.")
+    if p.get("inputs") not in ann.INPUT_KINDS:
+        raise UserError(f"{where} needs 'inputs' to be one of {', '.join(ann.INPUT_KINDS)}.")
+    for key in ("max_dphi_deg", "phi_limit_deg"):
+        v = p.get(key)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not (math.isfinite(v) and 0 < v <= 90):
+            raise UserError(f"{where} needs '{key}' to be a number of degrees in (0, 90].")
+    scales = p.get("input_scale", {})
+    if not isinstance(scales, dict):
+        raise UserError(f"{where} has an 'input_scale' entry that is not an object.")
+    for key, v in scales.items():
+        if key not in ann.SCALE_KEYS:
+            raise UserError(f"{where} has an unknown input scale {key!r}; known: {', '.join(ann.SCALE_KEYS)}.")
+        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+        if not ok or (key != "theta_center_deg" and v <= 0):
+            raise UserError(f"{where} has input scale {key} = {v!r}; it must be a positive number.")
+
+
+def ann_controller(weights, flap: FlapPattern | None = None, inputs: str = "relative",
+                   provenance: dict | None = None, name: str = "") -> ButterflyController:
+    """An ann controller (section 6) with the documented input scales of ``butterfly/ann.py``.
+
+    The default flap is section 6.3's: 10 Hz over [-60, 75] degrees."""
+    flap = flap or FlapPattern(10.0, -60.0, 75.0)
+    f = flap
+    params = {
+        "inputs": inputs,
+        "max_dphi_deg": ann.DEFAULT_MAX_DPHI_DEG,
+        "phi_limit_deg": ann.DEFAULT_PHI_LIMIT_DEG,
+        "input_scale": ann.default_scales(f.theta_c, f.theta_a, f.theta_a * 2.0 * math.pi * f.frequency_hz),
+        "weights": [float(x) for x in np.asarray(weights, dtype=float).ravel()],
+    }
+    return ButterflyController("ann", flap, params, dict(provenance or {}), name)
 
 
 def builtin_names() -> list[str]:

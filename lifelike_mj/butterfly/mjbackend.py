@@ -38,11 +38,11 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
-from numba import carray, cfunc, njit, types
+from numba import carray, cfunc, njit, prange, types
 
 from lifelike_mj.butterfly.aero import strip_nodes
 from lifelike_mj.butterfly.controllers import ButterflyController
-from lifelike_mj.butterfly.paper import Condition, check_timing, pitch_command
+from lifelike_mj.butterfly.paper import Condition, check_timing, fitness_term, pitch_command
 from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.butterfly.trajectory import Trajectory
 from lifelike_mj.errors import UserError
@@ -450,16 +450,20 @@ def setup_data(m: mujoco.MjModel, controller: ButterflyController, params: Butte
 
 
 @njit(cache=False)
-def advance(mptr, dptr, qpos, qvel, ud, k0, n_steps, kind, cp, flap, y0, lay, dt, phi, diverged):
+def advance(mptr, dptr, qpos, qvel, ud, k0, n_steps, kind, cp, flap, y_ref, lay, dt, phi, diverged, fit):
     """Steps ``k0 .. k0 + n_steps - 1`` (time ``t = k dt``): the controller sets the pitch once per
-    step, then ``mj_step``. Returns the last pitch (rad); sets ``diverged[0]`` on a runaway."""
+    step, then ``mj_step``. Returns the last pitch (rad); sets ``diverged[0]`` on a runaway and adds
+    each step's fitness term (eq. 13) to ``fit[0]``. Altitudes are measured from ``y_ref`` (m), the
+    target altitude (0 in every experiment; the start altitude is in the initial state)."""
     rich = lay[0] == 1
     qf, qh, df, dh, qp, dp = lay[1], lay[2], lay[3], lay[4], lay[5], lay[6]
+    air_z = ud[U_AIR]
+    air_y = ud[U_AIR + 2]
     for k in range(k0, k0 + n_steps):
         t = k * dt
         theta = flap[0] + flap[1] * math.cos(flap[2] * t)
         omega = -flap[1] * flap[2] * math.sin(flap[2] * t)
-        phi = pitch_command(kind, cp, t, theta, omega, qpos[qh] - y0, qpos[qf], qvel[dh], qvel[df], phi)
+        phi = pitch_command(kind, cp, t, theta, omega, qpos[qh] - y_ref, qpos[qf], qvel[dh], qvel[df], air_y, air_z, phi)
         if rich:
             ud[U_PHI_CMD] = phi
         else:
@@ -469,11 +473,29 @@ def advance(mptr, dptr, qpos, qvel, ud, k0, n_steps, kind, cp, flap, y0, lay, dt
         if not (abs(qvel[dh]) + abs(qvel[df]) < 1e4):
             diverged[0] = k + 1
             return phi
+        fit[0] += fitness_term(qpos[qh] - y_ref, qvel[df])
     return phi
 
 
+@njit(cache=False, parallel=True)
+def _fitness_batch(mptr, dptrs, kinds, cparams, flap, lay, dt, n_steps, diverged, fitness):
+    """Fly ``len(dptrs)`` butterflies (one ``mjData`` each, sharing model ``mptr``) on parallel
+    threads; writes each one's eq. 13 fitness and divergence step."""
+    nq_off = _OFF_QPOS
+    for b in prange(len(dptrs)):
+        base = dptrs[b]
+        ud = _f64(_ptr_at(base + _OFF_UD), N_USERDATA)
+        qpos = _f64(_ptr_at(base + nq_off), int(ud[U_NQ]))
+        qvel = _f64(_ptr_at(base + _OFF_QVEL), int(ud[U_NV]))
+        dv = np.full(1, -1, dtype=np.int64)
+        fit = np.zeros(1)
+        advance(mptr, _vp(base), qpos, qvel, ud, 0, n_steps, kinds[b], cparams[b], flap, 0.0, lay, dt, 0.0, dv, fit)
+        diverged[b] = dv[0]
+        fitness[b] = fit[0]
+
+
 @njit(cache=False)
-def _run(mptr, dptr, qpos, qvel, ud, n_steps, record_every, kind, cp, flap, y0, lay, dt, out, diverged):
+def _run(mptr, dptr, qpos, qvel, ud, n_steps, record_every, kind, cp, flap, y_ref, lay, dt, out, diverged, fit):
     """:func:`advance` over the whole flight, recording a row every ``record_every`` steps."""
     rich = lay[0] == 1
     qf, qh, df, dh, qp, ql = lay[1], lay[2], lay[3], lay[4], lay[5], lay[7]
@@ -482,7 +504,7 @@ def _run(mptr, dptr, qpos, qvel, ud, n_steps, record_every, kind, cp, flap, y0, 
     k = 0
     while k < n_steps:
         n = min(record_every, n_steps - k)
-        phi = advance(mptr, dptr, qpos, qvel, ud, k, n, kind, cp, flap, y0, lay, dt, phi, diverged)
+        phi = advance(mptr, dptr, qpos, qvel, ud, k, n, kind, cp, flap, y_ref, lay, dt, phi, diverged, fit)
         k += n
         if diverged[0] >= 0:
             for rr in range(r, out.shape[0]):
@@ -517,22 +539,53 @@ def fly_one(m: mujoco.MjModel, controller: ButterflyController, params: Butterfl
     out = np.empty((n_rec, 6))
     out[0] = (d.qpos[lay.q_height], d.qpos[lay.q_forward], 0.0, 0.0, 0.0, d.qpos[lay.q_flap_left])
     diverged = np.full(1, -1, dtype=np.int64)
+    fit = np.zeros(1)
     if callback == "compiled":
         with passive_callback(COMPILED_PASSIVE):
             _run(m._address, d._address, d.qpos, d.qvel, d.userdata, n_steps, record_every, kind,
-                 np.ascontiguousarray(cp, dtype=float), controller.flap.as_array(), cond.y0_m, lay.as_array(), dt,
-                 out, diverged)
+                 np.ascontiguousarray(cp, dtype=float), controller.flap.as_array(), 0.0, lay.as_array(), dt,
+                 out, diverged, fit)
     elif callback == "python":
-        _run_python(m, d, n_steps, record_every, controller, cond, lay, dt, out, diverged)
+        _run_python(m, d, n_steps, record_every, controller, cond, lay, dt, out, diverged, fit)
     else:
         raise UserError(f"unknown callback kind {callback!r}; choose compiled or python.")
     t = np.arange(n_rec) * (record_every * dt)
     return Trajectory(t=t, y=out[:, 0], z=out[:, 1], vy=out[:, 2], vz=out[:, 3], phi=out[:, 4], theta=out[:, 5],
                       y0=cond.y0_m, flap_period_s=1.0 / controller.flap.frequency_hz, backend="mujoco",
-                      diverged_step=int(diverged[0]))
+                      diverged_step=int(diverged[0]), fitness=float(fit[0]))
 
 
-def _run_python(m, d, n_steps, record_every, controller, cond, lay, dt, out, diverged):
+_MODEL_CACHE: dict = {}
+
+
+def fitness_batch(cparams: np.ndarray, flap, params: ButterflyParams | None, condition: Condition, n_steps: int,
+                  dt_s: float, config: str = "paper", force_mode: str = "tip") -> np.ndarray:
+    """Eq. 13 fitness of a batch of compiled ann controllers (rows of ``cparams``) flown on MuJoCo
+    under one condition: one ``mjData`` per individual, stepped on parallel native threads with the
+    compiled callback and the compiled controller (weights per simulation)."""
+    from lifelike_mj.butterfly.controllers import KIND_ANN, ann_controller
+
+    p = params or ButterflyParams()
+    key = (p, config, float(dt_s))
+    if key not in _MODEL_CACHE:
+        m = build_model(p, config)
+        m.opt.timestep = float(dt_s)
+        _MODEL_CACHE[key] = m
+    m = _MODEL_CACHE[key]
+    proto = ann_controller(np.zeros(cparams.shape[1] - 10), flap)
+    datas = [setup_data(m, proto, p, condition, force_mode) for _ in range(len(cparams))]
+    dptrs = np.array([d._address for d in datas], dtype=np.int64)
+    n = len(datas)
+    diverged = np.full(n, -1, dtype=np.int64)
+    fitness = np.zeros(n)
+    with passive_callback(COMPILED_PASSIVE):
+        _fitness_batch(m._address, dptrs, np.full(n, KIND_ANN, dtype=np.int64), np.ascontiguousarray(cparams),
+                       flap.as_array(), layout(m).as_array(), float(dt_s), int(n_steps), diverged, fitness)
+    del datas
+    return fitness
+
+
+def _run_python(m, d, n_steps, record_every, controller, cond, lay, dt, out, diverged, fit):
     """The stepping loop of :func:`_run` with the Python callback and controller (reference)."""
     kind, cp = controller.compiled()
     flap = controller.flap.as_array()
@@ -543,8 +596,9 @@ def _run_python(m, d, n_steps, record_every, controller, cond, lay, dt, out, div
             t = k * dt
             theta = flap[0] + flap[1] * math.cos(flap[2] * t)
             omega = -flap[1] * flap[2] * math.sin(flap[2] * t)
-            phi = pitch_command.py_func(kind, cp, t, theta, omega, qpos[lay.q_height] - cond.y0_m,
-                                        qpos[lay.q_forward], qvel[lay.d_height], qvel[lay.d_forward], phi)
+            air_z, air_y = cond.air_velocity()
+            phi = pitch_command.py_func(kind, cp, t, theta, omega, qpos[lay.q_height],
+                                        qpos[lay.q_forward], qvel[lay.d_height], qvel[lay.d_forward], air_y, air_z, phi)
             if lay.rich:
                 d.userdata[U_PHI_CMD] = phi
             else:
@@ -555,6 +609,7 @@ def _run_python(m, d, n_steps, record_every, controller, cond, lay, dt, out, div
                 diverged[0] = k + 1
                 out[r:] = np.nan
                 return
+            fit[0] += fitness_term.py_func(qpos[lay.q_height], qvel[lay.d_forward])
             if (k + 1) % record_every == 0:
                 if lay.rich:
                     w, x, y, z = qpos[lay.q_pitch : lay.q_pitch + 4]

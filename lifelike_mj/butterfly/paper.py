@@ -25,7 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, prange
 
-from lifelike_mj.butterfly.controllers import KIND_CONSTANT, KIND_SIMPLE_RULE, OMEGA_EPS, ButterflyController
+from lifelike_mj.butterfly.ann import ann_pitch
+from lifelike_mj.butterfly.controllers import KIND_ANN, KIND_CONSTANT, KIND_SIMPLE_RULE, OMEGA_EPS, ButterflyController
 from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.butterfly.trajectory import Trajectory
 from lifelike_mj.errors import UserError
@@ -41,11 +42,25 @@ def constants_row(p: ButterflyParams) -> np.ndarray:
 
 
 @njit(cache=True, inline="always")
-def pitch_command(kind, cparams, t, theta, omega, y, z, vy, vz, phi_prev):
-    """Pitch ``phi`` (rad) chosen once per step by the compiled controller ``kind``."""
+def pitch_command(kind, cparams, t, theta, omega, y, z, vy, vz, air_y, air_z, phi_prev):
+    """Pitch ``phi`` (rad) chosen once per step by the compiled controller ``kind``: flap angle
+    ``theta`` (rad) and rate ``omega`` (rad/s), altitude ``y`` (relative to the target altitude 0 m;
+    the start altitude of a :class:`Condition` only sets the initial state) and forward
+    position ``z`` (m), ground velocities ``vy``, ``vz`` and air velocity ``air_y``, ``air_z`` (m/s),
+    previous pitch ``phi_prev`` (rad)."""
     if kind == KIND_SIMPLE_RULE:
         return cparams[0] if omega > OMEGA_EPS else cparams[1]
+    if kind == KIND_ANN:
+        return ann_pitch(cparams, theta, omega, y, vy, vz, air_y, air_z, phi_prev)
     return cparams[0]  # KIND_CONSTANT
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def fitness_term(y_rel, vz):
+    """One step's term of the fitness ``H`` of Oe 2010 eq. 13: ``(v_z/3) 0.1/(|y| + 0.1)``, with the
+    ground forward speed ``v_z`` (m/s) and the altitude ``y`` (m) measured from the target altitude 0 m
+    (the paper's start altitude; section 7.1 keeps the target at 0 m when the start changes)."""
+    return vz / 3.0 * 0.1 / (abs(y_rel) + 0.1)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -70,7 +85,7 @@ def _flap_from(flap, cw, sw):
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def _simulate(kinds, cparams, flaps, airs, y0s, consts, n_steps, dt, record_every, out, diverged):
+def _simulate(kinds, cparams, flaps, airs, y0s, consts, n_steps, dt, record_every, out, diverged, fitness):
     nb = kinds.shape[0]
     for b in prange(nb):
         flap = flaps[b]
@@ -102,10 +117,11 @@ def _simulate(kinds, cparams, flaps, airs, y0s, consts, n_steps, dt, record_ever
         phi_prev = np.nan
         sphi = 0.0
         cphi = 1.0
+        fit = 0.0
         for k in range(n_steps):
             t = k * dt
             theta0 = flap[0] + flap[1] * cw0
-            phi = pitch_command(kind, cp, t, theta0, om0, y - y0s[b], z, vy, vz, phi)
+            phi = pitch_command(kind, cp, t, theta0, om0, y, z, vy, vz, air_y, air_z, phi)
             if phi != phi_prev:
                 sphi = math.sin(phi)
                 cphi = math.cos(phi)
@@ -145,6 +161,7 @@ def _simulate(kinds, cparams, flaps, airs, y0s, consts, n_steps, dt, record_ever
                     for j in range(5):
                         out[b, rr, j] = np.nan
                 break
+            fit += fitness_term(y, vz)
             countdown -= 1
             if countdown == 0:
                 countdown = record_every
@@ -154,6 +171,7 @@ def _simulate(kinds, cparams, flaps, airs, y0s, consts, n_steps, dt, record_ever
                 out[b, r, 3] = vz
                 out[b, r, 4] = phi
                 r += 1
+        fitness[b] = fit
 
 
 @dataclass(frozen=True)
@@ -195,29 +213,52 @@ def simulate(
     n = max(n, len(ps), len(cs))
     ctrls, ps, cs = _stretch(ctrls, n), _stretch(ps, n), _stretch(cs, n)
     n_steps = check_timing(duration_s, dt_s, record_every)
-    compiled = [c.compiled() for c in ctrls]
-    width = max(1, max(len(p) for _, p in compiled))
-    kinds = np.array([k for k, _ in compiled], dtype=np.int64)
-    cparams = np.zeros((n, width))
-    for i, (_, p) in enumerate(compiled):
-        cparams[i, : len(p)] = p
+    kinds, cparams = compile_controllers(ctrls)
     flaps = np.array([c.flap.as_array() for c in ctrls])
     airs = np.array([c.air_velocity() for c in cs])
     y0s = np.array([c.y0_m for c in cs], dtype=float)
     consts = np.array([constants_row(p) for p in ps])
-    n_rec = n_steps // record_every + 1
-    out = np.empty((n, n_rec, 5))
-    diverged = np.full(n, -1, dtype=np.int64)
-    _simulate(kinds, cparams, flaps, airs, y0s, consts, n_steps, float(dt_s), int(record_every), out, diverged)
+    out, diverged, fitness = run_batch(kinds, cparams, flaps, airs, y0s, consts, n_steps, dt_s, record_every)
+    n_rec = out.shape[1]
     t = np.arange(n_rec) * (record_every * dt_s)
     return [
         Trajectory(
             t=t, y=out[i, :, 0], z=out[i, :, 1], vy=out[i, :, 2], vz=out[i, :, 3], phi=out[i, :, 4],
             theta=ctrls[i].flap.theta(t), y0=cs[i].y0_m, flap_period_s=1.0 / ctrls[i].flap.frequency_hz,
-            backend="paper", diverged_step=int(diverged[i]),
+            backend="paper", diverged_step=int(diverged[i]), fitness=float(fitness[i]),
         )
         for i in range(n)
     ]
+
+
+def compile_controllers(ctrls: Sequence[ButterflyController]) -> tuple[np.ndarray, np.ndarray]:
+    """``(kinds, cparams)`` arrays of a batch of controllers for compiled code (rows zero-padded)."""
+    compiled = [c.compiled() for c in ctrls]
+    width = max(1, max(len(p) for _, p in compiled))
+    kinds = np.array([k for k, _ in compiled], dtype=np.int64)
+    cparams = np.zeros((len(ctrls), width))
+    for i, (_, p) in enumerate(compiled):
+        cparams[i, : len(p)] = p
+    return kinds, cparams
+
+
+def run_batch(kinds: np.ndarray, cparams: np.ndarray, flaps: np.ndarray, airs: np.ndarray, y0s: np.ndarray,
+              consts: np.ndarray, n_steps: int, dt_s: float, record_every: int
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Fly a batch given as arrays (one row per butterfly; see :func:`simulate`).
+
+    Returns ``out`` (batch, records, 5: y, z, v_y, v_z, phi in m, m/s, rad), ``diverged`` (step of a
+    runaway or -1) and ``fitness`` (``H`` of eq. 13 summed over the steps flown)."""
+    n = len(kinds)
+    n_rec = n_steps // record_every + 1
+    out = np.empty((n, n_rec, 5))
+    diverged = np.full(n, -1, dtype=np.int64)
+    fitness = np.zeros(n)
+    _simulate(np.ascontiguousarray(kinds, dtype=np.int64), np.ascontiguousarray(cparams, dtype=float),
+              np.ascontiguousarray(flaps, dtype=float), np.ascontiguousarray(airs, dtype=float),
+              np.ascontiguousarray(y0s, dtype=float), np.ascontiguousarray(consts, dtype=float),
+              int(n_steps), float(dt_s), int(record_every), out, diverged, fitness)
+    return out, diverged, fitness
 
 
 def simulate_naive(controller: ButterflyController, params: ButterflyParams | None = None,
@@ -243,11 +284,16 @@ def simulate_naive(controller: ButterflyController, params: ButterflyParams | No
                 (f * math.sin(phi) * ct - cb * vzr * abs(vzr)) / m)
 
     y, z, vy, vz = cond.y0_m, 0.0, 0.0, 0.0
+    phi = 0.0
     h = 0.5 * dt_s
+    cp_arr = np.asarray(cp)
     for k in range(n_steps):
         t = k * dt_s
         if kind == KIND_SIMPLE_RULE:
             phi = cp[0] if -th_a * w * math.sin(w * t) > OMEGA_EPS else cp[1]
+        elif kind == KIND_ANN:
+            phi = ann_pitch.py_func(cp_arr, th_c + th_a * math.cos(w * t), -th_a * w * math.sin(w * t), y,
+                                    vy, vz, air_y, air_z, phi)
         else:
             assert kind == KIND_CONSTANT
             phi = cp[0]

@@ -26,6 +26,7 @@ class Trajectory:
     flap_period_s: float = 0.1
     backend: str = "paper"
     diverged_step: int = -1
+    fitness: float = float("nan")  #: ``H`` of Oe 2010 eq. 13 over the flight (dimensionless)
 
     def settled(self, window_s: float = 10.0) -> np.ndarray:
         """Mask of samples in the last ``window_s`` seconds."""
@@ -47,9 +48,11 @@ class Trajectory:
         return float(np.polyfit(self.t[mask], self.y[mask], 1)[0])
 
     def summary(self, window_s: float = 10.0) -> dict:
-        """The numbers that ``butterfly fly --json`` reports (altitudes relative to the start)."""
+        """The numbers that ``butterfly fly --json`` reports. Altitudes are measured from the target
+        altitude 0 m (which is the start altitude unless the flight starts elsewhere, section 7.1);
+        the initial drop is measured from the start."""
         mask = self.settled(window_s)
-        rel = self.y - self.y0
+        rel = self.y
         dur = self.t[-1] - self.t[0]
         return {
             "backend": self.backend,
@@ -57,7 +60,8 @@ class Trajectory:
             "final_altitude_m": float(rel[-1]),
             "min_altitude_m": float(np.nanmin(rel)),
             "max_altitude_m": float(np.nanmax(rel)),
-            "initial_drop_m": float(max(0.0, -np.nanmin(rel))),
+            "start_altitude_m": float(self.y0),
+            "initial_drop_m": float(max(0.0, self.y0 - np.nanmin(rel))),
             "mean_forward_speed_cm_s": float(100.0 * (self.z[-1] - self.z[0]) / dur) if dur > 0 else 0.0,
             "settled_altitude_min_m": float(np.nanmin(rel[mask])),
             "settled_altitude_max_m": float(np.nanmax(rel[mask])),
@@ -65,6 +69,7 @@ class Trajectory:
             "settled_climb_rate_cm_s": float(100.0 * self.climb_rate_m_s(window_s)),
             "ripple_cm": float(100.0 * self.ripple_m(window_s)),
             "diverged_step": self.diverged_step,
+            "fitness_H": self.fitness,
         }
 
     def to_npz_dict(self) -> dict:

@@ -16,9 +16,9 @@ from lifelike_mj.io import atomic_path  # noqa: E402
 def fig_flight(traj, path: str | Path, title: str = "") -> Path:
     """Altitude y (m) vs forward distance z (m), and phi, theta (deg) over the first 0.5 s."""
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4), gridspec_kw={"width_ratios": [2, 1]})
-    a.plot(traj.z, traj.y - traj.y0, lw=0.8)
+    a.plot(traj.z, traj.y, lw=0.8)
     a.set_xlabel("forward distance z [m]")
-    a.set_ylabel("altitude y [m] (relative to start)")
+    a.set_ylabel("altitude y [m] (target 0 m)")
     a.grid(alpha=0.3)
     a.set_title(title or f"flight ({traj.backend} backend)")
     mask = traj.t <= min(traj.t[-1], 0.5)

@@ -258,6 +258,7 @@ class _Flight:
         self.k = 0
         self.phi = 0.0
         self.diverged = np.full(1, -1, dtype=np.int64)
+        self._fit = np.zeros(1)
         self.body = self.m.body("butterfly").id
         self._fn = _advance_fn()
         self._call(0)  # compiles the loop on first use (about 1 s), steps nothing
@@ -288,7 +289,7 @@ class _Flight:
     def _call(self, n: int) -> None:
         d = self.d
         self.phi = self._fn(self.m._address, d._address, d.qpos, d.qvel, d.userdata, self.k, n, self.kind, self.cp,
-                            self.flap, self.cond.y0_m, self.lay, self.dt, self.phi, self.diverged)
+                            self.flap, 0.0, self.lay, self.dt, self.phi, self.diverged, self._fit)
 
     def refresh(self) -> None:
         """Recompute the kinematics of the current state for drawing."""

@@ -1,0 +1,121 @@
+"""The neural pitch controller of Oe 2010 section 6.1 (eq. 12), compiled.
+
+Network: 6 inputs -> 6 hidden neurons -> 1 output neuron, every neuron with the transfer function
+``G(u) = 1/(1+exp(-12(u+0.5))) + 1/(1+exp(-12(u-0.5))) - 1`` (eq. 12, range (-1, 1), flat near 0).
+The output is scaled to a pitch change of at most ``max_dphi`` (3 degrees) per integration step,
+and the pitch is clipped to ``[-phi_limit, phi_limit]`` (30 degrees), as section 6.3 states.
+
+The paper gives neither input scaling nor biases. Our choice (kept fixed in the controller file):
+
+* inputs, in the paper's order, divided by a scale so that their usual range is about [-1, 1]:
+  ``phi / 30 deg``, ``omega / (theta_a 2 pi f)`` (the flap's peak rate), ``(theta - theta_c) /
+  theta_a`` (flap angle about the stroke centre), ``v_y / 2 m/s`` (climb rate), ``y / 10 m``
+  (altitude above the target 0 m), ``v_z / 3 m/s`` (forward speed; 3 m/s as in eq. 13). The
+  altitude and climb-rate scales span the experiments' range (start altitudes of +-10 m of
+  section 7.1, sink rates up to about 2 m/s). In a trial (one seed, 300 generations) with 1 m and 1 m/s
+  the network held level flight as well but crashed from +10 m (E7); with 10 m and 2 m/s two of
+  two trial seeds descended from +10 m and held 0 m;
+* one bias per neuron (hidden and output): 6 x (6 + 1) + 6 + 1 = 49 weights (genes);
+* velocities are air-relative (``inputs = "relative"``) or ground velocities (``"ground"``),
+  the two readings of section 7.2; without wind they are the same.
+
+Weight order (the genome): for hidden neuron ``h = 0..5``: its 6 input weights then its bias
+(indices ``7h .. 7h + 6``); then the 6 output weights (42..47) and the output bias (48).
+
+Compiled code sees the controller as a float array (see ``A_*`` below); :func:`ann_pitch` is the
+step function shared by the paper backend and the MuJoCo stepping loop.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+N_INPUTS = 6
+N_HIDDEN = 6
+N_WEIGHTS = N_HIDDEN * (N_INPUTS + 1) + N_HIDDEN + 1  # 49
+INPUT_NAMES = ("phi", "omega", "theta", "climb_rate", "altitude", "forward_speed")
+INPUT_KINDS = ("relative", "ground")
+
+# layout of the compiled parameter array
+A_RELATIVE, A_DMAX, A_LIMIT, A_THETA_C = 0, 1, 2, 3
+A_SCALE = 4  # 6 multipliers (1 / scale) in input order
+A_W = A_SCALE + N_INPUTS  # 10: the 49 weights
+N_COMPILED = A_W + N_WEIGHTS
+
+#: Default input scales (units in the key names); the theta and omega scales follow the flap.
+DEFAULT_SCALES = {"phi_deg": 30.0, "vy_m_s": 2.0, "y_m": 10.0, "vz_m_s": 3.0}
+DEFAULT_MAX_DPHI_DEG = 3.0
+DEFAULT_PHI_LIMIT_DEG = 30.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def transfer(u):
+    """``G(u)`` of Oe 2010 eq. 12 (dimensionless)."""
+    return 1.0 / (1.0 + math.exp(-12.0 * (u + 0.5))) + 1.0 / (1.0 + math.exp(-12.0 * (u - 0.5))) - 1.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def ann_pitch(cp, theta, omega, y, vy, vz, air_y, air_z, phi_prev):
+    """New pitch (rad) from the previous pitch ``phi_prev`` (rad), flap angle ``theta`` (rad) and
+    rate ``omega`` (rad/s), altitude ``y`` (m, relative to the start), ground velocities ``vy``
+    (up), ``vz`` (forward) and the air velocity (m/s)."""
+    if cp[A_RELATIVE] > 0.5:
+        vy = vy - air_y
+        vz = vz - air_z
+    x0 = phi_prev * cp[A_SCALE]
+    x1 = omega * cp[A_SCALE + 1]
+    x2 = (theta - cp[A_THETA_C]) * cp[A_SCALE + 2]
+    x3 = vy * cp[A_SCALE + 3]
+    x4 = y * cp[A_SCALE + 4]
+    x5 = vz * cp[A_SCALE + 5]
+    out = cp[A_W + 48]
+    for h in range(N_HIDDEN):
+        b = A_W + 7 * h
+        s = cp[b] * x0 + cp[b + 1] * x1 + cp[b + 2] * x2 + cp[b + 3] * x3 + cp[b + 4] * x4 + cp[b + 5] * x5 + cp[b + 6]
+        out += cp[A_W + 42 + h] * transfer(s)
+    phi = phi_prev + cp[A_DMAX] * transfer(out)
+    lim = cp[A_LIMIT]
+    if phi > lim:
+        phi = lim
+    elif phi < -lim:
+        phi = -lim
+    return phi
+
+
+def default_scales(theta_c_rad: float, theta_a_rad: float, omega_peak_rad_s: float) -> dict:
+    """The documented input scales for a flap pattern (see module docstring)."""
+    return {
+        "phi_deg": DEFAULT_SCALES["phi_deg"],
+        "omega_rad_s": float(omega_peak_rad_s),
+        "theta_center_deg": math.degrees(theta_c_rad),
+        "theta_half_range_deg": math.degrees(theta_a_rad),
+        "vy_m_s": DEFAULT_SCALES["vy_m_s"],
+        "y_m": DEFAULT_SCALES["y_m"],
+        "vz_m_s": DEFAULT_SCALES["vz_m_s"],
+    }
+
+
+SCALE_KEYS = ("phi_deg", "omega_rad_s", "theta_center_deg", "theta_half_range_deg", "vy_m_s", "y_m", "vz_m_s")
+
+
+def compile_params(inputs: str, scales: dict, weights, max_dphi_deg: float = DEFAULT_MAX_DPHI_DEG,
+                   phi_limit_deg: float = DEFAULT_PHI_LIMIT_DEG) -> np.ndarray:
+    """The compiled parameter array of one network (rad inside)."""
+    cp = np.zeros(N_COMPILED)
+    cp[A_RELATIVE] = 1.0 if inputs == "relative" else 0.0
+    cp[A_DMAX] = math.radians(max_dphi_deg)
+    cp[A_LIMIT] = math.radians(phi_limit_deg)
+    cp[A_THETA_C] = math.radians(scales["theta_center_deg"])
+    cp[A_SCALE : A_W] = (
+        1.0 / math.radians(scales["phi_deg"]),
+        1.0 / scales["omega_rad_s"],
+        1.0 / math.radians(scales["theta_half_range_deg"]),
+        1.0 / scales["vy_m_s"],
+        1.0 / scales["y_m"],
+        1.0 / scales["vz_m_s"],
+    )
+    cp[A_W:] = np.asarray(weights, dtype=float)
+    return cp

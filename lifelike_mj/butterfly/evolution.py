@@ -1,0 +1,195 @@
+"""The butterfly's pitch-controller search as an optimisation problem (Oe 2010 section 6).
+
+A genome is the 49 weights of the network of ``butterfly/ann.py``; its fitness is ``H`` of eq. 13
+summed over the steps of a 20 s flight (dt = 1/1200 s, flap 10 Hz over [-60, 75] degrees), to be
+maximised. :class:`PitchProblem` implements the ``evolve.Problem`` protocol: it is a small,
+picklable value whose ``evaluate`` flies a whole population as one batch (parallel threads on the
+paper backend, one ``mjData`` per individual on parallel threads on the MuJoCo backend).
+
+With several :class:`Condition` s (start altitudes, winds), the fitness is the mean of ``H`` over
+them: the "training over varied conditions" that section 7 proposes as future work.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import asdict, dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+
+from lifelike_mj.butterfly import ann
+from lifelike_mj.butterfly.controllers import KIND_ANN, ButterflyController, ann_controller
+from lifelike_mj.butterfly.paper import Condition, check_timing, constants_row, run_batch
+from lifelike_mj.butterfly.params import ButterflyParams, FlapPattern
+from lifelike_mj.errors import UserError
+
+BACKENDS = ("paper", "mujoco")
+#: Gene bounds for optimisers that need them (nlopt, CMA-ES); the RCGA starts in [-1, 1] and is
+#: unbounded, as in the paper.
+GENE_BOUND = 5.0
+PAPER_FLAP = FlapPattern(10.0, -60.0, 75.0)
+
+
+@dataclass(frozen=True)
+class PitchProblem:
+    """Evolve the 49 weights of the section-6 network to maximise the mean ``H`` (eq. 13)."""
+
+    backend: str = "paper"
+    conditions: tuple[Condition, ...] = (Condition(),)
+    inputs: str = "relative"
+    duration_s: float = 20.0
+    dt_s: float = 1.0 / 1200.0
+    flap: FlapPattern = PAPER_FLAP
+    params: ButterflyParams = field(default_factory=ButterflyParams)
+    gene_bound: float = GENE_BOUND
+
+    def __post_init__(self) -> None:
+        if self.backend not in BACKENDS:
+            raise UserError(f"unknown backend {self.backend!r}; choose one of: {', '.join(BACKENDS)}.")
+        if self.inputs not in ann.INPUT_KINDS:
+            raise UserError(f"inputs must be one of {', '.join(ann.INPUT_KINDS)}, got {self.inputs!r}.")
+        if not self.conditions:
+            raise UserError("an evolution needs at least one flight condition.")
+        check_timing(self.duration_s, self.dt_s)
+
+    # ---- the evolve.Problem protocol ----
+    @property
+    def dim(self) -> int:
+        return ann.N_WEIGHTS
+
+    @property
+    def lower(self) -> np.ndarray:
+        return np.full(ann.N_WEIGHTS, -self.gene_bound)
+
+    @property
+    def upper(self) -> np.ndarray:
+        return np.full(ann.N_WEIGHTS, self.gene_bound)
+
+    @property
+    def maximize(self) -> bool:
+        return True
+
+    def describe(self) -> dict:
+        """Plain-data description (what the fingerprint hashes)."""
+        return {
+            "problem": "butterfly-pitch-ann",
+            "backend": self.backend,
+            "conditions": [{"y0_m": c.y0_m, "wind_m_s": list(c.wind_m_s)} for c in self.conditions],
+            "inputs": self.inputs,
+            "duration_s": self.duration_s,
+            "dt_s": self.dt_s,
+            "flap": asdict(self.flap),
+            "params": asdict(self.params),
+            "gene_bound": self.gene_bound,
+            "n_weights": ann.N_WEIGHTS,
+        }
+
+    def fingerprint(self) -> str:
+        text = json.dumps(self.describe(), sort_keys=True)
+        return "butterfly-pitch-ann:" + hashlib.sha256(text.encode()).hexdigest()[:16]
+
+    def evaluate(self, X: np.ndarray) -> np.ndarray:
+        """Mean eq. 13 fitness of each row of ``X`` (n, 49) over the conditions. A flight that
+        diverges keeps the fitness it had gathered up to then."""
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        if X.shape[1] != ann.N_WEIGHTS:
+            raise UserError(f"a genome has {ann.N_WEIGHTS} weights, got {X.shape[1]}.")
+        n, nc = X.shape[0], len(self.conditions)
+        template = self.controller(np.zeros(ann.N_WEIGHTS)).compiled()[1]
+        cp = np.repeat(template[None, :], n, axis=0)
+        cp[:, ann.A_W :] = X
+        n_steps = check_timing(self.duration_s, self.dt_s)
+        if self.backend == "paper":
+            cps = np.tile(cp, (nc, 1))
+            kinds = np.full(n * nc, KIND_ANN, dtype=np.int64)
+            flaps = np.repeat(self.flap.as_array()[None, :], n * nc, axis=0)
+            airs = np.repeat(np.array([c.air_velocity() for c in self.conditions]), n, axis=0)
+            y0s = np.repeat(np.array([c.y0_m for c in self.conditions], dtype=float), n)
+            consts = np.repeat(constants_row(self.params)[None, :], n * nc, axis=0)
+            _, _, fit = run_batch(kinds, cps, flaps, airs, y0s, consts, n_steps, self.dt_s, n_steps)
+            return fit.reshape(nc, n).mean(axis=0)
+        from lifelike_mj.butterfly.mjbackend import fitness_batch
+
+        return np.mean([fitness_batch(cp, self.flap, self.params, cond, n_steps, self.dt_s) for cond in self.conditions],
+                       axis=0)
+
+    # ---- helpers ----
+    def controller(self, weights, provenance: dict | None = None, name: str = "") -> ButterflyController:
+        """The controller file content of a genome."""
+        return ann_controller(weights, self.flap, self.inputs, provenance, name)
+
+
+def robust_conditions() -> tuple[Condition, ...]:
+    """Training conditions for ``ann_robust``: start altitudes from -10 to +10 m in still air, and
+    2 m/s winds from the four directions of section 7.2 plus diagonal ones, from 0 m."""
+    alts = (-10.0, -5.0, -2.0, 0.0, 2.0, 10.0)
+    winds = ((2.0, 0.0), (-2.0, 0.0), (0.0, 2.0), (0.0, -2.0), (-1.5, 1.0), (-1.5, -1.0))
+    return tuple(Condition(a) for a in alts) + tuple(Condition(0.0, w) for w in winds)
+
+
+def paper_problem(backend: str = "paper", inputs: str = "relative") -> PitchProblem:
+    """The task of section 6.3: still air, start and target at 0 m."""
+    return PitchProblem(backend=backend, inputs=inputs)
+
+
+TASKS = ("paper", "robust")
+
+
+def make_problem(task: str = "paper", backend: str = "paper", inputs: str = "relative",
+                 params: ButterflyParams | None = None) -> PitchProblem:
+    """``paper``: section 6.3's task (still air, from 0 m); ``robust``: :func:`robust_conditions`."""
+    if task not in TASKS:
+        raise UserError(f"unknown task {task!r}; choose one of: {', '.join(TASKS)}.")
+    conds = (Condition(),) if task == "paper" else robust_conditions()
+    return PitchProblem(backend=backend, conditions=conds, inputs=inputs, params=params or ButterflyParams())
+
+
+def evolve_controller(problem: PitchProblem, optimizer: str, seed: int, out: str | Path,
+                      population: int | None = None, generations: int | None = None, evaluations: int | None = None,
+                      executor: str = "process", workers: int | None = None, ray_address: str | None = None,
+                      checkpoint: str | Path | None = None, resume: bool = False, progress: bool = True,
+                      task: str = "", command: str = ""):
+    """Run an optimiser on ``problem`` and write the best network as a controller file ``out``
+    (atomically, also when stopped by Ctrl-C: then with ``"interrupted": true`` in its provenance).
+
+    Returns ``(result, controller)``. The checkpoint (default ``out`` + ``.ckpt``) is written every
+    generation; ``resume`` continues from it."""
+    from lifelike_mj import __version__
+    from lifelike_mj.evolve import make_evaluator, optimize
+    from lifelike_mj.io import write_json
+
+    out = Path(out)
+    ckpt = Path(checkpoint) if checkpoint else out.with_name(out.name + ".ckpt")
+    with make_evaluator(problem, executor=executor, workers=workers, ray_address=ray_address) as ev:
+        res = optimize(problem, optimizer, seed=seed, population=population, generations=generations,
+                       evaluations=evaluations, evaluator=ev, checkpoint=ckpt, resume=resume, progress=progress)
+    if not np.all(np.isfinite(res.best_x)):
+        raise UserError(f"stopped before the first generation was evaluated; no controller written "
+                        f"(the checkpoint {ckpt} holds nothing yet).")
+    prov = {
+        "source": "lifelike-mj butterfly evolve",
+        "command": command,
+        "task": task or "custom",
+        "problem": problem.describe(),
+        "problem_fingerprint": problem.fingerprint(),
+        "optimizer": res.optimizer,
+        "seed": res.seed,
+        "population": res.population,
+        "budget": {"generations": generations, "evaluations": evaluations},
+        "generations_done": res.generations,
+        "evaluations_done": res.evaluations,
+        "best_fitness": float(res.best_f),
+        "interrupted": bool(res.interrupted),
+        "resumed": bool(res.resumed),
+        "executor": executor,
+        "wall_time_s": float(res.wall_time_s),
+        "package_version": __version__,
+        "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "fitness_history": [dict(h) for h in res.history],
+    }
+    ctrl = problem.controller(res.best_x, prov, out.stem)
+    write_json(out, ctrl.to_dict())
+    return res, ctrl
