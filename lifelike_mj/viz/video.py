@@ -28,15 +28,14 @@ import math
 import os
 import subprocess
 import sys
-import tempfile
 import time
-from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from lifelike_mj.errors import UserError
+from lifelike_mj.io import atomic_path
 
 if TYPE_CHECKING:  # pragma: no cover
     from lifelike_mj.butterfly.controllers import ButterflyController
@@ -338,24 +337,6 @@ def _camera(m, body: int, camera: str):
 # ---- writing files atomically -------------------------------------------------------------------
 
 
-@contextlib.contextmanager
-def _atomic_path(out_path: Path) -> Iterator[Path]:
-    """A temporary path beside ``out_path`` (same suffix) that replaces it when the block succeeds."""
-    out_path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=out_path.parent, prefix=f".{out_path.stem}.", suffix=out_path.suffix)
-    os.close(fd)
-    tmp_path = Path(tmp)
-    try:
-        yield tmp_path
-        mask = os.umask(0)  # mkstemp makes the file private; give it the permissions of a normal new file
-        os.umask(mask)
-        os.chmod(tmp_path, 0o666 & ~mask)
-        os.replace(tmp_path, out_path)
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            tmp_path.unlink()
-
-
 class _MP4Writer:
     def __init__(self, path: Path, fps: float) -> None:
         import imageio.v2 as iio
@@ -446,7 +427,7 @@ def render_butterfly(out_path: str | Path, controller: ButterflyController, para
     cam = _camera(flight.m, flight.body, camera)
     renderer = _Offscreen(flight.m, width, height)
     try:
-        with _atomic_path(out) as tmp:
+        with atomic_path(out) as tmp:
             writer = _WRITERS[suffix](tmp, fps)
             try:
                 for j in range(n_frames):
@@ -604,6 +585,6 @@ def snapshot_figure(out_path: str | Path, controller: ButterflyController, param
         a.imshow(img)
         a.set_axis_off()
         a.set_title(f"t = {times[i]:.3f} s", fontsize=9, pad=2)
-    with _atomic_path(out) as tmp:
+    with atomic_path(out) as tmp:
         fig.savefig(tmp, format="png", dpi=dpi)
     return out
