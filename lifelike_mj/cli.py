@@ -55,6 +55,8 @@ def _add_controller(p: argparse.ArgumentParser, required: bool = True) -> None:
     p.add_argument("--phi-up-deg", type=float, help="override simple_rule's upstroke pitch, deg")
     p.add_argument("--phi-down-deg", type=float, help="override simple_rule's downstroke pitch, deg")
     p.add_argument("--phi-deg", type=float, help="override a constant controller's pitch, deg")
+    p.add_argument("--inputs", choices=None, default=None,
+                   help="network controllers: feed relative (air) or ground velocities (section 7.2)")
 
 
 def _controller(args):
@@ -62,7 +64,10 @@ def _controller(args):
 
     ctrl = controllers.load(args.controller)
     overrides = {"phi_up_deg": args.phi_up_deg, "phi_down_deg": args.phi_down_deg, "phi_deg": args.phi_deg}
-    return ctrl.with_parameters(**overrides)
+    ctrl = ctrl.with_parameters(**overrides)
+    if getattr(args, "inputs", None):
+        ctrl = ctrl.with_inputs(args.inputs)
+    return ctrl
 
 
 def _add_backend(p: argparse.ArgumentParser) -> None:
@@ -168,6 +173,64 @@ def cmd_fly(args) -> None:
     _emit(args, summary, human)
 
 
+def cmd_evolve(args) -> None:
+    from lifelike_mj.butterfly.evolution import evolve_controller, make_problem
+
+    if args.generations is not None and args.evaluations is not None:
+        raise UserError("give either --generations or --evaluations, not both.")
+    gens = args.generations
+    if gens is None and args.evaluations is None:
+        gens = 1000  # the paper's budget (section 6.3)
+    problem = make_problem(args.task, args.backend, args.inputs, _params(args))
+    out = Path(args.out or f"butterfly_{args.optimizer}_{args.task}_s{args.seed}.json")
+    if out.suffix != ".json":
+        raise UserError(f"--out must be a .json file, got {str(out)!r}.")
+    res, ctrl = evolve_controller(problem, args.optimizer, args.seed, out, population=args.population,
+                                  generations=gens, evaluations=args.evaluations, executor=args.executor,
+                                  workers=args.workers, ray_address=args.ray_address, checkpoint=args.checkpoint,
+                                  resume=args.resume, progress=not args.quiet, task=args.task,
+                                  command="lifelike-mj " + " ".join(sys.argv[1:]))
+    d = {"out": str(out), **{k: v for k, v in ctrl.provenance.items() if k not in ("fitness_history", "problem")}}
+    state = "stopped early (Ctrl-C); best so far" if res.interrupted else "done"
+    _emit(args, d, f"{state}: best fitness H = {res.best_f:.1f} after {res.evaluations} evaluations "
+          f"({res.wall_time_s:.1f} s); controller written to {out}")
+    if res.interrupted:
+        raise KeyboardInterrupt
+
+
+def cmd_windmap(args) -> None:
+    from lifelike_mj.butterfly.ann_experiments import e11_windmap
+
+    ctrl = _controller(args)
+    if ctrl.type != "ann":
+        raise UserError(f"the wind map needs a network (ann) controller; {args.controller!r} is {ctrl.type!r}.")
+    m = e11_windmap(ctrl, args.inputs, _positive("--step", args.step), _positive("--max", args.max), _params(args),
+                    progress=not args.json)
+    d = {"controller": ctrl.name or args.controller, **m.to_dict()}
+    if args.plot:
+        from lifelike_mj.viz.ann_figures import fig_windmap
+
+        fig_windmap(m, args.plot, titles=[f"{d['controller']} ({m.inputs} inputs)"])
+        d["plot"] = args.plot
+    _emit(args, d, f"{m.pass_cells} of {m.total_cells} wind cells pass ({m.inputs} velocity inputs)")
+
+
+def cmd_assess(args) -> None:
+    from lifelike_mj.butterfly.ann_experiments import assess
+
+    ctrl = _controller(args)
+    if ctrl.type != "ann":
+        raise UserError(f"assess needs a network (ann) controller; {args.controller!r} is {ctrl.type!r}.")
+    d = {"controller": ctrl.name or args.controller, **assess(ctrl, _params(args))}
+    s = d["still_air"]
+    human = (f"still air: drop {s['initial_drop_m']:.2f} m, settled [{s['settled_altitude_min_m']:+.3f}, "
+             f"{s['settled_altitude_max_m']:+.3f}] m at {s['settled_forward_speed_cm_s']:.0f} cm/s; from +10 m holds: "
+             f"{d['from_+10m_holds']}; from below reaches 0 m: {d['from_below_reaches_target']}; 2 m/s tail wind "
+             f"holds +-0.5 m: {d['tail_wind_2m_s']['holds_0_5m']}; wind map passes {d['windmap_pass_cells']} of "
+             f"{d['windmap_total_cells']}")
+    _emit(args, d, human)
+
+
 def cmd_compare(args) -> None:
     from lifelike_mj.butterfly.compare import compare
 
@@ -271,6 +334,39 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="folder for trajectory.npz/.csv, flight.png, summary.json")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_fly)
+    p = bf.add_parser("evolve", help="evolve the network pitch controller (section 6) with an optimiser")
+    p.add_argument("--optimizer", required=True, help="rcga (the paper's GA), cmaes, crs2, esch or isres")
+    p.add_argument("--task", default="paper", help="paper (still air from 0 m, section 6.3) or robust (varied starts, winds)")
+    p.add_argument("--population", type=int, default=None, help="population size (rcga default 40)")
+    p.add_argument("--generations", type=int, default=None, help="generations (default 1000)")
+    p.add_argument("--evaluations", type=int, default=None, help="budget in evaluations instead of generations")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--backend", default="paper", help="paper (compiled eq. 7-11) or mujoco")
+    p.add_argument("--inputs", default=None,
+                   help="velocity inputs: relative (air), ground, or both (default: relative; robust task: both)")
+    p.add_argument("--executor", default="process", help="serial, process (default: all cores) or ray")
+    p.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
+    p.add_argument("--ray-address", default=None, help="Ray cluster address (default: start a local one)")
+    p.add_argument("--checkpoint", default=None, help="checkpoint file (default: OUT.ckpt), written every generation")
+    p.add_argument("--resume", action="store_true", help="continue from the checkpoint")
+    p.add_argument("--out", default=None, help="controller file to write (.json)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--json", action="store_true")
+    _add_physics(p)
+    p.set_defaults(func=cmd_evolve)
+    p = bf.add_parser("windmap", help="E11: pass/fail map over uniform winds (section 7.2)")
+    _add_controller(p)
+    _add_physics(p)
+    p.add_argument("--step", type=float, default=0.1, help="grid step, m/s")
+    p.add_argument("--max", type=float, default=3.0, help="largest wind component, m/s")
+    p.add_argument("--plot", default=None, help="write the map as a PNG")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_windmap)
+    p = bf.add_parser("assess", help="a network controller's acceptance numbers (E6, E7, E9, tail wind, E11)")
+    _add_controller(p)
+    _add_physics(p)
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_assess)
     p = bf.add_parser("compare", help="the same flight on both backends")
     _add_controller(p)
     _add_physics(p)

@@ -7,7 +7,10 @@ picklable value whose ``evaluate`` flies a whole population as one batch (parall
 paper backend, one ``mjData`` per individual on parallel threads on the MuJoCo backend).
 
 With several :class:`Condition` s (start altitudes, winds), the fitness is the mean of ``H`` over
-them: the "training over varied conditions" that section 7 proposes as future work.
+them: the "training over varied conditions" that section 7 proposes as future work. With
+``inputs="both"`` every windy condition is flown twice, once with air-relative and once with ground
+velocity inputs (section 7.2's two readings), so that one network is trained for both; the
+controller file then reads relative velocities by default.
 """
 
 from __future__ import annotations
@@ -49,8 +52,8 @@ class PitchProblem:
     def __post_init__(self) -> None:
         if self.backend not in BACKENDS:
             raise UserError(f"unknown backend {self.backend!r}; choose one of: {', '.join(BACKENDS)}.")
-        if self.inputs not in ann.INPUT_KINDS:
-            raise UserError(f"inputs must be one of {', '.join(ann.INPUT_KINDS)}, got {self.inputs!r}.")
+        if self.inputs not in (*ann.INPUT_KINDS, "both"):
+            raise UserError(f"inputs must be one of {', '.join(ann.INPUT_KINDS)} or both, got {self.inputs!r}.")
         if not self.conditions:
             raise UserError("an evolution needs at least one flight condition.")
         check_timing(self.duration_s, self.dt_s)
@@ -97,36 +100,54 @@ class PitchProblem:
         X = np.atleast_2d(np.asarray(X, dtype=float))
         if X.shape[1] != ann.N_WEIGHTS:
             raise UserError(f"a genome has {ann.N_WEIGHTS} weights, got {X.shape[1]}.")
-        n, nc = X.shape[0], len(self.conditions)
+        n = X.shape[0]
         template = self.controller(np.zeros(ann.N_WEIGHTS)).compiled()[1]
         cp = np.repeat(template[None, :], n, axis=0)
         cp[:, ann.A_W :] = X
         n_steps = check_timing(self.duration_s, self.dt_s)
+        flights = self.flights()
+        nf = len(flights)
+        fits = []
         if self.backend == "paper":
-            cps = np.tile(cp, (nc, 1))
-            kinds = np.full(n * nc, KIND_ANN, dtype=np.int64)
-            flaps = np.repeat(self.flap.as_array()[None, :], n * nc, axis=0)
-            airs = np.repeat(np.array([c.air_velocity() for c in self.conditions]), n, axis=0)
-            y0s = np.repeat(np.array([c.y0_m for c in self.conditions], dtype=float), n)
-            consts = np.repeat(constants_row(self.params)[None, :], n * nc, axis=0)
+            cps = np.tile(cp, (nf, 1))
+            cps[:, ann.A_RELATIVE] = np.repeat([1.0 if rel else 0.0 for _, rel in flights], n)
+            kinds = np.full(n * nf, KIND_ANN, dtype=np.int64)
+            flaps = np.repeat(self.flap.as_array()[None, :], n * nf, axis=0)
+            airs = np.repeat(np.array([c.air_velocity() for c, _ in flights]), n, axis=0)
+            y0s = np.repeat(np.array([c.y0_m for c, _ in flights], dtype=float), n)
+            consts = np.repeat(constants_row(self.params)[None, :], n * nf, axis=0)
             _, _, fit = run_batch(kinds, cps, flaps, airs, y0s, consts, n_steps, self.dt_s, n_steps)
-            return fit.reshape(nc, n).mean(axis=0)
+            return fit.reshape(nf, n).mean(axis=0)
         from lifelike_mj.butterfly.mjbackend import fitness_batch
 
-        return np.mean([fitness_batch(cp, self.flap, self.params, cond, n_steps, self.dt_s) for cond in self.conditions],
-                       axis=0)
+        for cond, rel in flights:
+            c = cp.copy()
+            c[:, ann.A_RELATIVE] = 1.0 if rel else 0.0
+            fits.append(fitness_batch(c, self.flap, self.params, cond, n_steps, self.dt_s))
+        return np.mean(fits, axis=0)
+
+    def flights(self) -> list[tuple[Condition, bool]]:
+        """The flights of one evaluation: ``(condition, air-relative inputs?)``."""
+        out = []
+        for c in self.conditions:
+            windy = any(w != 0.0 for w in c.wind_m_s)
+            if self.inputs == "both" and windy:
+                out += [(c, True), (c, False)]
+            else:
+                out.append((c, self.inputs != "ground"))
+        return out
 
     # ---- helpers ----
     def controller(self, weights, provenance: dict | None = None, name: str = "") -> ButterflyController:
         """The controller file content of a genome."""
-        return ann_controller(weights, self.flap, self.inputs, provenance, name)
+        return ann_controller(weights, self.flap, "ground" if self.inputs == "ground" else "relative", provenance, name)
 
 
 def robust_conditions() -> tuple[Condition, ...]:
     """Training conditions for ``ann_robust``: start altitudes from -10 to +10 m in still air, and
-    2 m/s winds from the four directions of section 7.2 plus diagonal ones, from 0 m."""
-    alts = (-10.0, -5.0, -2.0, 0.0, 2.0, 10.0)
-    winds = ((2.0, 0.0), (-2.0, 0.0), (0.0, 2.0), (0.0, -2.0), (-1.5, 1.0), (-1.5, -1.0))
+    2 m/s winds from the four directions of section 7.2 plus two tail-and-vertical ones, from 0 m."""
+    alts = (-10.0, -4.0, 0.0, 4.0, 10.0)
+    winds = ((2.0, 0.0), (-2.0, 0.0), (0.0, 2.0), (0.0, -2.0), (-2.0, 1.0), (-2.0, -1.0))
     return tuple(Condition(a) for a in alts) + tuple(Condition(0.0, w) for w in winds)
 
 
@@ -138,12 +159,15 @@ def paper_problem(backend: str = "paper", inputs: str = "relative") -> PitchProb
 TASKS = ("paper", "robust")
 
 
-def make_problem(task: str = "paper", backend: str = "paper", inputs: str = "relative",
+def make_problem(task: str = "paper", backend: str = "paper", inputs: str | None = None,
                  params: ButterflyParams | None = None) -> PitchProblem:
-    """``paper``: section 6.3's task (still air, from 0 m); ``robust``: :func:`robust_conditions`."""
+    """``paper``: section 6.3's task (still air, from 0 m; inputs default ``relative``);
+    ``robust``: :func:`robust_conditions` (inputs default ``both``)."""
     if task not in TASKS:
         raise UserError(f"unknown task {task!r}; choose one of: {', '.join(TASKS)}.")
     conds = (Condition(),) if task == "paper" else robust_conditions()
+    if inputs is None:
+        inputs = "both" if task == "robust" else "relative"
     return PitchProblem(backend=backend, conditions=conds, inputs=inputs, params=params or ButterflyParams())
 
 
