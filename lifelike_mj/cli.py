@@ -336,7 +336,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_fly)
     p = bf.add_parser("evolve", help="evolve the network pitch controller (section 6) with an optimiser")
     p.add_argument("--optimizer", required=True, help="rcga (the paper's GA), cmaes, crs2, esch or isres")
-    p.add_argument("--task", default="paper", help="paper (still air from 0 m, section 6.3) or robust (varied starts, winds)")
+    p.add_argument("--task", default="paper",
+                   help="paper (still air from 0 m, section 6.3), robust or robust_wide (varied starts and winds)")
     p.add_argument("--population", type=int, default=None, help="population size (rcga default 40)")
     p.add_argument("--generations", type=int, default=None, help="generations (default 1000)")
     p.add_argument("--evaluations", type=int, default=None, help="budget in evaluations instead of generations")

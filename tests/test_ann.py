@@ -165,3 +165,35 @@ def test_windmap_small_grid():
     assert bool(m.passed[1, 1]) == ok
     with pytest.raises(UserError):
         e11_windmap(c, step_m_s=0.3, max_m_s=1.0)
+
+
+def test_robust_task_flies_windy_conditions_with_both_input_readings():
+    prob = make_problem("robust")
+    flights = prob.flights()
+    windy = [c for c in prob.conditions if any(c.wind_m_s)]
+    assert prob.inputs == "both" and len(flights) == len(prob.conditions) + len(windy)
+    short = PitchProblem(duration_s=0.3, conditions=prob.conditions, inputs="both")
+    x = _weights(7)
+    c = short.controller(x)
+    vals = [paper.simulate(c.with_inputs("relative" if rel else "ground"), conditions=cd, duration_s=0.3)[0].fitness
+            for cd, rel in short.flights()]
+    assert short.evaluate(x[None])[0] == pytest.approx(np.mean(vals), rel=1e-12)
+
+
+def test_cli_evolve_writes_a_controller_with_provenance_same_on_serial_and_process(tmp_path):
+    outs = {}
+    for ex in ("serial", "process"):
+        out = tmp_path / f"{ex}.json"
+        assert main(["butterfly", "evolve", "--optimizer", "rcga", "--population", "6", "--generations", "3", "--seed",
+                     "5", "--executor", ex, "--workers", "2", "--quiet", "--out", str(out)]) == 0
+        outs[ex] = json.loads(out.read_text())
+        assert (tmp_path / f"{ex}.json.ckpt").exists()
+    a, b = outs["serial"], outs["process"]
+    assert a["parameters"]["weights"] == b["parameters"]["weights"]
+    prov = a["provenance"]
+    for key in ("optimizer", "seed", "budget", "fitness_history", "package_version", "wall_time_s", "problem"):
+        assert key in prov
+    assert prov["optimizer"] == "rcga" and prov["seed"] == 5 and len(prov["fitness_history"]) == 3
+    c = controllers.load(tmp_path / "serial.json")
+    tr = paper.simulate(c)[0]
+    assert tr.fitness == pytest.approx(prov["best_fitness"], rel=1e-12)  # the file reproduces its fitness

@@ -145,9 +145,19 @@ class PitchProblem:
 
 def robust_conditions() -> tuple[Condition, ...]:
     """Training conditions for ``ann_robust``: start altitudes from -10 to +10 m in still air, and
-    2 m/s winds from the four directions of section 7.2 plus two tail-and-vertical ones, from 0 m."""
+    2 m/s winds from 0 m: the four of section 7.2 and two tail winds combined with wind from above
+    and from below (the paper's weak corner of the E11 map)."""
     alts = (-10.0, -4.0, 0.0, 4.0, 10.0)
     winds = ((2.0, 0.0), (-2.0, 0.0), (0.0, 2.0), (0.0, -2.0), (-2.0, 1.0), (-2.0, -1.0))
+    return tuple(Condition(a) for a in alts) + tuple(Condition(0.0, w) for w in winds)
+
+
+def robust_wide_conditions() -> tuple[Condition, ...]:
+    """:func:`robust_conditions` widened to the edge of the E11 map: 3 m/s winds from each side, and
+    the tail-plus-vertical winds at 1.5 m/s vertical."""
+    alts = (-10.0, -4.0, 0.0, 4.0, 10.0)
+    winds = ((2.0, 0.0), (-2.0, 0.0), (0.0, 2.0), (0.0, -2.0), (3.0, 0.0), (-3.0, 0.0), (0.0, 3.0), (0.0, -3.0),
+             (-2.0, 1.5), (-2.0, -1.5))
     return tuple(Condition(a) for a in alts) + tuple(Condition(0.0, w) for w in winds)
 
 
@@ -156,18 +166,19 @@ def paper_problem(backend: str = "paper", inputs: str = "relative") -> PitchProb
     return PitchProblem(backend=backend, inputs=inputs)
 
 
-TASKS = ("paper", "robust")
+TASKS = ("paper", "robust", "robust_wide")
 
 
 def make_problem(task: str = "paper", backend: str = "paper", inputs: str | None = None,
                  params: ButterflyParams | None = None) -> PitchProblem:
     """``paper``: section 6.3's task (still air, from 0 m; inputs default ``relative``);
-    ``robust``: :func:`robust_conditions` (inputs default ``both``)."""
+    ``robust`` / ``robust_wide``: :func:`robust_conditions` / :func:`robust_wide_conditions`
+    (inputs default ``both``)."""
     if task not in TASKS:
         raise UserError(f"unknown task {task!r}; choose one of: {', '.join(TASKS)}.")
-    conds = (Condition(),) if task == "paper" else robust_conditions()
+    conds = {"paper": (Condition(),), "robust": robust_conditions(), "robust_wide": robust_wide_conditions()}[task]
     if inputs is None:
-        inputs = "both" if task == "robust" else "relative"
+        inputs = "relative" if task == "paper" else "both"
     return PitchProblem(backend=backend, conditions=conds, inputs=inputs, params=params or ButterflyParams())
 
 

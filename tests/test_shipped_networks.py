@@ -1,0 +1,75 @@
+"""The shipped evolved controllers meet the issue's acceptance numbers (computed, not stored)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lifelike_mj.butterfly import ann_experiments as ax
+from lifelike_mj.butterfly import controllers, mjbackend, paper
+from lifelike_mj.butterfly.evolution import make_problem
+from lifelike_mj.butterfly.paper import Condition
+
+
+@pytest.fixture(scope="module")
+def ann_paper():
+    return controllers.load("ann_paper")
+
+
+@pytest.fixture(scope="module")
+def ann_robust():
+    return controllers.load("ann_robust")
+
+
+def test_ann_paper_reproduces_its_recorded_fitness(ann_paper):
+    prov = ann_paper.provenance
+    assert prov["optimizer"] == "rcga" and prov["population"] == 40 and prov["generations_done"] == 1000
+    prob = make_problem("paper")
+    assert prov["problem_fingerprint"] == prob.fingerprint()
+    assert prob.evaluate(ann_paper.weights[None])[0] == pytest.approx(prov["best_fitness"], rel=1e-12)
+
+
+def test_ann_paper_level_flight_e6(ann_paper):
+    s = ax.e6_level(ann_paper).numbers
+    assert s["initial_drop_m"] <= 1.0
+    assert -0.25 <= s["settled_altitude_min_m"] and s["settled_altitude_max_m"] <= 0.25
+    assert s["settled_forward_speed_cm_s"] > 200.0
+
+
+def test_ann_paper_from_plus_10m_descends_and_holds_e7(ann_paper):
+    s = ax.e7_from_above(ann_paper).flights["+10 m"]
+    assert s["holds_level"], s
+
+
+def test_ann_paper_fails_from_minus_10m_like_the_paper_e9(ann_paper):
+    assert not ax.e9_from_below(ann_paper, starts=(-10.0,)).flights["-10 m"]["reaches_target"]
+
+
+def test_ann_paper_on_mujoco_matches_the_paper_backend(ann_paper):
+    ref = paper.simulate(ann_paper)[0]
+    mj = mjbackend.simulate(ann_paper)[0]
+    assert np.max(np.abs(ref.y - mj.y)) < 0.02
+
+
+def test_ann_robust_climbs_back_from_minus_10m(ann_robust):
+    s = ax.e9_from_below(ann_robust, starts=(-10.0,)).flights["-10 m"]
+    assert s["time_to_within_0_5m_s"] is not None and s["time_to_within_0_5m_s"] < 20.0
+    assert s["reaches_target"]
+
+
+def test_ann_robust_survives_the_tail_wind(ann_robust):
+    tr = paper.simulate(ann_robust, conditions=Condition(0.0, (-2.0, 0.0)))[0]
+    s = ax.flight_numbers(tr, 0.5)
+    assert s["initial_drop_m"] <= 2.0 and s["holds_level"]
+
+
+def test_ann_robust_holds_level_in_still_air(ann_robust):
+    s = ax.e6_level(ann_robust).numbers
+    assert s["holds_level"] and s["settled_forward_speed_cm_s"] > 200.0
+
+
+@pytest.mark.parametrize("inputs", ["relative", "ground"])
+def test_ann_robust_passes_more_wind_cells(ann_paper, ann_robust, inputs):
+    a = ax.e11_windmap(ann_paper, inputs)
+    b = ax.e11_windmap(ann_robust, inputs)
+    assert b.pass_cells > a.pass_cells
