@@ -8,12 +8,16 @@ Prints the result (``OptimizationResult.to_dict()``) as one JSON line on stdout.
 from __future__ import annotations
 
 import json
+import signal
 import sys
 
 from lifelike_mj.evolve import Rastrigin, make_evaluator, optimize
 
 
 def main(argv: list[str]) -> int:
+    # Behave like a program started from a terminal even when the test run itself was started in the
+    # background (a non-interactive shell then sets SIGINT to "ignore", and children inherit that).
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     checkpoint, optimizer, seed, population, generations, delay_s, executor, workers = argv
     problem = Rastrigin(dim=3, delay_s=float(delay_s))
     with make_evaluator(problem, executor, workers=int(workers)) as evaluator:
