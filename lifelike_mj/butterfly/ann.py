@@ -85,13 +85,14 @@ def ann_pitch(cp, theta, omega, y, vy, vz, air_y, air_z, phi_prev):
     return phi
 
 
-def default_scales(theta_c_rad: float, theta_a_rad: float, omega_peak_rad_s: float) -> dict:
-    """The documented input scales for a flap pattern (see module docstring)."""
+def default_scales(flap) -> dict:
+    """The documented input scales for a :class:`~lifelike_mj.butterfly.params.FlapPattern`
+    (see module docstring): omega over the flap's peak rate ``theta_a 2 pi f``, theta about its centre."""
     return {
         "phi_deg": DEFAULT_SCALES["phi_deg"],
-        "omega_rad_s": float(omega_peak_rad_s),
-        "theta_center_deg": math.degrees(theta_c_rad),
-        "theta_half_range_deg": math.degrees(theta_a_rad),
+        "omega_rad_s": float(flap.theta_a * 2.0 * math.pi * flap.frequency_hz),
+        "theta_center_deg": math.degrees(flap.theta_c),
+        "theta_half_range_deg": math.degrees(flap.theta_a),
         "vy_m_s": DEFAULT_SCALES["vy_m_s"],
         "y_m": DEFAULT_SCALES["y_m"],
         "vz_m_s": DEFAULT_SCALES["vz_m_s"],

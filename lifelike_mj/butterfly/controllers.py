@@ -88,8 +88,7 @@ class ButterflyController:
 
     def input_scale(self) -> dict:
         """The network's input scales (ann only): the file's values over the flap's defaults."""
-        f = self.flap
-        scales = ann.default_scales(f.theta_c, f.theta_a, f.theta_a * 2.0 * math.pi * f.frequency_hz)
+        scales = ann.default_scales(self.flap)
         scales.update(self.parameters.get("input_scale", {}))
         return scales
 
@@ -188,12 +187,11 @@ def ann_controller(weights, flap: FlapPattern | None = None, inputs: str = "rela
 
     The default flap is section 6.3's: 10 Hz over [-60, 75] degrees."""
     flap = flap or FlapPattern(10.0, -60.0, 75.0)
-    f = flap
     params = {
         "inputs": inputs,
         "max_dphi_deg": ann.DEFAULT_MAX_DPHI_DEG,
         "phi_limit_deg": ann.DEFAULT_PHI_LIMIT_DEG,
-        "input_scale": ann.default_scales(f.theta_c, f.theta_a, f.theta_a * 2.0 * math.pi * f.frequency_hz),
+        "input_scale": ann.default_scales(flap),
         "weights": [float(x) for x in np.asarray(weights, dtype=float).ravel()],
     }
     return ButterflyController("ann", flap, params, dict(provenance or {}), name)

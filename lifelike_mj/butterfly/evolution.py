@@ -24,12 +24,12 @@ from pathlib import Path
 import numpy as np
 
 from lifelike_mj.butterfly import ann
+from lifelike_mj.butterfly.backends import check_backend
 from lifelike_mj.butterfly.controllers import KIND_ANN, ButterflyController, ann_controller
 from lifelike_mj.butterfly.paper import Condition, check_timing, constants_row, run_batch
 from lifelike_mj.butterfly.params import ButterflyParams, FlapPattern
 from lifelike_mj.errors import UserError
 
-BACKENDS = ("paper", "mujoco")
 #: Gene bounds for optimisers that need them (nlopt, CMA-ES); the RCGA starts in [-1, 1] and is
 #: unbounded, as in the paper.
 GENE_BOUND = 5.0
@@ -50,8 +50,7 @@ class PitchProblem:
     gene_bound: float = GENE_BOUND
 
     def __post_init__(self) -> None:
-        if self.backend not in BACKENDS:
-            raise UserError(f"unknown backend {self.backend!r}; choose one of: {', '.join(BACKENDS)}.")
+        check_backend(self.backend)
         if self.inputs not in (*ann.INPUT_KINDS, "both"):
             raise UserError(f"inputs must be one of {', '.join(ann.INPUT_KINDS)} or both, got {self.inputs!r}.")
         if not self.conditions:
@@ -107,7 +106,6 @@ class PitchProblem:
         n_steps = check_timing(self.duration_s, self.dt_s)
         flights = self.flights()
         nf = len(flights)
-        fits = []
         if self.backend == "paper":
             cps = np.tile(cp, (nf, 1))
             cps[:, ann.A_RELATIVE] = np.repeat([1.0 if rel else 0.0 for _, rel in flights], n)
@@ -120,6 +118,7 @@ class PitchProblem:
             return fit.reshape(nf, n).mean(axis=0)
         from lifelike_mj.butterfly.mjbackend import fitness_batch
 
+        fits = []
         for cond, rel in flights:
             c = cp.copy()
             c[:, ann.A_RELATIVE] = 1.0 if rel else 0.0
@@ -159,11 +158,6 @@ def robust_wide_conditions() -> tuple[Condition, ...]:
     winds = ((2.0, 0.0), (-2.0, 0.0), (0.0, 2.0), (0.0, -2.0), (3.0, 0.0), (-3.0, 0.0), (0.0, 3.0), (0.0, -3.0),
              (-2.0, 1.5), (-2.0, -1.5))
     return tuple(Condition(a) for a in alts) + tuple(Condition(0.0, w) for w in winds)
-
-
-def paper_problem(backend: str = "paper", inputs: str = "relative") -> PitchProblem:
-    """The task of section 6.3: still air, start and target at 0 m."""
-    return PitchProblem(backend=backend, inputs=inputs)
 
 
 TASKS = ("paper", "robust", "robust_wide")

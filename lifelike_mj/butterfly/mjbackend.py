@@ -481,11 +481,10 @@ def advance(mptr, dptr, qpos, qvel, ud, k0, n_steps, kind, cp, flap, y_ref, lay,
 def _fitness_batch(mptr, dptrs, kinds, cparams, flap, lay, dt, n_steps, diverged, fitness):
     """Fly ``len(dptrs)`` butterflies (one ``mjData`` each, sharing model ``mptr``) on parallel
     threads; writes each one's eq. 13 fitness and divergence step."""
-    nq_off = _OFF_QPOS
     for b in prange(len(dptrs)):
         base = dptrs[b]
         ud = _f64(_ptr_at(base + _OFF_UD), N_USERDATA)
-        qpos = _f64(_ptr_at(base + nq_off), int(ud[U_NQ]))
+        qpos = _f64(_ptr_at(base + _OFF_QPOS), int(ud[U_NQ]))
         qvel = _f64(_ptr_at(base + _OFF_QVEL), int(ud[U_NV]))
         dv = np.full(1, -1, dtype=np.int64)
         fit = np.zeros(1)
@@ -563,6 +562,7 @@ def fitness_batch(cparams: np.ndarray, flap, params: ButterflyParams | None, con
     """Eq. 13 fitness of a batch of compiled ann controllers (rows of ``cparams``) flown on MuJoCo
     under one condition: one ``mjData`` per individual, stepped on parallel native threads with the
     compiled callback and the compiled controller (weights per simulation)."""
+    from lifelike_mj.butterfly import ann
     from lifelike_mj.butterfly.controllers import KIND_ANN, ann_controller
 
     p = params or ButterflyParams()
@@ -572,7 +572,7 @@ def fitness_batch(cparams: np.ndarray, flap, params: ButterflyParams | None, con
         m.opt.timestep = float(dt_s)
         _MODEL_CACHE[key] = m
     m = _MODEL_CACHE[key]
-    proto = ann_controller(np.zeros(cparams.shape[1] - 10), flap)
+    proto = ann_controller(np.zeros(ann.N_WEIGHTS), flap)  # setup_data needs only its flap
     datas = [setup_data(m, proto, p, condition, force_mode) for _ in range(len(cparams))]
     dptrs = np.array([d._address for d in datas], dtype=np.int64)
     n = len(datas)
@@ -590,13 +590,13 @@ def _run_python(m, d, n_steps, record_every, controller, cond, lay, dt, out, div
     kind, cp = controller.compiled()
     flap = controller.flap.as_array()
     qpos, qvel = d.qpos, d.qvel
+    air_z, air_y = cond.air_velocity()
     phi, r = 0.0, 1
     with passive_callback(python_passive):
         for k in range(n_steps):
             t = k * dt
             theta = flap[0] + flap[1] * math.cos(flap[2] * t)
             omega = -flap[1] * flap[2] * math.sin(flap[2] * t)
-            air_z, air_y = cond.air_velocity()
             phi = pitch_command.py_func(kind, cp, t, theta, omega, qpos[lay.q_height],
                                         qpos[lay.q_forward], qvel[lay.d_height], qvel[lay.d_forward], air_y, air_z, phi)
             if lay.rich:
