@@ -243,19 +243,101 @@ def cmd_compare(args) -> None:
           f"{r.max_altitude_excursion_m:.2f} m excursion), largest forward difference {r.max_forward_diff_m * 100:.2f} cm")
 
 
-def cmd_reproduce(args) -> None:
-    if args.what != "butterfly":
-        raise UserError(f"nothing to reproduce for {args.what!r} yet; available: butterfly.")
-    from lifelike_mj.butterfly.reproduce import reproduce_all
+def _fish_preset(args):
+    from lifelike_mj.fish.params import load_preset
 
-    out = Path(args.out)
-    reproduce_all(out, _params(args))
+    return load_preset(args.preset)
+
+
+def _fish_count(n) -> int:
+    if n is None or n < 1:
+        raise UserError(f"--fish must be at least 1, got {n}.")
+    return int(n)
+
+
+def _tank(args):
+    from lifelike_mj.fish.scene import tank_size
+
+    return tank_size(_positive("--tank-scale", args.tank_scale))
+
+
+def cmd_fish_swim(args) -> None:
+    from lifelike_mj.fish.experiments import swim_summary, write_tracks
+    from lifelike_mj.fish.sim import swim
+
+    params = _fish_preset(args)
+    n = _fish_count(args.fish)
+    if args.seed < 0:
+        raise UserError(f"--seed must be a non-negative whole number, got {args.seed}.")
+    if args.video and Path(args.video).suffix.lower() not in (".mp4", ".gif"):
+        raise UserError(f"--video must end in .mp4 or .gif, got {args.video!r}.")
+    r = swim(params, n, _positive("--duration", args.duration), args.seed, _tank(args), progress=not args.json)
+    summary = swim_summary(r)
+    if args.out:
+        from lifelike_mj.io import write_json
+        from lifelike_mj.viz.fish_figures import accel_histogram_figure, tracks_figure
+
+        out = Path(args.out)
+        files = write_tracks(r, out)
+        tracks_figure(r, out / "tracks.png")
+        accel_histogram_figure(r, out / "accel_histogram.png")
+        write_json(out / "measures.json", summary)
+        summary["files"] = [str(f) for f in (*files.values(), out / "tracks.png", out / "accel_histogram.png",
+                                                out / "measures.json")]
+    if args.video:
+        from lifelike_mj.viz.fish_video import render_fish
+
+        info = render_fish(args.video, params, n, min(args.duration, args.video_duration), args.seed, _tank(args),
+                           camera=args.camera)
+        summary["video"] = info
+    _emit(args, summary, (f"{n} fish, {summary['duration_s']:.0f} s ({params.name}): a burst every "
+                          f"{summary['burst_interval_mean_s']:.2f} s, burstiness {summary['burstiness']:.3f}, "
+                          f"acceleration kurtosis {summary['accel_kurtosis']:.2f}, turning entropy "
+                          f"{summary['turn_entropy']:.2f} bits, mean speed {summary['mean_speed_body_lengths_s']:.2f} "
+                          f"body lengths/s, {summary['fish_outside_tank']} outside the tank "
+                          f"({summary['realtime_factor']:.0f}x real time)"))
+
+
+def cmd_fish_drag_check(args) -> None:
+    from lifelike_mj.fish.experiments import drag_check
+
+    r = drag_check()
+    _emit(args, r, f"custom drag vs MuJoCo's inertia-box fluid model: max relative error {r['max_rel_error']:.2e} "
+          f"over {r['trials']} random states")
+
+
+def cmd_reproduce(args) -> None:
+    if args.what not in ("butterfly", "fish"):
+        raise UserError(f"nothing to reproduce for {args.what!r} yet; available: butterfly, fish.")
+    out = Path(args.out or f"reports/{args.what}")
+    if args.what == "fish":
+        from lifelike_mj.fish.reproduce import reproduce_fish
+
+        reproduce_fish(out)
+    else:
+        from lifelike_mj.butterfly.reproduce import reproduce_all
+
+        reproduce_all(out, _params(args))
     print(f"report written to {out / 'report.md'}")
 
 
 def cmd_bench(args) -> None:
-    if args.what != "butterfly":
-        raise UserError(f"no benchmark for {args.what!r} yet; available: butterfly.")
+    if args.what not in ("butterfly", "fish"):
+        raise UserError(f"no benchmark for {args.what!r} yet; available: butterfly, fish.")
+    if args.what == "fish":
+        from lifelike_mj.fish import bench as fish_bench
+
+        r = fish_bench.run(repeats=args.repeats, long_minutes=args.long_minutes)
+        if args.out:
+            from lifelike_mj.io import write_json
+
+            write_json(args.out, r)
+        rend = r.get("render", {})
+        human = (f"10 fish x{r['ten']['realtime_factor']:.0f} real time, 1,000 fish "
+                 f"x{r['thousand']['realtime_factor']:.2f}, render {rend.get('render_fps', float('nan')):.0f} fps "
+                 f"at 640x480")
+        _emit(args, r, human)
+        return
     from lifelike_mj.butterfly import bench
 
     r = bench.run(repeats=args.repeats)
@@ -270,8 +352,13 @@ def cmd_bench(args) -> None:
 
 
 def cmd_view(args) -> None:
-    if args.what != "butterfly":
-        raise UserError(f"nothing to view for {args.what!r} yet; available: butterfly.")
+    if args.what not in ("butterfly", "fish"):
+        raise UserError(f"nothing to view for {args.what!r} yet; available: butterfly, fish.")
+    if args.what == "fish":
+        from lifelike_mj.viz.fish_video import view_fish
+
+        view_fish(_fish_preset(args), _fish_count(args.fish), args.seed, _tank(args), duration_s=args.duration)
+        return
     from lifelike_mj.butterfly.paper import Condition
     from lifelike_mj.viz.viewer import view_butterfly
 
@@ -281,10 +368,18 @@ def cmd_view(args) -> None:
 
 
 def cmd_render(args) -> None:
-    if args.what != "butterfly":
-        raise UserError(f"nothing to render for {args.what!r} yet; available: butterfly.")
+    if args.what not in ("butterfly", "fish"):
+        raise UserError(f"nothing to render for {args.what!r} yet; available: butterfly, fish.")
     if Path(args.out).suffix.lower() not in (".mp4", ".gif"):
         raise UserError(f"--out must end in .mp4 or .gif, got {args.out!r}.")
+    if args.what == "fish":
+        from lifelike_mj.viz.fish_video import render_fish
+
+        info = render_fish(args.out, _fish_preset(args), _fish_count(args.fish),
+                           _positive("--duration", args.duration), args.seed, _tank(args), fps=args.fps,
+                           width=args.width, height=args.height, camera=args.camera or "side")
+        _emit(args, info, f"wrote {info['frames']} frames to {args.out}")
+        return
     from lifelike_mj.butterfly.paper import Condition
     from lifelike_mj.viz.video import render_butterfly
 
@@ -293,6 +388,15 @@ def cmd_render(args) -> None:
                             duration_s=_positive("--duration", args.duration), fps=args.fps, width=args.width,
                             height=args.height)
     _emit(args, info, f"wrote {info['frames']} frames to {args.out}")
+
+
+def _add_fish(p) -> None:
+    p.add_argument("--preset", default="default",
+                   help="fish motion preset: NB-ND, NB-D, B-ND, B-D, default (= B-D), or a JSON file")
+    p.add_argument("--fish", type=int, default=10, help="number of fish")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--tank-scale", type=float, default=1.0,
+                   help="tank size as a fraction of the filmed 5 m x 0.5 m x 1 m tank")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -337,7 +441,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = bf.add_parser("evolve", help="evolve the network pitch controller (section 6) with an optimiser")
     p.add_argument("--optimizer", required=True, help="rcga (the paper's GA), cmaes, crs2, esch or isres")
     p.add_argument("--task", default="paper",
-                   help="paper (still air from 0 m, section 6.3), robust or robust_wide (varied starts and winds)")
+                   help="paper (still air from 0 m, section 6.3); robust, robust_wide or robust_map (varied starts and winds)")
     p.add_argument("--population", type=int, default=None, help="population size (rcga default 40)")
     p.add_argument("--generations", type=int, default=None, help="generations (default 1000)")
     p.add_argument("--evaluations", type=int, default=None, help="budget in evaluations instead of generations")
@@ -378,15 +482,31 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_compare)
 
+    fish = sub.add_parser("fish", help="the tropical fish of Satoi et al. 2015").add_subparsers(
+        dest="command", required=True, parser_class=_Parser)
+    p = fish.add_parser("swim", help="a tank of fish: tracks and life-likeness measures")
+    _add_fish(p)
+    p.add_argument("--duration", type=float, default=30.0, help="simulated seconds")
+    p.add_argument("--out", help="folder for tracks (npz, CSV), measures and figures")
+    p.add_argument("--video", help="also render FILE.mp4 or FILE.gif (same seed, same swim)")
+    p.add_argument("--video-duration", type=float, default=10.0, help="seconds of video (at most --duration)")
+    p.add_argument("--camera", default="side", help="video camera: side, oblique or follow")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_fish_swim)
+    p = fish.add_parser("drag-check", help="custom drag (C_D = 1) against MuJoCo's inertia-box fluid model")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_fish_drag_check)
+
     p = sub.add_parser("reproduce", help="run a paper's experiments and write a report")
-    p.add_argument("what", help="butterfly")
-    p.add_argument("--out", default="reports/butterfly", help="output folder")
+    p.add_argument("what", help="butterfly or fish")
+    p.add_argument("--out", default=None, help="output folder (default reports/WHAT)")
     _add_physics(p)
     p.set_defaults(func=cmd_reproduce)
 
     p = sub.add_parser("bench", help="speed benchmark")
-    p.add_argument("what", help="butterfly")
+    p.add_argument("what", help="butterfly or fish")
     p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--long-minutes", type=float, default=10.0, help="fish: simulated minutes of the no-escape run")
     p.add_argument("--out", help="also write the JSON here")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_bench)
@@ -394,7 +514,11 @@ def build_parser() -> argparse.ArgumentParser:
     for name, func, helptext in (("view", cmd_view, "open the MuJoCo viewer"),
                                  ("render", cmd_render, "render a video offscreen")):
         p = sub.add_parser(name, help=helptext)
-        p.add_argument("what", help="butterfly")
+        p.add_argument("what", help="butterfly or fish")
+        g = p.add_argument_group("fish")
+        _add_fish(g)
+        if name == "render":
+            g.add_argument("--camera", default=None, help="fish camera: side (default), oblique or follow")
         _add_controller(p, required=False)
         _add_physics(p)
         p.add_argument("--config", default="paper", help="paper or rich")
@@ -416,7 +540,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    if argv[:1] in (["render"], ["reproduce"]):
+    if argv[:1] in (["render"], ["reproduce"]) or (argv[:1] == ["fish"] and any(a.startswith("--video") for a in argv)):
         from lifelike_mj.viz.video import ensure_gl_backend
 
         ensure_gl_backend()  # before anything imports mujoco

@@ -15,19 +15,15 @@ that their ratios compare like with like on a noisy shared machine.
 
 from __future__ import annotations
 
-import os
-import platform
 import statistics
 import time
 
-import mujoco
-import numba
 import numpy as np
 from numba import njit
 
-from lifelike_mj import __version__
 from lifelike_mj.butterfly import controllers, mjbackend, paper
 from lifelike_mj.butterfly.paper import Condition
+from lifelike_mj.machine import machine_info
 from lifelike_mj.physics.callbacks import passive_callback
 
 _mj_step = mjbackend._mj_step
@@ -95,15 +91,6 @@ def run(repeats: int = 5, batch: int = 40, steps: int = 24000, naive_steps: int 
         "steps": steps,
         "integrator": "RK4",
         "dt_s": dt,
-        "machine": {
-            "platform": platform.platform(),
-            "processor": platform.processor() or platform.machine(),
-            "cpu_count": os.cpu_count(),
-            "numba_threads": numba.get_num_threads(),
-            "python": platform.python_version(),
-            "mujoco": mujoco.__version__,
-            "numba": numba.__version__,
-            "lifelike_mj": __version__,
-        },
+        "machine": machine_info(),
         "samples": {k: [x * 1e9 for x in v] for k, v in samples.items()},
     }

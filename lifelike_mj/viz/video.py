@@ -145,14 +145,15 @@ def _dress(m) -> None:
 class _Offscreen:
     """A minimal offscreen renderer (context, scene, pixel buffer) of one model."""
 
-    def __init__(self, m, width: int, height: int, maxgeom: int = 1000) -> None:
+    def __init__(self, m, width: int, height: int, maxgeom: int = 1000, dress: bool = True) -> None:
         import mujoco
 
         self.width, self.height = int(width), int(height)
         # the offscreen framebuffer is sized from the model when the MjrContext is made
         m.vis.global_.offwidth = max(int(m.vis.global_.offwidth), self.width)
         m.vis.global_.offheight = max(int(m.vis.global_.offheight), self.height)
-        _dress(m)
+        if dress:  # the butterfly's rendering touches; other scenes (the fish tank) keep their own lighting
+            _dress(m)
         self.ctx, self.backend = _gl_context(self.width, self.height)
         try:
             self.con = mujoco.MjrContext(m, mujoco.mjtFontScale.mjFONTSCALE_100)
@@ -383,6 +384,19 @@ def _check_size(width: int, height: int, what: str) -> None:
             raise UserError(f"{what} {name} must be a whole number of pixels between 8 and 4096, got {v!r}.")
 
 
+def _video_target(out_path: str | Path, width: int, height: int) -> tuple[Path, str]:
+    """The video's path and its lower-case suffix (a key of ``_WRITERS``); :class:`UserError` for another
+    suffix, a size outside 8-4096 pixels, or an odd size for an MP4."""
+    out = Path(out_path)
+    suffix = out.suffix.lower()
+    if suffix not in _WRITERS:
+        raise UserError(f"cannot write {out.name}: the video file must end in .mp4 or .gif.")
+    _check_size(width, height, "video")
+    if suffix == ".mp4" and (width % 2 or height % 2):
+        raise UserError(f"an MP4 video needs an even width and height, got {width}x{height}.")
+    return out, suffix
+
+
 def render_butterfly(out_path: str | Path, controller: ButterflyController, params: ButterflyParams | None = None,
                      condition: Condition | None = None, config: str = "paper", force_mode: str = "tip",
                      duration_s: float = 3.0, fps: float = 30, width: int = 640, height: int = 480,
@@ -404,13 +418,7 @@ def render_butterfly(out_path: str | Path, controller: ButterflyController, para
     Returns ``{"path", "frames", "fps", "width", "height", "gl_backend", "sim_duration_s",
     "render_s", "render_fps"}`` (``render_fps``: frames made per wall-clock second, physics included).
     """
-    out = Path(out_path)
-    suffix = out.suffix.lower()
-    if suffix not in _WRITERS:
-        raise UserError(f"cannot write {out.name}: the video file must end in .mp4 or .gif.")
-    _check_size(width, height, "video")
-    if suffix == ".mp4" and (width % 2 or height % 2):
-        raise UserError(f"an MP4 video needs an even width and height, got {width}x{height}.")
+    out, suffix = _video_target(out_path, width, height)
     for name, v in (("duration", duration_s), ("fps", fps), ("slowdown", slowdown)):
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not (math.isfinite(v) and v > 0):
             raise UserError(f"{name} must be a positive number, got {v!r}.")

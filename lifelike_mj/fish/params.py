@@ -1,0 +1,223 @@
+"""Fish motion presets: the parameters of Satoi, Nakadai, Hoshino 2015, named with their units.
+
+The paper gives the structure of its model but no values; every value here is ours, calibrated
+against the paper's observations (docs/results.md). A preset is a JSON file in
+``controllers/fish/`` (or any path)::
+
+    {"format": "lifelike-mj/fish-preset", "version": 1, "name": "B-D",
+     "description": "...", "parameters": {"P_a": 4.0, ..., "r_max_N": 0.03, ...}}
+
+A preset may instead name another (``"same_as": "B-D"``): ``default`` is the calibrated ``B-D``.
+
+Parameters (section numbers of the paper):
+
+* Markov chain of the motion units (MU) S1 accelerate, S2 coast, S3 cruise, S4 brake (3.3): five
+  non-negative weights ``P_a`` (S1 -> S1), ``P_b`` (S2, S3, S4 -> S1), ``P_c`` (-> S2),
+  ``P_d`` (-> S3), ``P_e`` (-> S4); each row of the 4 x 4 matrix is normalised
+  (:meth:`FishParams.transition_matrix`), redrawn every control step (``control_hz``).
+* Accelerate (3.4.1, eq. 2-9): force magnitude ``r ~ U(r_min_N, r_max_N)`` (N); direction angles
+  ``theta = 90 + U(-theta_range_deg, theta_range_deg) + balance_A_deg sgn(p) / (1 + exp(-balance_k_per_deg |p|))``
+  and ``phi = 90 + U(-phi_range_deg, phi_range_deg)`` (deg), ``p`` the fish's pitch (deg, nose up
+  > 0); angular acceleration = lateral or vertical component / (m R^2) with
+  ``R = inertia_radius_m``.
+* Drag (3.4.2-3.4.4): ``D = 1/2 rho C_D S v^2`` per body axis, ``rho = water_density_kg_m3``;
+  areas ``S_v`` (m^2) and ``S_w`` (m^5) of the body's equivalent inertia box
+  (``fish/scene.py``: :func:`box_areas`), with ``C_D = cd`` on the linear and ``cd_rot`` on the
+  angular velocity (a rigid box turns far more freely than a fish with spread fins; ``cd_rot``
+  stands for the fins); the brake MU adds ``brake_dS_v_m2`` and ``brake_dS_w_m5`` (per axis).
+* Buoyancy (not in the paper): the water carries the fish's weight at a centre of buoyancy
+  ``buoyancy_offset_m`` above its centre of mass, which rights roll and pitch. The paper's
+  integration (section 3.5) turns only about the pitch and yaw axes; a rigid body in MuJoCo also
+  couples yaw and pitch into roll (Euler's equations), and a real fish stays upright.
+* Vision (3.6): rays of length ``vision_distance_m`` straight ahead and at ``vision_angle_deg`` to
+  the sides, up and down.
+* Wall avoidance (3.7): for ``avoid_duration_s`` after a wall is seen, ``P_a`` and ``P_b`` are
+  multiplied by ``avoid_accel_gain`` (>= 1: the transition probability to accelerate rises), the
+  force range by ``avoid_force_scale`` (< 1: smaller pushes) and each push turns
+  ``avoid_turn_deg`` away from the wall (yaw, and pitch when the wall is above or below).
+* ``runaway_speed_bl_s``: a fish whose running mean speed (time constant 10 s) exceeds this many
+  body lengths per second stops the run with an error naming ``P_a`` or ``P_b`` (section 3.3: too high
+  a transition probability to accelerate makes the speed diverge; in MuJoCo's stable integration it
+  saturates instead, at a speed no damselfish keeps up).
+* ``control_hz`` (the paper's 60 frames per second) and ``substeps`` (MuJoCo steps per control
+  step).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass, field, fields
+from pathlib import Path
+
+import numpy as np
+
+from lifelike_mj.errors import UserError
+from lifelike_mj.paths import controllers_dir
+
+FORMAT = "lifelike-mj/fish-preset"
+#: The paper's four patterns (section 5.1.1) and the calibrated default.
+PRESETS = ("NB-ND", "NB-D", "B-ND", "B-D", "default")
+MU_NAMES = ("accelerate", "coast", "cruise", "brake")
+ACCELERATE, COAST, CRUISE, BRAKE = 0, 1, 2, 3
+
+
+@dataclass(frozen=True)
+class FishParams:
+    """One motion preset (units in the names; see the module docstring). The defaults are the
+    calibrated ``B-D`` pattern."""
+
+    P_a: float = 4.0
+    P_b: float = 0.035
+    P_c: float = 0.6
+    P_d: float = 0.2
+    P_e: float = 0.2
+    r_min_N: float = 0.01
+    r_max_N: float = 0.03
+    theta_range_deg: float = 30.0
+    phi_range_deg: float = 80.0
+    balance_A_deg: float = 10.0
+    balance_k_per_deg: float = 0.2
+    inertia_radius_m: float = 0.15
+    water_density_kg_m3: float = 1000.0
+    cd: float = 1.0
+    cd_rot: float = 5.0
+    buoyancy_offset_m: float = 0.001
+    brake_dS_v_m2: tuple[float, float, float] = (6e-4, 0.0, 0.0)
+    brake_dS_w_m5: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    vision_distance_m: float = 0.12
+    vision_angle_deg: float = 30.0
+    avoid_duration_s: float = 1.0
+    avoid_accel_gain: float = 8.0
+    avoid_force_scale: float = 0.5
+    avoid_turn_deg: float = 45.0
+    runaway_speed_bl_s: float = 4.5
+    control_hz: float = 60.0
+    substeps: int = 4
+    name: str = field(default="", compare=False)
+    description: str = field(default="", compare=False)
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            if f.name in ("name", "description"):
+                continue
+            v = getattr(self, f.name)
+            vals = v if isinstance(v, tuple) else (v,)
+            for x in vals:
+                if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+                    raise UserError(f"fish parameter {f.name} must be a finite number, got {v!r}.")
+            if isinstance(v, tuple) and len(v) != 3:
+                raise UserError(f"fish parameter {f.name} must have 3 values (x, y, z), got {len(v)}.")
+        probs = ("P_a", "P_b", "P_c", "P_d", "P_e")
+        for k in probs:
+            if getattr(self, k) < 0:
+                raise UserError(f"transition weight {k} must not be negative, got {getattr(self, k)}.")
+        if self.P_a + self.P_c + self.P_d + self.P_e <= 0 or self.P_b + self.P_c + self.P_d + self.P_e <= 0:
+            raise UserError("transition weights P_a..P_e are all zero in a row; at least one must be positive.")
+        if self.r_min_N < 0:
+            raise UserError(f"r_min_N must not be negative, got {self.r_min_N}.")
+        if self.r_min_N > self.r_max_N:
+            raise UserError(f"r_min_N ({self.r_min_N}) must not exceed r_max_N ({self.r_max_N}).")
+        positive = ("inertia_radius_m", "water_density_kg_m3", "cd", "cd_rot", "vision_distance_m", "control_hz",
+                    "runaway_speed_bl_s", "avoid_force_scale")
+        for k in positive:
+            if getattr(self, k) <= 0:
+                raise UserError(f"fish parameter {k} must be positive, got {getattr(self, k)}.")
+        for k in ("buoyancy_offset_m", "theta_range_deg", "phi_range_deg", "balance_A_deg", "balance_k_per_deg",
+                  "avoid_duration_s", "avoid_turn_deg"):
+            if getattr(self, k) < 0:
+                raise UserError(f"fish parameter {k} must not be negative, got {getattr(self, k)}.")
+        if min(self.brake_dS_v_m2) < 0 or min(self.brake_dS_w_m5) < 0:
+            raise UserError("brake area increments must not be negative.")
+        if self.avoid_accel_gain < 1:
+            raise UserError(f"avoid_accel_gain must be at least 1 (avoidance raises the chance to accelerate), "
+                            f"got {self.avoid_accel_gain}.")
+        if self.avoid_force_scale > 1:
+            raise UserError(f"avoid_force_scale must not exceed 1 (avoidance lowers r_min and r_max), "
+                            f"got {self.avoid_force_scale}.")
+        if not (0 < self.vision_angle_deg < 90):
+            raise UserError(f"vision_angle_deg must lie in (0, 90), got {self.vision_angle_deg}.")
+        if int(self.substeps) != self.substeps or self.substeps < 1:
+            raise UserError(f"substeps must be a positive whole number, got {self.substeps}.")
+
+    # ---- the Markov chain (section 3.3) ----
+    def transition_matrix(self, avoiding: bool = False) -> np.ndarray:
+        """The 4 x 4 row-stochastic matrix ``T[i, j] = P(next MU j | MU i)`` (spec section 1)."""
+        g = self.avoid_accel_gain if avoiding else 1.0
+        pa, pb = g * self.P_a, g * self.P_b
+        rows = np.array([[pa, self.P_c, self.P_d, self.P_e]] + [[pb, self.P_c, self.P_d, self.P_e]] * 3, dtype=float)
+        return rows / rows.sum(axis=1, keepdims=True)
+
+    def stationary(self, avoiding: bool = False) -> np.ndarray:
+        """Stationary distribution of :meth:`transition_matrix` (share of control steps per MU)."""
+        T = self.transition_matrix(avoiding)
+        w, v = np.linalg.eig(T.T)
+        p = np.real(v[:, np.argmin(np.abs(w - 1.0))])
+        return p / p.sum()
+
+    @property
+    def control_dt_s(self) -> float:
+        return 1.0 / self.control_hz
+
+    @property
+    def timestep_s(self) -> float:
+        return 1.0 / (self.control_hz * self.substeps)
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d.pop("name")
+        d.pop("description")
+        for k, v in d.items():
+            if isinstance(v, tuple):
+                d[k] = list(v)
+        return d
+
+    def to_file_dict(self) -> dict:
+        return {"format": FORMAT, "version": 1, "name": self.name, "description": self.description,
+                "parameters": self.to_dict()}
+
+
+_FIELDS = {f.name for f in fields(FishParams)} - {"name", "description"}
+
+
+def params_from_dict(data: dict, name: str = "") -> FishParams:
+    """Build :class:`FishParams` from a preset file's content (unknown keys are an error)."""
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        raise UserError(f"{name or 'the file'} is not a fish preset (format {FORMAT!r} expected).")
+    params = data.get("parameters")
+    if not isinstance(params, dict):
+        raise UserError(f"fish preset {name} has no 'parameters' object.")
+    unknown = sorted(set(params) - _FIELDS)
+    if unknown:
+        raise UserError(f"fish preset {name} has unknown parameter(s): {', '.join(unknown)}.")
+    kw = {k: (tuple(v) if isinstance(v, list) else v) for k, v in params.items()}
+    return FishParams(**kw, name=str(data.get("name", name)), description=str(data.get("description", "")))
+
+
+def preset_path(name: str) -> Path:
+    return controllers_dir() / "fish" / f"{name}.json"
+
+
+def load_preset(name_or_path: str | Path | None = None, _seen: tuple[str, ...] = ()) -> FishParams:
+    """A preset by name (``NB-ND``, ``NB-D``, ``B-ND``, ``B-D``, ``default``) or by path to a file."""
+    ref = "default" if name_or_path is None else str(name_or_path)
+    p = Path(ref)
+    if p.suffix == ".json" or p.exists():
+        if not p.is_file():
+            raise UserError(f"no fish preset file {ref}.")
+    else:
+        p = preset_path(ref)
+        if not p.is_file():
+            raise UserError(f"unknown fish preset {ref!r}; known presets: {', '.join(PRESETS)} (or a path to a JSON file).")
+    try:
+        data = json.loads(p.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise UserError(f"cannot read fish preset {p}: {e}.") from None
+    if isinstance(data, dict) and "same_as" in data:
+        target = str(data["same_as"])
+        if target in _seen:
+            raise UserError(f"fish preset {ref} refers back to itself through 'same_as'.")
+        base = load_preset(target, (*_seen, ref))
+        return FishParams(**{k: getattr(base, k) for k in _FIELDS}, name=str(data.get("name", p.stem)),
+                          description=str(data.get("description", base.description)))
+    return params_from_dict(data, p.stem)

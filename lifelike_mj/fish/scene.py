@@ -1,0 +1,161 @@
+"""The tank scene for N fish, built with MjSpec from ``models/tank.xml`` and ``models/fish.xml``.
+
+World frame: x along the tank (horizontal in the side view), y depth (towards the side camera),
+z up, origin at the centre of the floor. The water fills ``[-L/2, L/2] x [-D/2, D/2] x [0, H]``.
+The filmed tank of Satoi et al. 2015 (section 4) was about 5 m wide, 1 m high and 0.5 m deep;
+:func:`tank_size` keeps those proportions at any scale (default 0.6: 3.0 x 0.3 x 0.6 m).
+
+Besides the main model, :func:`build_scene` compiles a *vision model*: the same base scene without
+the fish. The fish cast their vision rays (section 3.6) into it, so every static geom of the base
+scene is seen (walls, floor, the water surface, and any obstacle a user adds to the base spec),
+and the cost of a ray does not grow with the number of fish.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from lifelike_mj.errors import UserError
+from lifelike_mj.paths import models_dir
+
+#: The filmed tank (section 4): length (x, m), depth (y, m), height (z, m).
+FILMED_TANK_M = (5.0, 0.5, 1.0)
+DEFAULT_TANK_SCALE = 1.0
+WALL_THICKNESS_M = 0.02
+#: Snout to tail tip of models/fish.xml (m), the body length of every "per body length" number.
+BODY_LENGTH_M = 0.070
+#: Fish attached per intermediate spec (MjSpec attach costs grow with the size of the target spec).
+_GROUP = 32
+
+
+def tank_size(scale: float = DEFAULT_TANK_SCALE) -> tuple[float, float, float]:
+    """Water volume ``(L, D, H)`` in m: the filmed tank times ``scale``."""
+    if not (isinstance(scale, (int, float)) and math.isfinite(scale) and scale > 0):
+        raise UserError(f"tank scale must be a positive number, got {scale!r}.")
+    return tuple(float(scale * s) for s in FILMED_TANK_M)  # type: ignore[return-value]
+
+
+def check_tank(size) -> tuple[float, float, float]:
+    vals = tuple(float(v) for v in size)
+    if len(vals) != 3 or not all(math.isfinite(v) and v > 0 for v in vals):
+        raise UserError(f"a tank size is three positive lengths in m (length, depth, height), got {size!r}.")
+    if min(vals) < 2.5 * BODY_LENGTH_M:
+        raise UserError(f"every side of the tank must be at least {2.5 * BODY_LENGTH_M:.3f} m (2.5 body lengths), got {vals}.")
+    return vals  # type: ignore[return-value]
+
+
+def base_spec(size=None) -> mujoco.MjSpec:
+    """The tank of ``models/tank.xml`` with its walls resized to the water volume ``size`` (m)."""
+    L, D, H = check_tank(size if size is not None else tank_size())
+    t = WALL_THICKNESS_M
+    spec = mujoco.MjSpec.from_file(str(models_dir() / "tank.xml"))
+    boxes = {
+        "floor": ((L / 2 + 2 * t, D / 2 + 2 * t, t), (0.0, 0.0, -t)),
+        "lid": ((L / 2 + 2 * t, D / 2 + 2 * t, t), (0.0, 0.0, H + t)),
+        "wall_back": ((L / 2 + 2 * t, t, H / 2), (0.0, D / 2 + t, H / 2)),
+        "wall_front": ((L / 2 + 2 * t, t, H / 2), (0.0, -D / 2 - t, H / 2)),
+        "wall_left": ((t, D / 2, H / 2), (-L / 2 - t, 0.0, H / 2)),
+        "wall_right": ((t, D / 2, H / 2), (L / 2 + t, 0.0, H / 2)),
+    }
+    for name, (half, pos) in boxes.items():
+        g = spec.geom(name)
+        g.size = list(half)
+        g.pos = list(pos)
+    planes = {"glass_floor": (0.0, 0.0, 0.0), "glass_lid": (0.0, 0.0, H), "glass_back": (0.0, D / 2, H / 2),
+              "glass_front": (0.0, -D / 2, H / 2), "glass_left": (-L / 2, 0.0, H / 2), "glass_right": (L / 2, 0.0, H / 2)}
+    for name, pos in planes.items():
+        spec.geom(name).pos = list(pos)
+    # side camera: the whole length in a 4:3 frame (vertical field of view 30 deg)
+    half_h = math.radians(30.0) / 2
+    half_w = math.atan(math.tan(half_h) * 4.0 / 3.0)
+    dist = max(0.55 * L / math.tan(half_w), 0.55 * H / math.tan(half_h))
+    spec.camera("side").pos = [0.0, -(D / 2 + dist), H / 2]
+    spec.camera("oblique").pos = [0.0, -(D / 2 + 0.62 * dist), H / 2 + 0.33 * dist]
+    return spec
+
+
+@dataclass(frozen=True)
+class FishScene:
+    """A compiled tank with ``n`` fish, and its fish-free vision model."""
+
+    model: mujoco.MjModel
+    vision_model: mujoco.MjModel
+    size: tuple[float, float, float]
+    body: np.ndarray  # (n,) body ids of the fish
+    qadr: np.ndarray  # (n,) qpos addresses of their free joints
+    dadr: np.ndarray  # (n,) qvel addresses
+    mass_kg: float
+    inertia: np.ndarray  # (3,) principal moments (kg m^2), body frame = inertia frame
+    head_m: float  # distance of the snout (vision origin) ahead of the centre of mass
+
+    @property
+    def n(self) -> int:
+        return len(self.body)
+
+
+def build_scene(n_fish: int, size=None, spec: mujoco.MjSpec | None = None, nuserdata: int = 0) -> FishScene:
+    """Compile the tank (``spec``, default :func:`base_spec` of ``size``) with ``n_fish`` fish.
+
+    The fish are attached in groups of 32 (MjSpec's attach slows down as the target grows; groups
+    keep 1,000 fish under a second). Fish ``i`` is body ``s<i // 32>/f<i>/fish``. ``nuserdata``: size of
+    ``mjData.userdata`` (the simulation's per-model parameters)."""
+    if isinstance(n_fish, bool) or not isinstance(n_fish, (int, np.integer)) or n_fish < 1:
+        raise UserError(f"the number of fish must be a whole number of at least 1, got {n_fish!r}.")
+    n_fish = int(n_fish)
+    if spec is None:
+        spec = base_spec(size)
+        size = check_tank(size if size is not None else tank_size())
+    else:
+        size = check_tank(size if size is not None else tank_size())
+    vision_model = spec.copy().compile()
+    fish = mujoco.MjSpec.from_file(str(models_dir() / "fish.xml"))
+    src = fish.body("fish")
+    spec.copy_during_attach = True
+    for start in range(0, n_fish, _GROUP):
+        grp = mujoco.MjSpec()
+        grp.copy_during_attach = True
+        grp.option.timestep = spec.option.timestep
+        for i in range(start, min(start + _GROUP, n_fish)):
+            grp.worldbody.add_frame().attach_body(src, f"f{i}/", "")
+        spec.attach(grp, frame=spec.worldbody.add_frame(), prefix=f"s{start // _GROUP}/")
+    spec.nuserdata = int(nuserdata)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = spec.compile()
+    body = np.array([model.body(fish_name(i)).id for i in range(n_fish)], dtype=np.int64)
+    jnt = np.array([model.body_jntadr[b] for b in body], dtype=np.int64)
+    if np.any(model.jnt_type[jnt] != mujoco.mjtJoint.mjJNT_FREE):
+        raise RuntimeError("every fish must have a free joint")
+    if np.any(np.abs(model.body_ipos[body]) > 0) or np.any(np.abs(model.body_iquat[body] - [1, 0, 0, 0]) > 0):
+        raise RuntimeError("the fish's body frame must be its inertia frame (models/fish.xml)")
+    head = model.site(fish_name(0).replace("/fish", "/head")).pos[0]
+    return FishScene(model, vision_model, tuple(size), body, model.jnt_qposadr[jnt].astype(np.int64),
+                     model.jnt_dofadr[jnt].astype(np.int64), float(model.body_mass[body[0]]),
+                     model.body_inertia[body[0]].copy(), float(head))
+
+
+def fish_name(i: int) -> str:
+    """Body name of fish ``i`` in a scene of :func:`build_scene`."""
+    return f"s{i // _GROUP}/f{i}/fish"
+
+
+def inertia_box(mass_kg: float, inertia) -> np.ndarray:
+    """Full side lengths (m) of the equivalent inertia box of a body (MuJoCo's inertia-box fluid
+    model): ``b_x = sqrt(6 (I_y + I_z - I_x) / m)`` and cyclically."""
+    I = np.asarray(inertia, dtype=float)
+    return np.sqrt(6.0 * np.array([I[1] + I[2] - I[0], I[0] + I[2] - I[1], I[0] + I[1] - I[2]]) / mass_kg)
+
+
+def box_areas(mass_kg: float, inertia) -> tuple[np.ndarray, np.ndarray]:
+    """Drag areas of the equivalent inertia box: ``S_v`` (m^2, the face normal to each axis) and
+    ``S_w`` (m^5, ``b_i (b_j^4 + b_k^4) / 32``), chosen so that ``1/2 rho C_D S v|v|`` with
+    ``C_D = 1`` is MuJoCo's inertia-box quadratic drag (force and torque)."""
+    b = inertia_box(mass_kg, inertia)
+    sv = np.array([b[1] * b[2], b[2] * b[0], b[0] * b[1]])
+    sw = np.array([b[0] * (b[1] ** 4 + b[2] ** 4), b[1] * (b[2] ** 4 + b[0] ** 4), b[2] * (b[0] ** 4 + b[1] ** 4)]) / 32.0
+    return sv, sw

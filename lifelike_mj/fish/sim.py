@@ -1,0 +1,554 @@
+"""Swimming fish on MuJoCo: motion units, drag, vision and wall avoidance (Satoi et al. 2015, 3.3-3.7).
+
+Each fish is a free rigid body (``models/fish.xml``). Every control step (``control_hz``, the
+paper's 60 frames per second) each fish
+
+1. looks (3.6): five MuJoCo ray casts of length ``vision_distance_m`` from its snout into the
+   fish-free vision model of the tank (``fish/scene.py``); a hit starts (or renews) wall avoidance
+   for ``avoid_duration_s``, remembering the direction away from the wall (the hit normals);
+2. draws its next motion unit (MU) from the Markov chain (3.3; spec section 1), with the avoidance
+   weights while avoiding (3.7);
+3. if the MU is *accelerate*, draws a push (3.4.1, eq. 2-9): ``r ~ U(r_min, r_max)``,
+   ``theta = 90 + U(-theta_range, theta_range) + A sgn(p) / (1 + exp(-k |p|))`` with the pitch ``p``
+   (3.6, balance), ``phi = 90 + U(-phi_range, phi_range)``, plus a turn of ``avoid_turn_deg`` away from
+   a seen wall; in the body frame (x forward = the paper's z, y left = the paper's x, z up = the
+   paper's y) the components are ``lateral = r sin(theta) cos(phi)``, ``vertical = r cos(theta)``,
+   ``forward = r sin(theta) sin(phi)`` (while turning away from a wall it faces, the forward part is
+   scaled by ``max(-1/2, 1 + 2 h.n)``, ``h.n`` the cosine between heading and wall normal: the fish
+   turns on the spot, backing off when it faces the glass squarely, rather than pushing into it):
+   a forward force, and angular accelerations
+   ``vertical / (m R^2)`` nose-up and ``lateral / (m R^2)`` to the left (eq. 8-9).
+
+MuJoCo then integrates ``substeps`` steps. The compiled passive callback (:data:`COMPILED_PASSIVE`)
+adds, per fish and per step, the held push and the quadratic drag of 3.4.2-3.4.4 in the body frame,
+``D = -1/2 rho C_D S v|v|`` per axis on the linear (``S_v``, ``cd``) and angular (``S_w``, ``cd_rot``) velocity, built on
+:func:`lifelike_mj.physics.fluid.normal_drag_scalar`: coast and accelerate with the body's areas,
+cruise without translational drag, brake with the areas enlarged by ``brake_dS_v_m2`` and
+``brake_dS_w_m5``; and the righting moment of buoyancy acting ``buoyancy_offset_m`` above the centre
+of mass. Water is neutral (``gravcomp``: no net sinking); the fish collide with the tank, not with
+each other.
+
+Randomness: one ``numpy.random.Generator`` per fish (seeded from ``SeedSequence(seed)``), four
+uniforms per fish per control step (MU, r, theta, phi) drawn whether used or not, so that the same
+seed gives the same tracks in any chunking.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+from numba import carray, cfunc, njit, types
+
+from lifelike_mj.errors import UserError
+from lifelike_mj.fish.params import ACCELERATE, BRAKE, CRUISE, MU_NAMES, FishParams
+from lifelike_mj.fish.scene import BODY_LENGTH_M, FishScene, box_areas, build_scene
+from lifelike_mj.physics import mjabi
+from lifelike_mj.physics.callbacks import passive_callback
+from lifelike_mj.physics.fluid import normal_drag_scalar
+
+# ---- userdata layout (per model; the callback is process-global) ----------------------------------
+U_MAGIC = 0  # identifies a fish model's userdata (the callback ignores other models)
+U_N = 1  # number of fish
+U_RHO, U_CD = 2, 3
+U_SV = 4  # 3: S_v (m^2)
+U_SW = 7  # 3: S_w (m^5)
+U_DSV = 10  # 3: brake dS_v
+U_DSW = 13  # 3: brake dS_w
+U_CDROT = 16
+U_RIGHT = 17  # m g h: righting moment scale (N m) of the centre of buoyancy h above the centre of mass
+U_FISH = 18  # per fish: qadr, dadr, mu, F_forward (N), torque_y, torque_z (N m, body frame)
+FISH_BLOCK = 6
+MAGIC = 7.25e5
+
+_OFF = mjabi.data_offsets()
+_OFF_QPOS, _OFF_QVEL, _OFF_QFRC, _OFF_UD = _OFF["qpos"], _OFF["qvel"], _OFF["qfrc_passive"], _OFF["userdata"]
+_LIB = mjabi.libmujoco()
+_LIB.mj_ray.argtypes = [ctypes.c_void_p] * 6 + [ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p]
+_LIB.mj_ray.restype = ctypes.c_double
+_LIB.mj_kinematics.argtypes = [ctypes.c_void_p, ctypes.c_void_p]
+_LIB.mj_kinematics.restype = None
+_mj_step = _LIB.mj_step
+_mj_ray = _LIB.mj_ray
+_vp = mjabi.voidptr_from_int
+_addr = mjabi.int_from_voidptr
+
+
+@njit(cache=False, inline="always")
+def _ptr_at(address):
+    return carray(_vp(address), (1,), np.uint64)[0]
+
+
+@njit(cache=False, inline="always")
+def _f64(address, n):
+    return carray(_vp(address), (n,), np.float64)
+
+
+@njit(cache=True, inline="always")
+def _rotmat(q, R):
+    """Rotation matrix (row-major 3x3 in ``R[9]``) of the unit quaternion ``q = (w, x, y, z)``."""
+    w, x, y, z = q[0], q[1], q[2], q[3]
+    R[0] = 1 - 2 * (y * y + z * z)
+    R[1] = 2 * (x * y - w * z)
+    R[2] = 2 * (x * z + w * y)
+    R[3] = 2 * (x * y + w * z)
+    R[4] = 1 - 2 * (x * x + z * z)
+    R[5] = 2 * (y * z - w * x)
+    R[6] = 2 * (x * z - w * y)
+    R[7] = 2 * (y * z + w * x)
+    R[8] = 1 - 2 * (x * x + y * y)
+
+
+@njit(cache=True)
+def fish_forces(ud, qpos, qvel, qfrc):
+    """Add every fish's held push and drag (Satoi 2015 3.4.1-3.4.4) to ``qfrc`` (generalized forces).
+
+    Free joint: ``qvel[d:d+3]`` is the world velocity of the body origin (= centre of mass),
+    ``qvel[d+3:d+6]`` the angular velocity in the body frame; the generalized force is the world
+    force and the body-frame torque. Drag per body axis: ``normal_drag_scalar`` (Oe 2010 eq. 1 form,
+    ``-1/2 rho C_D S v|v|``), in N and N m."""
+    n = int(ud[U_N])
+    rho, cd = ud[U_RHO], ud[U_CD]
+    R = np.empty(9)
+    vb = np.empty(3)
+    fb = np.empty(3)
+    for i in range(n):
+        base = U_FISH + FISH_BLOCK * i
+        qa = int(ud[base])
+        da = int(ud[base + 1])
+        mu = int(ud[base + 2])
+        _rotmat(qpos[qa + 3 : qa + 7], R)
+        for a in range(3):
+            vb[a] = R[a] * qvel[da] + R[3 + a] * qvel[da + 1] + R[6 + a] * qvel[da + 2]  # R^T v
+        brake = 1.0 if mu == BRAKE else 0.0
+        for a in range(3):
+            if mu == CRUISE:
+                fb[a] = 0.0
+            else:
+                fb[a] = normal_drag_scalar(ud[U_SV + a] + brake * ud[U_DSV + a], rho, cd, vb[a])
+        fb[0] += ud[base + 3]
+        for a in range(3):
+            qfrc[da + a] += R[3 * a] * fb[0] + R[3 * a + 1] * fb[1] + R[3 * a + 2] * fb[2]
+        for a in range(3):
+            qfrc[da + 3 + a] += normal_drag_scalar(ud[U_SW + a] + brake * ud[U_DSW + a], rho, ud[U_CDROT],
+                                                   qvel[da + 3 + a])
+        # buoyancy W at h R e_z from the centre of mass: world torque W h (R12, -R02, 0), to the body frame
+        tx, ty = ud[U_RIGHT] * R[5], -ud[U_RIGHT] * R[2]
+        qfrc[da + 3] += R[0] * tx + R[3] * ty
+        qfrc[da + 4] += R[1] * tx + R[4] * ty + ud[base + 4]
+        qfrc[da + 5] += R[2] * tx + R[5] * ty + ud[base + 5]
+
+
+@njit(cache=False)
+def _passive_kernel(m, d):
+    base = _addr(d)
+    ud = _f64(_ptr_at(base + _OFF_UD), U_FISH)
+    if ud[U_MAGIC] != MAGIC:
+        return
+    n = int(ud[U_N])
+    ud = _f64(_ptr_at(base + _OFF_UD), U_FISH + FISH_BLOCK * n)
+    last = U_FISH + FISH_BLOCK * (n - 1)
+    nq = int(ud[last]) + 7
+    nv = int(ud[last + 1]) + 6
+    qpos = _f64(_ptr_at(base + _OFF_QPOS), nq)
+    qvel = _f64(_ptr_at(base + _OFF_QVEL), nv)
+    qfrc = _f64(_ptr_at(base + _OFF_QFRC), nv)
+    fish_forces(ud, qpos, qvel, qfrc)
+
+
+@cfunc(types.void(types.voidptr, types.voidptr), cache=False)
+def _passive_cfunc(m, d):
+    _passive_kernel(m, d)
+
+
+#: The compiled passive callback (a ctypes function pointer MuJoCo accepts).
+COMPILED_PASSIVE = _passive_cfunc.ctypes
+
+
+def python_passive(m: mujoco.MjModel, d: mujoco.MjData) -> None:
+    """The same forces through the Python bindings and ``mj_applyFT`` (the test reference)."""
+    ud = d.userdata
+    if ud.size <= U_FISH or ud[U_MAGIC] != MAGIC:
+        return
+    n = int(ud[U_N])
+    rho, cd = ud[U_RHO], ud[U_CD]
+    for i in range(n):
+        base = U_FISH + FISH_BLOCK * i
+        qa, da, mu = int(ud[base]), int(ud[base + 1]), int(ud[base + 2])
+        R = np.zeros(9)
+        mujoco.mju_quat2Mat(R, d.qpos[qa + 3 : qa + 7])
+        R = R.reshape(3, 3)
+        vb = R.T @ d.qvel[da : da + 3]
+        sv = ud[U_SV : U_SV + 3] + (ud[U_DSV : U_DSV + 3] if mu == BRAKE else 0.0)
+        sw = ud[U_SW : U_SW + 3] + (ud[U_DSW : U_DSW + 3] if mu == BRAKE else 0.0)
+        fb = np.zeros(3) if mu == CRUISE else -0.5 * rho * cd * sv * vb * np.abs(vb)
+        fb[0] += ud[base + 3]
+        w = d.qvel[da + 3 : da + 6]
+        tb = -0.5 * rho * ud[U_CDROT] * sw * w * np.abs(w) + np.array([0.0, ud[base + 4], ud[base + 5]])
+        tb += R.T @ (ud[U_RIGHT] * np.array([R[1, 2], -R[0, 2], 0.0]))
+        body = int(np.nonzero(m.jnt_qposadr == qa)[0][0])
+        body = m.jnt_bodyid[body]
+        mujoco.mj_applyFT(m, d, R @ fb, R @ tb, d.xipos[body], body, d.qfrc_passive)
+
+
+# ---- the control step (sections 3.3-3.7), compiled ---------------------------------------------------
+
+# per-fish state columns
+S_MU, S_AVOID_T, S_AWAY = 0, 1, 2  # S_AWAY: 3 (unit vector away from the last wall seen)
+S_YAW, S_PITCH = 5, 6  # turn directions chosen when an avoidance starts (+1 left / nose up, -1, or 0)
+S_SPEED = 7  # running mean of the speed (time constant RUNAWAY_TAU_S, m/s)
+N_STATE = 8
+#: Time constant (s) of the running mean speed that the runaway check reads.
+RUNAWAY_TAU_S = 10.0
+# control constants (float array)
+C_RMIN, C_RMAX, C_THR, C_PHR, C_BA, C_BK, C_R, C_VIS, C_VANG, C_AVT, C_AVF, C_TURN, C_HEAD, C_MASS = range(14)
+C_IY, C_IZ, C_DT, C_VMAX = 14, 15, 16, 17
+N_CONST = 18
+#: A seen surface counts when the heading points into it by more than asin(0.2) = 11.5 deg.
+APPROACH_MIN = 0.2
+#: During an avoidance the chosen turn side flips only when the away direction lies this far
+#: (sine of the angle) on the other side.
+TURN_FLIP = 0.3
+
+
+@njit(cache=False)
+def _look(vm, vd, pos, R, head, dist_m, ang, away):
+    """Five rays (ahead, left, right, up, down at ``ang`` rad) from the snout; returns True when
+    one hits, within ``dist_m``, a surface that the fish is heading into (at more than
+    ``asin(APPROACH_MIN)`` to it: a wall the fish swims along is no threat), and writes the
+    weighted sum of those hit normals to ``away``."""
+    pnt = np.empty(3)
+    vec = np.empty(3)
+    nrm = np.empty(3)
+    gid = np.empty(1, dtype=np.int32)
+    for a in range(3):
+        pnt[a] = pos[a] + R[3 * a] * head
+        away[a] = 0.0
+    c, s = math.cos(ang), math.sin(ang)
+    seen = False
+    for r in range(5):
+        bx, by, bz = 1.0, 0.0, 0.0
+        if r == 1:
+            bx, by = c, s
+        elif r == 2:
+            bx, by = c, -s
+        elif r == 3:
+            bx, bz = c, s
+        elif r == 4:
+            bx, bz = c, -s
+        for a in range(3):
+            vec[a] = R[3 * a] * bx + R[3 * a + 1] * by + R[3 * a + 2] * bz
+        dist = _mj_ray(vm, vd, _vp(pnt.ctypes.data), _vp(vec.ctypes.data), _vp(0), 1, -1,
+                       _vp(gid.ctypes.data), _vp(nrm.ctypes.data))
+        approach = -(R[0] * nrm[0] + R[3] * nrm[1] + R[6] * nrm[2])  # heading . (-normal)
+        if dist >= 0.0 and dist <= dist_m and approach > APPROACH_MIN:
+            seen = True
+            w = 1.0 - dist / dist_m + 1e-3
+            for a in range(3):
+                away[a] += w * nrm[a]
+    return seen
+
+
+@njit(cache=False)
+def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n):
+    """One control step for all fish: look, choose the MU, set the push (module docstring)."""
+    R = np.empty(9)
+    away = np.empty(3)
+    for i in range(n):
+        base = U_FISH + FISH_BLOCK * i
+        qa = int(ud[base])
+        _rotmat(qpos[qa + 3 : qa + 7], R)
+        if _look(vm, vd, qpos[qa : qa + 3], R, c[C_HEAD], c[C_VIS], c[C_VANG], away):
+            nn = math.sqrt(away[0] ** 2 + away[1] ** 2 + away[2] ** 2)
+            if nn > 0:
+                fresh = state[i, S_AVOID_T] <= 0.0
+                # the away direction: this look's, or during an avoidance the running mean of the
+                # looks (two walls of a corner, seen in turn, add up to the way out of the corner)
+                for a in range(3):
+                    away[a] = away[a] / nn + (0.0 if fresh else state[i, S_AWAY + a])
+                nn = math.sqrt(away[0] ** 2 + away[1] ** 2 + away[2] ** 2)
+                if nn < 1e-9:
+                    nn = 1.0
+                for a in range(3):
+                    state[i, S_AWAY + a] = away[a] / nn
+                # turn towards it (body frame); the side is chosen when an avoidance starts and
+                # changed only when clearly wrong, so that the fish does not dither
+                ay = R[1] * state[i, 2] + R[4] * state[i, 3] + R[7] * state[i, 4]
+                az = R[2] * state[i, 2] + R[5] * state[i, 3] + R[8] * state[i, 4]
+                if fresh or ay * state[i, S_YAW] < -TURN_FLIP:
+                    state[i, S_YAW] = 1.0 if ay >= 0.0 else -1.0
+                if fresh or az * state[i, S_PITCH] < -TURN_FLIP:
+                    state[i, S_PITCH] = (1.0 if az >= 0.0 else -1.0) if abs(state[i, 4]) > 0.5 else 0.0
+                state[i, S_AVOID_T] = c[C_AVT]
+        avoiding = state[i, S_AVOID_T] > 0.0
+        if avoiding:
+            state[i, S_AVOID_T] -= c[C_DT]
+        mu = int(state[i, S_MU])
+        tab = cum_avoid if avoiding else cum
+        nxt = 3
+        for j in range(4):
+            if u[i, 0] < tab[mu, j]:
+                nxt = j
+                break
+        state[i, S_MU] = nxt
+        ud[base + 2] = nxt
+        ud[base + 3] = 0.0
+        ud[base + 4] = 0.0
+        ud[base + 5] = 0.0
+        if nxt != ACCELERATE:
+            continue
+        scale = c[C_AVF] if avoiding else 1.0
+        fwd_scale = 1.0
+        r = scale * (c[C_RMIN] + (c[C_RMAX] - c[C_RMIN]) * u[i, 1])
+        pitch = math.degrees(math.asin(min(1.0, max(-1.0, R[6]))))  # nose up > 0
+        sg = 1.0 if pitch > 0 else (-1.0 if pitch < 0 else 0.0)
+        theta = 90.0 + c[C_THR] * (2.0 * u[i, 2] - 1.0) + c[C_BA] * sg / (1.0 + math.exp(-c[C_BK] * abs(pitch)))
+        phi = 90.0 + c[C_PHR] * (2.0 * u[i, 3] - 1.0)
+        if avoiding:
+            # turn until the heading no longer points into the wall (parallel to it is enough:
+            # facing straight away from one wall of a long tank means facing the opposite one)
+            ax = R[0] * state[i, 2] + R[3] * state[i, 3] + R[6] * state[i, 4]
+            if ax < 0.0:
+                phi -= c[C_TURN] * state[i, S_YAW]
+                theta -= c[C_TURN] * state[i, S_PITCH]
+                # facing the wall: turn on the spot, and back off when facing it squarely (a fish
+                # wedged nose-first in a corner cannot turn without backing off)
+                fwd_scale = max(-0.5, 1.0 + 2.0 * ax)
+        th = math.radians(theta)
+        ph = math.radians(phi)
+        lateral = r * math.sin(th) * math.cos(ph)
+        vertical = r * math.cos(th)
+        forward = fwd_scale * r * math.sin(th) * math.sin(ph)
+        mr2 = c[C_MASS] * c[C_R] * c[C_R]
+        ud[base + 3] = forward
+        ud[base + 4] = -c[C_IY] * vertical / mr2  # about the body's left axis: negative = nose up
+        ud[base + 5] = c[C_IZ] * lateral / mr2  # about the up axis: positive = turn left
+
+
+@njit(cache=False)
+def _run_chunk(mptr, dptr, vm, vd, qpos, qvel, ud, state, cum, cum_avoid, U, c, n, substeps, out_pos, out_quat,
+               out_mu, record, err):
+    """Control steps ``U.shape[0]`` (each: :func:`_control`, then ``substeps`` ``mj_step``), recording
+    positions, orientations and MUs after each when ``record``. On a runaway (the running mean speed
+    above ``C_VMAX``) or NaN writes ``err = (kind, step, fish, speed)`` (kind 1 runaway, 2 not
+    finite) and returns."""
+    for k in range(U.shape[0]):
+        _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, U[k], c, n)
+        for _ in range(substeps):
+            _mj_step(mptr, dptr)
+        for i in range(n):
+            qa = int(ud[U_FISH + FISH_BLOCK * i])
+            da = int(ud[U_FISH + FISH_BLOCK * i + 1])
+            sp = math.sqrt(qvel[da] ** 2 + qvel[da + 1] ** 2 + qvel[da + 2] ** 2)
+            ok = True
+            for a in range(7):
+                if not math.isfinite(qpos[qa + a]):
+                    ok = False
+            if not ok or not math.isfinite(sp):
+                err[0], err[1], err[2], err[3] = 2.0, k, i, sp
+                return
+            state[i, S_SPEED] += (sp - state[i, S_SPEED]) * c[C_DT] / RUNAWAY_TAU_S
+            if state[i, S_SPEED] > c[C_VMAX]:
+                err[0], err[1], err[2], err[3] = 1.0, k, i, state[i, S_SPEED]
+                return
+            if record:
+                for a in range(3):
+                    out_pos[k, i, a] = qpos[qa + a]
+                for a in range(4):
+                    out_quat[k, i, a] = qpos[qa + 3 + a]
+                out_mu[k, i] = int(state[i, S_MU]) + (4 if state[i, S_AVOID_T] > 0.0 else 0)
+
+
+# ---- Python driver ----------------------------------------------------------------------------------
+
+
+@dataclass
+class SwimResult:
+    """Tracks of a swim: ``times_s`` (T,), ``positions`` (T, F, 3) m, ``quats`` (T, F, 4), ``mu``
+    (T, F) MU codes (0 accelerate, 1 coast, 2 cruise, 3 brake), sampled every control step;
+    row 0 is the initial state."""
+
+    params: FishParams
+    seed: int
+    tank_m: tuple[float, float, float]
+    times_s: np.ndarray
+    positions: np.ndarray
+    quats: np.ndarray
+    mu: np.ndarray
+    wall_time_s: float = 0.0
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def n_fish(self) -> int:
+        return self.positions.shape[1]
+
+    def outside_tank(self, tol_m: float = 0.0) -> np.ndarray:
+        """Per fish: True if its centre of mass was ever outside the water volume (+ ``tol_m``)."""
+        L, D, H = self.tank_m
+        p = self.positions
+        out = (np.abs(p[..., 0]) > L / 2 + tol_m) | (np.abs(p[..., 1]) > D / 2 + tol_m)
+        out |= (p[..., 2] < -tol_m) | (p[..., 2] > H + tol_m)
+        return out.any(axis=0)
+
+
+class Swimmer:
+    """A tank of fish with their state; :meth:`run` advances it. One per thread (mjData)."""
+
+    def __init__(self, params: FishParams, n_fish: int = 10, seed: int = 0, size=None,
+                 scene: FishScene | None = None):
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+            raise UserError(f"seed must be a non-negative whole number, got {seed!r}.")
+        self.params = params
+        self.seed = int(seed)
+        self.scene = scene if scene is not None else build_scene(n_fish, size, nuserdata=U_FISH + FISH_BLOCK * n_fish)
+        sc = self.scene
+        m = sc.model
+        m.opt.timestep = params.timestep_s
+        n = sc.n
+        need = U_FISH + FISH_BLOCK * n
+        if m.nuserdata < need:
+            raise RuntimeError("internal: the scene was compiled without room for the fish userdata")
+        self.data = mujoco.MjData(m)
+        self.vision_data = mujoco.MjData(sc.vision_model)
+        mujoco.mj_kinematics(sc.vision_model, self.vision_data)
+        mjabi.verify_offsets(self.data)
+        ud = self.data.userdata
+        sv, sw = box_areas(sc.mass_kg, sc.inertia)
+        ud[U_MAGIC] = MAGIC
+        ud[U_N] = n
+        ud[U_RHO] = params.water_density_kg_m3
+        ud[U_CD] = params.cd
+        ud[U_CDROT] = params.cd_rot
+        ud[U_RIGHT] = sc.mass_kg * float(np.linalg.norm(m.opt.gravity)) * params.buoyancy_offset_m
+        ud[U_SV : U_SV + 3] = sv
+        ud[U_SW : U_SW + 3] = sw
+        ud[U_DSV : U_DSV + 3] = params.brake_dS_v_m2
+        ud[U_DSW : U_DSW + 3] = params.brake_dS_w_m5
+        for i in range(n):
+            b = U_FISH + FISH_BLOCK * i
+            ud[b] = sc.qadr[i]
+            ud[b + 1] = sc.dadr[i]
+            ud[b + 2] = 1  # coast
+        ss = np.random.SeedSequence(self.seed)
+        children = ss.spawn(n + 1)
+        self.rngs = [np.random.Generator(np.random.PCG64(ch)) for ch in children[1:]]
+        self._place(np.random.Generator(np.random.PCG64(children[0])))
+        self.state = np.zeros((n, N_STATE))
+        self.state[:, S_MU] = 1
+        self.cum = np.cumsum(params.transition_matrix(False), axis=1)
+        self.cum_avoid = np.cumsum(params.transition_matrix(True), axis=1)
+        self.cum[:, -1] = self.cum_avoid[:, -1] = 1.0
+        c = np.zeros(N_CONST)
+        c[C_RMIN], c[C_RMAX] = params.r_min_N, params.r_max_N
+        c[C_THR], c[C_PHR] = params.theta_range_deg, params.phi_range_deg
+        c[C_BA], c[C_BK] = params.balance_A_deg, params.balance_k_per_deg
+        c[C_R] = params.inertia_radius_m
+        c[C_VIS], c[C_VANG] = params.vision_distance_m, math.radians(params.vision_angle_deg)
+        c[C_AVT], c[C_AVF], c[C_TURN] = params.avoid_duration_s, params.avoid_force_scale, params.avoid_turn_deg
+        c[C_HEAD], c[C_MASS] = sc.head_m, sc.mass_kg
+        c[C_IY], c[C_IZ] = sc.inertia[1], sc.inertia[2]
+        c[C_DT] = params.control_dt_s
+        c[C_VMAX] = params.runaway_speed_bl_s * BODY_LENGTH_M
+        self.c = c
+        self.step = 0  # control steps done
+        mujoco.mj_forward(m, self.data)
+
+    def _place(self, rng: np.random.Generator) -> None:
+        """Random positions in the water (a body length from every wall), random heading, level."""
+        L, D, H = self.scene.size
+        mgn = BODY_LENGTH_M
+        d = self.data
+        for i in range(self.scene.n):
+            qa = self.scene.qadr[i]
+            d.qpos[qa : qa + 3] = [rng.uniform(-L / 2 + mgn, L / 2 - mgn), rng.uniform(-D / 2 + mgn, D / 2 - mgn),
+                                   rng.uniform(mgn, H - mgn)]
+            yaw = rng.uniform(-math.pi, math.pi)
+            d.qpos[qa + 3 : qa + 7] = [math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]
+        d.qvel[:] = 0.0
+
+    def _randoms(self, k: int) -> np.ndarray:
+        U = np.empty((k, self.scene.n, 4))
+        for i, g in enumerate(self.rngs):
+            U[:, i, :] = g.random((k, 4))
+        return U
+
+    def run(self, n_control_steps: int, record: bool = True):
+        """Advance ``n_control_steps`` control steps. Returns ``(pos, quat, mu)`` for them (empty
+        arrays when not recording). Raises :class:`UserError` on a runaway speed."""
+        sc = self.scene
+        n = sc.n
+        k = int(n_control_steps)
+        U = self._randoms(k)
+        shape = (k if record else 0, n)
+        pos = np.zeros((*shape, 3))
+        quat = np.zeros((*shape, 4))
+        mu = np.zeros(shape, dtype=np.int8)
+        err = np.zeros(4)
+        with passive_callback(COMPILED_PASSIVE):
+            _run_chunk(sc.model._address, self.data._address, sc.vision_model._address, self.vision_data._address,
+                       self.data.qpos, self.data.qvel, self.data.userdata, self.state, self.cum, self.cum_avoid,
+                       U, self.c, n, int(self.params.substeps), pos, quat, mu, record, err)
+        if err[0] != 0:
+            t = (self.step + err[1] + 1) * self.params.control_dt_s
+            self.step += int(err[1]) + 1
+            raise UserError(self._runaway_message(int(err[0]), int(err[2]), err[3], t))
+        self.step += k
+        return pos, quat, mu
+
+    def _runaway_message(self, kind: int, fish: int, speed: float, t: float) -> str:
+        p = self.params
+        T = p.transition_matrix(False)
+        name, val, prob = ("P_a", p.P_a, T[0, 0]) if T[0, 0] >= T[1, 0] else ("P_b", p.P_b, T[1, 0])
+        what = "became NaN" if kind == 2 else (f"kept up {speed:.2f} m/s ({speed / BODY_LENGTH_M:.1f} body lengths/s over "
+                                                f"{RUNAWAY_TAU_S:g} s, above runaway_speed_bl_s = {p.runaway_speed_bl_s:g})")
+        return (f"the speed ran away: fish {fish} {what} at t = {t:.2f} s; {name} = {val:g} is too high "
+                f"(the chance to accelerate again is {prob:.2f} per step): lower {name}.")
+
+    def snapshot(self) -> tuple[np.ndarray, np.ndarray]:
+        sc = self.scene
+        pos = np.array([self.data.qpos[a : a + 3] for a in sc.qadr])
+        quat = np.array([self.data.qpos[a + 3 : a + 7] for a in sc.qadr])
+        return pos, quat
+
+
+def swim(params: FishParams, n_fish: int = 10, duration_s: float = 30.0, seed: int = 0, size=None,
+         progress: bool = False, chunk_s: float = 1.0) -> SwimResult:
+    """Simulate ``n_fish`` fish for ``duration_s`` seconds; the tracks at every control step."""
+    import time
+
+    if not (isinstance(duration_s, (int, float)) and math.isfinite(duration_s) and duration_s > 0):
+        raise UserError(f"duration must be a positive number of seconds, got {duration_s!r}.")
+    t0 = time.perf_counter()
+    sw = Swimmer(params, n_fish, seed, size)
+    total = int(round(duration_s * params.control_hz))
+    chunk = max(1, int(round(chunk_s * params.control_hz)))
+    p0, q0 = sw.snapshot()
+    P, Q, M = [p0[None]], [q0[None]], [np.full((1, sw.scene.n), 1, dtype=np.int8)]
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=total, unit="step", desc="swim", leave=False)
+    try:
+        done = 0
+        while done < total:
+            k = min(chunk, total - done)
+            p, q, m = sw.run(k)
+            P.append(p)
+            Q.append(q)
+            M.append(m)
+            done += k
+            if bar is not None:
+                bar.update(k)
+    finally:
+        if bar is not None:
+            bar.close()
+    times = np.arange(total + 1) * params.control_dt_s
+    return SwimResult(params, sw.seed, sw.scene.size, times, np.concatenate(P), np.concatenate(Q), np.concatenate(M),
+                      time.perf_counter() - t0)
+
+
+__all__ = ["MU_NAMES", "SwimResult", "Swimmer", "swim", "COMPILED_PASSIVE", "python_passive", "fish_forces"]

@@ -1,0 +1,281 @@
+"""Figures of the fish swims, after Satoi, Nakadai, Hoshino 2015 ("Satoi 2015"; life-like tropical fish).
+
+* :func:`tracks_figure`: horizontal and vertical position of one fish against time over 30 s, with
+  its *accelerate* motion units marked, and its path in the side view (Satoi 2015 Fig. 7 and 8);
+* :func:`accel_histogram_figure`: the histogram of the tangential acceleration seen from the side
+  at 24 frames/s, in body lengths/s^2 (Satoi 2015 Fig. 2 for real fish, Fig. 7 and 8 simulated);
+* :func:`patterns_figure`: the four motion patterns NB-ND, NB-D, B-ND, B-D on the objective measures
+  (burstiness, kurtosis of the acceleration, turning entropy) that stand in for the paper's
+  questionnaire (Satoi 2015 Fig. 10-12);
+* :func:`tank_snapshot`: one rendered frame of the tank (:mod:`lifelike_mj.viz.fish_video`).
+
+The figures are built on :class:`matplotlib.figure.Figure` with the Agg canvas, without pyplot (the
+process's matplotlib backend is never changed); every PNG is written atomically (a temporary file
+beside it, then renamed).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from lifelike_mj.errors import UserError
+from lifelike_mj.io import atomic_path
+
+if TYPE_CHECKING:  # pragma: no cover
+    from lifelike_mj.fish.params import FishParams
+    from lifelike_mj.fish.sim import SwimResult
+
+DPI = 120
+#: The paper's four motion patterns (Satoi 2015 section 5.1.1), in the order of its figures.
+PATTERN_ORDER = ("NB-ND", "NB-D", "B-ND", "B-D")
+_PATTERN_COLOURS = {"NB-ND": "tab:gray", "NB-D": "tab:green", "B-ND": "tab:orange", "B-D": "tab:blue"}
+#: The measures of :func:`patterns_figure`: key, axis label, what the paper's ratings imply.
+PATTERN_MEASURES = (
+    ("burstiness", "burstiness of acceleration events\n(Kim & Jo A_n; -1 periodic, 0 Poisson, 1 bursty)",
+     "expected: B-* above NB-*"),
+    ("accel_kurtosis", "excess kurtosis of the side-view\nacceleration (24 fps)", "expected: B-* above NB-*"),
+    ("turn_entropy", "entropy of turning angles\nover 0.25 s (bits)", "expected: *-D above *-ND"),
+)
+
+
+def _new_figure(width_in: float, height_in: float) -> Figure:
+    fig = Figure(figsize=(width_in, height_in), layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _png_path(path: str | os.PathLike, what: str) -> Path:
+    p = Path(path)
+    if p.suffix.lower() != ".png":
+        raise UserError(f"cannot write {p.name}: the {what} is a .png file.")
+    return p
+
+
+def _save(fig: Figure, path: Path) -> Path:
+    """Write ``fig`` as a PNG to ``path`` atomically; return the path."""
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=DPI)
+    return path
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """``(start, end)`` index pairs (end exclusive) of the runs of True in a 1-D boolean array."""
+    m = np.concatenate(([False], np.asarray(mask, dtype=bool), [False]))
+    edges = np.flatnonzero(m[1:] != m[:-1])
+    return list(zip(edges[::2].tolist(), edges[1::2].tolist()))
+
+
+def _shade(ax, t: np.ndarray, mask: np.ndarray, dt: float, colour: str, label: str, y0: float = 0.0,
+           y1: float = 1.0, alpha: float = 0.35) -> None:
+    """Shade the time spans where ``mask`` holds (a sample ``t[i]`` covers ``[t[i] - dt, t[i]]``: the
+    control step that led to it) from ``y0`` to ``y1`` in axes coordinates."""
+    trans = ax.get_xaxis_transform()
+    for n, (a, b) in enumerate(_runs(mask)):
+        ax.axvspan(t[a] - dt, t[b - 1], ymin=y0, ymax=y1, color=colour, alpha=alpha, lw=0,
+                   label=label if n == 0 else None, transform=trans)
+
+
+def tracks_figure(result: SwimResult, out_path: str | os.PathLike, fish: int = 0, duration_s: float = 30.0) -> Path:
+    """Satoi 2015 Fig. 7/8 style: the tracks of fish ``fish`` over the first ``duration_s`` s (or
+    the whole swim if shorter), written as a PNG.
+
+    Three panels: the horizontal position x (m, along the tank) and the vertical position z (m,
+    above the floor) against time (s), with the control steps whose motion unit was *accelerate*
+    shaded and those spent avoiding a wall marked by a bar along the bottom; and the path in the
+    side view (x against z, true aspect, the tank's walls dashed), from a circle (start) to a
+    square (end). ``result``: a :class:`~lifelike_mj.fish.sim.SwimResult`. Returns the path written.
+    """
+    out = _png_path(out_path, "tracks figure")
+    n = result.n_fish
+    if isinstance(fish, bool) or not isinstance(fish, (int, np.integer)) or not 0 <= fish < n:
+        raise UserError(f"fish must be a whole number from 0 to {n - 1}, got {fish!r}.")
+    if isinstance(duration_s, bool) or not isinstance(duration_s, (int, float)) or not duration_s > 0:
+        raise UserError(f"duration must be a positive number of seconds, got {duration_s!r}.")
+    t_all = np.asarray(result.times_s, dtype=float)
+    keep = t_all <= t_all[0] + duration_s + 1e-9
+    t = t_all[keep]
+    pos = np.asarray(result.positions)[keep, fish, :]
+    mu = np.asarray(result.mu)[keep, fish]
+    accel = (mu % 4) == 0
+    avoid = mu >= 4
+    accel[0] = avoid[0] = False  # row 0 is the initial state, no control step led to it
+    dt = float(np.median(np.diff(t_all))) if t_all.size > 1 else 0.0
+    L, _D, H = result.tank_m
+    name = result.params.name or "custom"
+    span = float(t[-1] - t[0])
+
+    fig = _new_figure(11.0, 8.0)
+    grid = fig.add_gridspec(3, 1, height_ratios=(1.0, 1.0, 1.25))
+    ax_x = fig.add_subplot(grid[0])
+    ax_z = fig.add_subplot(grid[1], sharex=ax_x)
+    ax_p = fig.add_subplot(grid[2])
+    for ax, col, label, lo, hi in ((ax_x, 0, "horizontal position x (m)", -L / 2, L / 2),
+                                   (ax_z, 2, "vertical position z (m)", 0.0, H)):
+        _shade(ax, t, accel, dt, "tab:red", "accelerate MU", alpha=0.3)
+        _shade(ax, t, avoid, dt, "k", "avoiding a wall", y0=0.0, y1=0.04, alpha=0.6)
+        ax.plot(t, pos[:, col], color="tab:blue", lw=1.2, label=f"fish {fish}")
+        for wall in (lo, hi):
+            ax.axhline(wall, color="0.4", ls="--", lw=0.8)
+        pad = 0.03 * (hi - lo)
+        ax.set_ylim(lo - pad, hi + pad)
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    ax_x.legend(loc="upper right", fontsize=8, ncols=3)
+    ax_z.set_xlabel("time (s)")
+    ax_x.set_xlim(t[0], t[-1])
+    ax_x.set_title(f"Horizontal and vertical track of fish {fish} over {span:.0f} s, preset {name} "
+                   f"(cf. Satoi 2015 Fig. 7 and 8); shaded: accelerate MU "
+                   f"({100.0 * accel[1:].mean():.0f} % of control steps)", fontsize=10)
+
+    ax_p.plot([-L / 2, L / 2, L / 2, -L / 2, -L / 2], [0.0, 0.0, H, H, 0.0], color="0.4", ls="--", lw=0.8)
+    ax_p.plot(pos[:, 0], pos[:, 2], color="tab:blue", lw=0.9)
+    ax_p.plot(pos[accel, 0], pos[accel, 2], ".", color="tab:red", ms=2.5, label="accelerate MU")
+    ax_p.plot(pos[0, 0], pos[0, 2], "o", color="k", ms=6, mfc="none", label=f"start (t = {t[0]:.0f} s)")
+    ax_p.plot(pos[-1, 0], pos[-1, 2], "s", color="k", ms=6, mfc="none", label=f"end (t = {t[-1]:.0f} s)")
+    ax_p.set_aspect("equal")
+    ax_p.set_xlim(-L / 2 - 0.02 * L, L / 2 + 0.02 * L)
+    ax_p.set_ylim(-0.05 * H, 1.05 * H)
+    ax_p.set_xlabel("x (m, along the tank)")
+    ax_p.set_ylabel("z (m)")
+    ax_p.set_title(f"Path in the side view (tank {L:g} m x {H:g} m, dashed)", fontsize=10)
+    ax_p.legend(loc="upper left", fontsize=8, ncols=3)
+    return _save(fig, out)
+
+
+def side_accelerations_bl(result: SwimResult, body_length_m: float = 0.07, fps: float | None = None) -> np.ndarray:
+    """Side-view tangential accelerations of every fish in body lengths/s^2, shape (N - 2, F): the
+    tracks resampled at ``fps`` frames/s (default the paper's 24), projected on the side view (x, z)
+    and differentiated twice (:mod:`lifelike_mj.fish.metrics`), divided by ``body_length_m`` (m)."""
+    from lifelike_mj.fish.metrics import VIDEO_FPS, resample, side_view, speed_and_accel
+
+    rate = VIDEO_FPS if fps is None else fps
+    _t, p = resample(result.times_s, result.positions, rate)
+    _speed, accel = speed_and_accel(side_view(p), rate)
+    return accel / body_length_m
+
+
+def accel_histogram_figure(result: SwimResult, out_path: str | os.PathLike, body_length_m: float = 0.07) -> Path:
+    """Satoi 2015 Fig. 2/7/8 style: histogram of the tangential acceleration in the side view, pooled
+    over the fish, in body lengths/s^2, written as a PNG.
+
+    As the paper's video analysis: the tracks at 24 frames/s, side view (x, z), speed from frame to
+    frame, acceleration from speed to speed (:func:`side_accelerations_bl`). 41 bins over +-the
+    99th percentile of |a| (:func:`lifelike_mj.fish.metrics.accel_histogram`); the zero line and the
+    histogram's mode are drawn, and the mode, the share of positive samples, the skewness and the
+    excess kurtosis are printed. ``body_length_m``: m (the model fish: 0.07). Returns the path.
+    """
+    from lifelike_mj.fish.metrics import VIDEO_FPS, accel_histogram, histogram_summary, kurtosis
+
+    out = _png_path(out_path, "acceleration histogram")
+    if isinstance(body_length_m, bool) or not isinstance(body_length_m, (int, float)) or not body_length_m > 0:
+        raise UserError(f"the body length must be a positive number of m, got {body_length_m!r}.")
+    a = side_accelerations_bl(result, body_length_m)
+    finite = a[np.isfinite(a)]
+    if finite.size < 4:
+        raise UserError("the swim is too short for an acceleration histogram (it needs at least 0.25 s).")
+    counts, edges = accel_histogram(finite, bins=41)
+    summary = histogram_summary(finite, bins=41)
+    centres = 0.5 * (edges[:-1] + edges[1:])
+    name = result.params.name or "custom"
+    span = float(result.times_s[-1] - result.times_s[0])
+
+    fig = _new_figure(8.0, 5.0)
+    ax = fig.subplots()
+    ax.bar(centres, counts, width=np.diff(edges), color="tab:blue", alpha=0.75, edgecolor="white", lw=0.5,
+           label=f"{finite.size} frames, {result.n_fish} fish pooled")
+    ax.axvline(0.0, color="k", lw=1.0, label="zero acceleration")
+    ax.axvline(summary["mode"], color="tab:red", ls="--", lw=1.5,
+               label=f"mode {summary['mode']:+.2f} body lengths/s$^2$")
+    ax.set_xlabel("tangential acceleration in the side view (body lengths/s$^2$)")
+    ax.set_ylabel(f"count of {VIDEO_FPS:g} fps frames")
+    ax.set_xlim(edges[0], edges[-1])
+    ax.grid(alpha=0.3, axis="y")
+    ax.legend(loc="upper right", fontsize=8)
+    ax.text(0.02, 0.97, f"positive: {100.0 * summary['fraction_positive']:.0f} %\n"
+            f"skewness: {summary['skewness']:+.2f}\nexcess kurtosis: {kurtosis(finite):.1f}\n"
+            f"(outside +-{edges[-1]:.1f}: {finite.size - int(counts.sum())} frames)",
+            transform=ax.transAxes, va="top", ha="left", fontsize=8,
+            bbox={"boxstyle": "round,pad=0.3", "fc": "white", "ec": "0.7", "alpha": 0.9})
+    ax.set_title(f"Side-view acceleration at {VIDEO_FPS:g} fps, preset {name}, {span:.0f} s "
+                 "(cf. Satoi 2015 Fig. 2 real fish, Fig. 7/8 simulated)", fontsize=10)
+    return _save(fig, out)
+
+
+def patterns_figure(rows: list[dict], out_path: str | os.PathLike) -> Path:
+    """Satoi 2015 Fig. 10-12 stand-in: the four motion patterns NB-ND, NB-D, B-ND, B-D (not bursty /
+    bursty, not diverse / diverse) compared on the objective measures that replace the paper's
+    questionnaire ratings, written as a PNG.
+
+    ``rows``: one dict per swim with ``"preset"`` (str), ``"seed"`` (int) and the measures
+    ``"burstiness"`` (Kim & Jo A_n of the acceleration events, dimensionless), ``"accel_kurtosis"``
+    (excess kurtosis of the side-view acceleration, dimensionless) and ``"turn_entropy"`` (bits),
+    as :func:`lifelike_mj.fish.experiments.pattern_table` produces; other keys are ignored. One
+    panel per measure: a point per seed (slightly spread sideways) and the median over seeds (bar
+    and value); the paper's four patterns first, any other preset after them. Non-finite values
+    are left out. Returns the path written.
+    """
+    out = _png_path(out_path, "patterns figure")
+    if not isinstance(rows, (list, tuple)) or not rows:
+        raise UserError("the patterns figure needs at least one row of measures.")
+    for i, r in enumerate(rows):
+        if not isinstance(r, dict):
+            raise UserError(f"row {i} of the patterns figure is not a dict of measures.")
+        missing = [k for k in ("preset", *(m[0] for m in PATTERN_MEASURES)) if k not in r]
+        if missing:
+            raise UserError(f"row {i} of the patterns figure lacks {', '.join(missing)}.")
+    present = {str(r["preset"]) for r in rows}
+    presets = [p for p in PATTERN_ORDER if p in present] + sorted(present - set(PATTERN_ORDER))
+    seeds = sorted({r.get("seed") for r in rows}, key=lambda s: (s is None, s))
+
+    fig = _new_figure(4.0 * len(PATTERN_MEASURES) + 0.5, 4.8)
+    axes = fig.subplots(1, len(PATTERN_MEASURES))
+    for ax, (key, label, expected) in zip(np.atleast_1d(axes), PATTERN_MEASURES):
+        for i, preset in enumerate(presets):
+            vals = np.array([float(r[key]) for r in rows if str(r["preset"]) == preset
+                             and r[key] is not None], dtype=float)
+            vals = vals[np.isfinite(vals)]
+            colour = _PATTERN_COLOURS.get(preset, "tab:purple")
+            if vals.size:
+                spread = np.linspace(-0.15, 0.15, vals.size) if vals.size > 1 else np.zeros(1)
+                ax.plot(i + spread, vals, "o", color=colour, ms=5, alpha=0.7, mfc="none")
+                med = float(np.median(vals))
+                ax.plot([i - 0.3, i + 0.3], [med, med], color=colour, lw=2.5)
+                ax.annotate(f"{med:.3g}", (i + 0.32, med), va="center", fontsize=8, color=colour)
+        ax.set_xticks(range(len(presets)), presets)
+        ax.set_xlim(-0.6, len(presets) - 0.4)
+        ax.set_ylabel(label, fontsize=9)
+        ax.set_title(expected, fontsize=9)
+        ax.grid(alpha=0.3, axis="y")
+    seed_text = f"{len(seeds)} seed{'s' if len(seeds) != 1 else ''}"
+    fig.suptitle(f"The four motion patterns (Satoi 2015 Fig. 10-12) on objective measures in place of the "
+                 f"questionnaire: one point per seed ({seed_text}), bar = median", fontsize=10)
+    return _save(fig, out)
+
+
+def tank_snapshot(out_path: str | os.PathLike, params: FishParams, n_fish: int = 10, seed: int = 0, t_s: float = 5.0,
+                  camera: str = "side", width: int = 640, height: int = 480, size=None) -> Path:
+    """One rendered frame of the swim at time ``t_s`` (s), as a PNG of ``width`` x ``height`` pixels.
+
+    ``camera``: ``side`` (the whole tank, Satoi 2015's view), ``oblique`` or ``follow`` (1 m of tank
+    around fish 0); ``size``: the water volume (m). See :func:`lifelike_mj.viz.fish_video.render_frame`.
+    Written atomically; returns the path.
+    """
+    from PIL import Image
+
+    from lifelike_mj.viz.fish_video import render_frame
+
+    out = _png_path(out_path, "snapshot")
+    img = render_frame(params, t_s=t_s, n_fish=n_fish, seed=seed, size=size, camera=camera, width=width, height=height)
+    with atomic_path(out) as tmp:
+        Image.fromarray(img).save(tmp, format="PNG")
+    return out
+
+
+__all__ = ["PATTERN_ORDER", "accel_histogram_figure", "patterns_figure", "side_accelerations_bl", "tank_snapshot",
+           "tracks_figure"]
