@@ -334,7 +334,7 @@ def cmd_bench(args) -> None:
             write_json(args.out, r)
         rend = r.get("render", {})
         human = (f"10 fish x{r['ten']['realtime_factor']:.0f} real time, 1,000 fish "
-                 f"x{r['thousand']['realtime_factor']:.2f}, render {rend.get('render_fps', float('nan')):.0f} fps "
+                 f"x{r['thousand']['realtime_factor']:.2f}, render {rend.get('fps', float('nan')):.0f} fps "
                  f"at 640x480")
         _emit(args, r, human)
         return
