@@ -180,6 +180,28 @@ def test_robust_task_flies_windy_conditions_with_both_input_readings():
     assert short.evaluate(x[None])[0] == pytest.approx(np.mean(vals), rel=1e-12)
 
 
+def test_robust_map_task_weights_flights_by_ground_speed():
+    """robust_map: each flight's H divided by its head-wind share of eq. 13's speed term
+    (V_REF / max(V_REF - a, V_MIN)), weights summing to 1; unweighted tasks keep their fingerprints."""
+    prob = make_problem("robust_map")
+    assert prob.weighting == "ground_speed" and "weighting" in prob.describe()
+    assert "weighting" not in make_problem("robust").describe()
+    w = prob.weights()
+    assert w.sum() == pytest.approx(1.0)
+    heads = np.array([c.wind_m_s[0] for c, _ in prob.flights()])
+    expected = 3.0 / np.maximum(3.0 - heads, 0.5)
+    np.testing.assert_allclose(w, expected / expected.sum())
+    assert w[heads == 3.0][0] == pytest.approx(6 * w[heads == 0.0][0])
+    short = PitchProblem(duration_s=0.3, conditions=prob.conditions, inputs="both", weighting="ground_speed")
+    x = _weights(3)
+    c = short.controller(x)
+    vals = [paper.simulate(c.with_inputs("relative" if rel else "ground"), conditions=cd, duration_s=0.3)[0].fitness
+            for cd, rel in short.flights()]
+    assert short.evaluate(x[None])[0] == pytest.approx(float(np.dot(short.weights(), vals)), rel=1e-12)
+    with pytest.raises(UserError):
+        PitchProblem(weighting="nonsense")
+
+
 def test_cli_evolve_writes_a_controller_with_provenance_same_on_serial_and_process(tmp_path):
     outs = {}
     for ex in ("serial", "process"):

@@ -68,8 +68,18 @@ def test_ann_robust_holds_level_in_still_air(ann_robust):
     assert s["holds_level"] and s["settled_forward_speed_cm_s"] > 200.0
 
 
-def test_ann_robust_passes_more_wind_cells_with_relative_inputs(ann_paper, ann_robust):
-    # with ground-velocity inputs it does not (2361 vs 2699 cells): an open point of issue 3, see docs/results.md
-    a = ax.e11_windmap(ann_paper, "relative")
-    b = ax.e11_windmap(ann_robust, "relative")
+def test_ann_robust_reproduces_its_recorded_fitness(ann_robust):
+    prov = ann_robust.provenance
+    assert prov["task"] == "robust_map" and prov["optimizer"] == "cmaes"
+    prob = make_problem("robust_map")
+    assert prov["problem_fingerprint"] == prob.fingerprint()
+    assert prob.evaluate(ann_robust.weights[None])[0] == pytest.approx(prov["best_fitness"], rel=1e-12)
+
+
+@pytest.mark.parametrize("inputs", ["relative", "ground"])
+def test_ann_robust_passes_more_wind_cells(ann_paper, ann_robust, inputs):
+    # E11 on a 0.25 m/s grid here (625 cells, to keep the suite fast); the 0.1 m/s map of the issue
+    # (3721 cells) is in docs/results.md and `lifelike-mj butterfly assess --controller ann_robust`
+    a = ax.e11_windmap(ann_paper, inputs, step_m_s=0.25)
+    b = ax.e11_windmap(ann_robust, inputs, step_m_s=0.25)
     assert b.pass_cells > a.pass_cells

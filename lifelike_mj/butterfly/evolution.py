@@ -11,6 +11,11 @@ them: the "training over varied conditions" that section 7 proposes as future wo
 ``inputs="both"`` every windy condition is flown twice, once with air-relative and once with ground
 velocity inputs (section 7.2's two readings), so that one network is trained for both; the
 controller file then reads relative velocities by default.
+
+Eq. 13 rewards ground speed, so a flight into a head wind ``a`` scores at most about
+``(V_REF - a)/V_REF`` of a still-air flight however well it holds, and a plain mean over winds lets
+the search neglect head winds. ``weighting="ground_speed"`` divides each flight's ``H`` by that
+factor (:func:`flight_weight`), so that every flight counts for about the same when it holds.
 """
 
 from __future__ import annotations
@@ -33,6 +38,10 @@ from lifelike_mj.errors import UserError
 #: Gene bounds for optimisers that need them (nlopt, CMA-ES); the RCGA starts in [-1, 1] and is
 #: unbounded, as in the paper.
 GENE_BOUND = 5.0
+#: Eq. 13's speed scale (m/s), and the smallest ground speed a flight weight assumes (m/s).
+V_REF_M_S = 3.0
+V_MIN_M_S = 0.5
+WEIGHTINGS = ("none", "ground_speed")
 PAPER_FLAP = FlapPattern(10.0, -60.0, 75.0)
 
 
@@ -48,9 +57,12 @@ class PitchProblem:
     flap: FlapPattern = PAPER_FLAP
     params: ButterflyParams = field(default_factory=ButterflyParams)
     gene_bound: float = GENE_BOUND
+    weighting: str = "none"
 
     def __post_init__(self) -> None:
         check_backend(self.backend)
+        if self.weighting not in WEIGHTINGS:
+            raise UserError(f"weighting must be one of {', '.join(WEIGHTINGS)}, got {self.weighting!r}.")
         if self.inputs not in (*ann.INPUT_KINDS, "both"):
             raise UserError(f"inputs must be one of {', '.join(ann.INPUT_KINDS)} or both, got {self.inputs!r}.")
         if not self.conditions:
@@ -75,8 +87,9 @@ class PitchProblem:
         return True
 
     def describe(self) -> dict:
-        """Plain-data description (what the fingerprint hashes)."""
-        return {
+        """Plain-data description (what the fingerprint hashes; ``weighting`` only when not
+        ``none``, so that fingerprints of unweighted problems are unchanged)."""
+        d = {
             "problem": "butterfly-pitch-ann",
             "backend": self.backend,
             "conditions": [{"y0_m": c.y0_m, "wind_m_s": list(c.wind_m_s)} for c in self.conditions],
@@ -88,14 +101,17 @@ class PitchProblem:
             "gene_bound": self.gene_bound,
             "n_weights": ann.N_WEIGHTS,
         }
+        if self.weighting != "none":
+            d["weighting"] = self.weighting
+        return d
 
     def fingerprint(self) -> str:
         text = json.dumps(self.describe(), sort_keys=True)
         return "butterfly-pitch-ann:" + hashlib.sha256(text.encode()).hexdigest()[:16]
 
     def evaluate(self, X: np.ndarray) -> np.ndarray:
-        """Mean eq. 13 fitness of each row of ``X`` (n, 49) over the conditions. A flight that
-        diverges keeps the fitness it had gathered up to then."""
+        """Mean eq. 13 fitness of each row of ``X`` (n, 49) over the flights (weighted by
+        :meth:`weights`). A flight that diverges keeps the fitness it had gathered up to then."""
         X = np.atleast_2d(np.asarray(X, dtype=float))
         if X.shape[1] != ann.N_WEIGHTS:
             raise UserError(f"a genome has {ann.N_WEIGHTS} weights, got {X.shape[1]}.")
@@ -115,7 +131,7 @@ class PitchProblem:
             y0s = np.repeat(np.array([c.y0_m for c, _ in flights], dtype=float), n)
             consts = np.repeat(constants_row(self.params)[None, :], n * nf, axis=0)
             _, _, fit = run_batch(kinds, cps, flaps, airs, y0s, consts, n_steps, self.dt_s, n_steps)
-            return fit.reshape(nf, n).mean(axis=0)
+            return self.weights() @ fit.reshape(nf, n)
         from lifelike_mj.butterfly.mjbackend import fitness_batch
 
         fits = []
@@ -123,7 +139,14 @@ class PitchProblem:
             c = cp.copy()
             c[:, ann.A_RELATIVE] = 1.0 if rel else 0.0
             fits.append(fitness_batch(c, self.flap, self.params, cond, n_steps, self.dt_s))
-        return np.mean(fits, axis=0)
+        return self.weights() @ np.asarray(fits)
+
+    def weights(self) -> np.ndarray:
+        """Weights of :meth:`flights` in the fitness, summing to 1: equal, or with
+        ``weighting="ground_speed"`` proportional to :func:`flight_weight`."""
+        w = np.array([flight_weight(c.wind_m_s[0]) if self.weighting == "ground_speed" else 1.0
+                      for c, _ in self.flights()])
+        return w / w.sum()
 
     def flights(self) -> list[tuple[Condition, bool]]:
         """The flights of one evaluation: ``(condition, air-relative inputs?)``."""
@@ -140,6 +163,12 @@ class PitchProblem:
     def controller(self, weights, provenance: dict | None = None, name: str = "") -> ButterflyController:
         """The controller file content of a genome."""
         return ann_controller(weights, self.flap, "ground" if self.inputs == "ground" else "relative", provenance, name)
+
+
+def flight_weight(head_wind_m_s: float) -> float:
+    """``V_REF / max(V_REF - a, V_MIN)`` for a wind ``a`` (m/s, > 0 from the front): the inverse of the
+    share of eq. 13's speed term left to a flight that holds its altitude at about ``V_REF`` air speed."""
+    return V_REF_M_S / max(V_REF_M_S - head_wind_m_s, V_MIN_M_S)
 
 
 def robust_conditions() -> tuple[Condition, ...]:
@@ -160,20 +189,33 @@ def robust_wide_conditions() -> tuple[Condition, ...]:
     return tuple(Condition(a) for a in alts) + tuple(Condition(0.0, w) for w in winds)
 
 
-TASKS = ("paper", "robust", "robust_wide")
+def robust_map_conditions() -> tuple[Condition, ...]:
+    """Start altitudes -10 to +10 m in still air, and from 0 m winds spread over the E11 map
+    (+-3 m/s): 2 and 3 m/s from each side and 2 m/s along both diagonals (12 winds)."""
+    alts = (-10.0, -4.0, 0.0, 4.0, 10.0)
+    winds = ((2.0, 0.0), (-2.0, 0.0), (0.0, 2.0), (0.0, -2.0), (3.0, 0.0), (-3.0, 0.0), (0.0, 3.0), (0.0, -3.0),
+             (2.0, 2.0), (2.0, -2.0), (-2.0, 2.0), (-2.0, -2.0))
+    return tuple(Condition(a) for a in alts) + tuple(Condition(0.0, w) for w in winds)
+
+
+TASKS = ("paper", "robust", "robust_wide", "robust_map")
 
 
 def make_problem(task: str = "paper", backend: str = "paper", inputs: str | None = None,
                  params: ButterflyParams | None = None) -> PitchProblem:
     """``paper``: section 6.3's task (still air, from 0 m; inputs default ``relative``);
     ``robust`` / ``robust_wide``: :func:`robust_conditions` / :func:`robust_wide_conditions`
-    (inputs default ``both``)."""
+    (inputs default ``both``); ``robust_map``: :func:`robust_map_conditions`, inputs ``both``, flights
+    weighted by ground speed (:func:`flight_weight`)."""
     if task not in TASKS:
         raise UserError(f"unknown task {task!r}; choose one of: {', '.join(TASKS)}.")
-    conds = {"paper": (Condition(),), "robust": robust_conditions(), "robust_wide": robust_wide_conditions()}[task]
+    conds = {"paper": (Condition(),), "robust": robust_conditions(), "robust_wide": robust_wide_conditions(),
+             "robust_map": robust_map_conditions()}[task]
     if inputs is None:
         inputs = "relative" if task == "paper" else "both"
-    return PitchProblem(backend=backend, conditions=conds, inputs=inputs, params=params or ButterflyParams())
+    weighting = "ground_speed" if task == "robust_map" else "none"
+    return PitchProblem(backend=backend, conditions=conds, inputs=inputs, params=params or ButterflyParams(),
+                        weighting=weighting)
 
 
 def evolve_controller(problem: PitchProblem, optimizer: str, seed: int, out: str | Path,
