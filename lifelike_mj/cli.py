@@ -306,19 +306,24 @@ def cmd_fish_drag_check(args) -> None:
           f"over {r['trials']} random states")
 
 
+REPRODUCIBLE = ("butterfly", "fish")
+
+
 def cmd_reproduce(args) -> None:
-    if args.what not in ("butterfly", "fish"):
-        raise UserError(f"nothing to reproduce for {args.what!r} yet; available: butterfly, fish.")
-    out = Path(args.out or f"reports/{args.what}")
-    if args.what == "fish":
-        from lifelike_mj.fish.reproduce import reproduce_fish
+    if args.what not in (*REPRODUCIBLE, "all"):
+        raise UserError(f"nothing to reproduce for {args.what!r}; available: {', '.join(REPRODUCIBLE)} or all.")
+    whats = REPRODUCIBLE if args.what == "all" else (args.what,)
+    for what in whats:
+        out = Path(args.out or "reports") / what if (args.what == "all" or not args.out) else Path(args.out)
+        if what == "fish":
+            from lifelike_mj.fish.reproduce import reproduce_fish
 
-        reproduce_fish(out)
-    else:
-        from lifelike_mj.butterfly.reproduce import reproduce_all
+            reproduce_fish(out)
+        else:
+            from lifelike_mj.butterfly.reproduce import reproduce_all
 
-        reproduce_all(out, _params(args))
-    print(f"report written to {out / 'report.md'}")
+            reproduce_all(out, _params(args))
+        print(f"report written to {out / 'report.md'}")
 
 
 def cmd_bench(args) -> None:
@@ -498,8 +503,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_fish_drag_check)
 
     p = sub.add_parser("reproduce", help="run a paper's experiments and write a report")
-    p.add_argument("what", help="butterfly or fish")
-    p.add_argument("--out", default=None, help="output folder (default reports/WHAT)")
+    p.add_argument("what", help="butterfly, fish, or all")
+    p.add_argument("--out", default=None, help="output folder (default reports/WHAT; with all: OUT/WHAT)")
     _add_physics(p)
     p.set_defaults(func=cmd_reproduce)
 

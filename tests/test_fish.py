@@ -291,3 +291,15 @@ def test_cli_bad_preset_file_exit_2(capsys, tmp_path):
     bad.write_text(json.dumps(data))
     assert main(["fish", "swim", "--preset", str(bad)]) == 2
     assert "r_min_N" in capsys.readouterr()[1]
+
+
+def test_reproduce_fish_writes_report_results_and_figures(tmp_path):
+    from lifelike_mj.fish.reproduce import reproduce_fish
+
+    res = reproduce_fish(tmp_path, seeds=(0, 1), pattern_s=10.0, swim_s=5.0, progress=False)
+    text = (tmp_path / "report.md").read_text()
+    assert "F4" in text and "B-D > NB-ND on burstiness" in text
+    assert json.loads((tmp_path / "results.json").read_text())["drag_check"]["max_rel_error"] < 1e-9
+    assert res["swim"]["fish"] == 10
+    for name in ("fig7_tracks.png", "fig8_accel_histogram.png", "fig11_patterns.png", "tracks.csv", "tracks.npz"):
+        assert (tmp_path / name).stat().st_size > 0
