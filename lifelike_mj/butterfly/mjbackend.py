@@ -38,7 +38,7 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
-from numba import carray, cfunc, njit, prange, types
+from numba import cfunc, njit, prange, types
 
 from lifelike_mj.butterfly.aero import strip_nodes
 from lifelike_mj.butterfly.controllers import ButterflyController
@@ -96,14 +96,8 @@ _vp = mjabi.voidptr_from_int
 _addr = mjabi.int_from_voidptr
 
 
-@njit(cache=False, inline="always")
-def _ptr_at(address):
-    return carray(_vp(address), (1,), np.uint64)[0]
-
-
-@njit(cache=False, inline="always")
-def _f64(address, n):
-    return carray(_vp(address), (n,), np.float64)
+_ptr_at = mjabi.ptr_at
+_f64 = mjabi.f64_at
 
 
 @njit(cache=False)

@@ -35,13 +35,12 @@ seed gives the same tracks in any chunking.
 
 from __future__ import annotations
 
-import ctypes
 import math
 from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
-from numba import carray, cfunc, njit, types
+from numba import cfunc, njit, types
 
 from lifelike_mj.errors import UserError
 from lifelike_mj.fish.params import ACCELERATE, BRAKE, CRUISE, MU_NAMES, FishParams
@@ -67,24 +66,14 @@ MAGIC = 7.25e5
 _OFF = mjabi.data_offsets()
 _OFF_QPOS, _OFF_QVEL, _OFF_QFRC, _OFF_UD = _OFF["qpos"], _OFF["qvel"], _OFF["qfrc_passive"], _OFF["userdata"]
 _LIB = mjabi.libmujoco()
-_LIB.mj_ray.argtypes = [ctypes.c_void_p] * 6 + [ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p]
-_LIB.mj_ray.restype = ctypes.c_double
-_LIB.mj_kinematics.argtypes = [ctypes.c_void_p, ctypes.c_void_p]
-_LIB.mj_kinematics.restype = None
 _mj_step = _LIB.mj_step
 _mj_ray = _LIB.mj_ray
 _vp = mjabi.voidptr_from_int
 _addr = mjabi.int_from_voidptr
 
 
-@njit(cache=False, inline="always")
-def _ptr_at(address):
-    return carray(_vp(address), (1,), np.uint64)[0]
-
-
-@njit(cache=False, inline="always")
-def _f64(address, n):
-    return carray(_vp(address), (n,), np.float64)
+_ptr_at = mjabi.ptr_at
+_f64 = mjabi.f64_at
 
 
 @njit(cache=True, inline="always")

@@ -24,7 +24,7 @@ import re
 import mujoco
 import numpy as np
 from llvmlite import ir
-from numba import types
+from numba import carray, njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
@@ -54,6 +54,18 @@ def int_from_voidptr(typingctx, pointer):
     return sig, codegen
 
 
+@njit(cache=False, inline="always")
+def ptr_at(address):
+    """Compiled: the pointer (as uint64) stored at ``address`` (e.g. an ``mjData`` field)."""
+    return carray(voidptr_from_int(address), (1,), np.uint64)[0]
+
+
+@njit(cache=False, inline="always")
+def f64_at(address, n):
+    """Compiled: a float64 array view of ``n`` values at ``address``."""
+    return carray(voidptr_from_int(address), (n,), np.float64)
+
+
 def _mujoco_dir() -> str:
     return os.path.dirname(mujoco.__file__)
 
@@ -76,6 +88,10 @@ def libmujoco() -> ctypes.CDLL:
     lib.mj_applyFT.restype = None
     lib.mj_objectVelocity.argtypes = [vp, vp, ci, ci, vp, ci]
     lib.mj_objectVelocity.restype = None
+    lib.mj_kinematics.argtypes = [vp, vp]
+    lib.mj_kinematics.restype = None
+    lib.mj_ray.argtypes = [vp, vp, vp, vp, vp, ctypes.c_ubyte, ci, vp, vp]  # ... flg_static, bodyexclude, geomid, normal
+    lib.mj_ray.restype = ctypes.c_double
     return lib
 
 
