@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from PIL import Image, ImageSequence
+from conftest import gif_frames
+from PIL import Image
 
 from lifelike_mj.errors import UserError
 from lifelike_mj.fish.params import load_preset
 from lifelike_mj.fish.sim import swim
-from lifelike_mj.viz import fish_figures, fish_video, video, viewer
+from lifelike_mj.viz import fish_figures, fish_video, viewer
 
 
 @pytest.fixture(scope="module")
@@ -20,27 +21,6 @@ def params():
 @pytest.fixture(scope="module")
 def short_swim(params):
     return swim(params, n_fish=3, duration_s=5.0, seed=0)
-
-
-@pytest.fixture(scope="module")
-def gl_backend():
-    """The offscreen backend this machine offers; skip the rendering tests only if there is none."""
-    backend = video.ensure_gl_backend()
-    if backend is None:
-        pytest.skip("no offscreen OpenGL backend can be created here (tried MUJOCO_GL=egl and osmesa; install "
-                    "libegl1 or libosmesa6)")
-    import mujoco
-
-    try:
-        video._Offscreen(mujoco.MjModel.from_xml_string("<mujoco/>"), 16, 16, dress=False).close()
-    except UserError as exc:
-        pytest.skip(f"no offscreen OpenGL context can be created here: {exc}")
-    return backend
-
-
-def _gif_frames(path):
-    with Image.open(path) as im:
-        return [np.asarray(f.convert("RGB"), dtype=float) for f in ImageSequence.Iterator(im)]
 
 
 def _fish_pixels(img) -> int:
@@ -57,7 +37,7 @@ def test_render_tiny_gif(tmp_path, params, gl_backend):
     assert info["path"] == str(out) and info["frames"] == 15 and info["start_s"] == pytest.approx(2.0)
     assert (info["width"], info["height"], info["fps"], info["camera"]) == (160, 120, 30, "follow")
     assert info["seconds"] == pytest.approx(0.5) and info["render_fps"] > 0
-    frames = _gif_frames(out)
+    frames = gif_frames(out)
     assert len(frames) == 15 and frames[0].shape == (120, 160, 3)
     assert all(f.std() > 3.0 for f in frames)  # water, glass, floor: not a blank image
     assert all(_fish_pixels(f) > 5 for f in frames)  # the followed fish is in view, blue

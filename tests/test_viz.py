@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from PIL import Image, ImageSequence
+from conftest import gif_frames
+from PIL import Image
 
 from lifelike_mj.butterfly import controllers, mjbackend
 from lifelike_mj.errors import UserError
@@ -16,32 +17,13 @@ def rule():
     return controllers.load("simple_rule")
 
 
-@pytest.fixture(scope="module")
-def gl_backend():
-    """The offscreen backend this machine offers; skip the rendering tests only if there is none."""
-    backend = video.ensure_gl_backend()
-    if backend is None:
-        pytest.skip("no offscreen OpenGL backend can be created here (tried MUJOCO_GL=egl and osmesa; install "
-                    "libegl1 or libosmesa6)")
-    try:
-        video._Offscreen(mjbackend.build_model(), 16, 16).close()
-    except UserError as exc:
-        pytest.skip(f"no offscreen OpenGL context can be created here: {exc}")
-    return backend
-
-
-def _gif_frames(path):
-    with Image.open(path) as im:
-        return [np.asarray(f.convert("RGB"), dtype=float) for f in ImageSequence.Iterator(im)]
-
-
 def test_render_short_gif(tmp_path, rule, gl_backend):
     out = tmp_path / "fly.gif"
     info = video.render_butterfly(out, rule, duration_s=0.3, fps=30, width=64, height=48)
     assert info["frames"] == 9 and info["path"] == str(out)
     assert (info["width"], info["height"], info["fps"]) == (64, 48, 30)
     assert info["gl_backend"] in ("egl", "osmesa", "glfw", "cgl", "wgl", gl_backend)
-    frames = _gif_frames(out)
+    frames = gif_frames(out)
     assert len(frames) == 9 and frames[0].shape == (48, 64, 3)
     assert all(f.std() > 5.0 for f in frames)  # sky, ground and butterfly, not a blank image
     # the wings move between frames (10 Hz beat, 3 frames per cycle) while the camera follows the body

@@ -1,0 +1,33 @@
+"""Shared fixtures."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PIL import Image, ImageSequence
+
+from lifelike_mj.errors import UserError
+
+
+@pytest.fixture(scope="session")
+def gl_backend():
+    """The offscreen backend this machine offers; skip the rendering tests only if there is none."""
+    import mujoco
+
+    from lifelike_mj.viz import video
+
+    backend = video.ensure_gl_backend()
+    if backend is None:
+        pytest.skip("no offscreen OpenGL backend can be created here (tried MUJOCO_GL=egl and osmesa; install "
+                    "libegl1 or libosmesa6)")
+    try:
+        video._Offscreen(mujoco.MjModel.from_xml_string("<mujoco/>"), 16, 16, dress=False).close()
+    except UserError as exc:
+        pytest.skip(f"no offscreen OpenGL context can be created here: {exc}")
+    return backend
+
+
+def gif_frames(path) -> list[np.ndarray]:
+    """The frames of a GIF as float RGB arrays."""
+    with Image.open(path) as im:
+        return [np.asarray(f.convert("RGB"), dtype=float) for f in ImageSequence.Iterator(im)]
