@@ -271,6 +271,11 @@ def cmd_fish_swim(args) -> None:
         raise UserError(f"--seed must be a non-negative whole number, got {args.seed}.")
     if args.video and Path(args.video).suffix.lower() not in (".mp4", ".gif"):
         raise UserError(f"--video must end in .mp4 or .gif, got {args.video!r}.")
+    if args.video:
+        from lifelike_mj.viz.fish_video import CAMERAS
+
+        if args.camera not in CAMERAS:
+            raise UserError(f"unknown camera {args.camera!r}; choose one of {', '.join(CAMERAS)}.")
     r = swim(params, n, _positive("--duration", args.duration), args.seed, _tank(args), progress=not args.json)
     summary = swim_summary(r)
     if args.out:

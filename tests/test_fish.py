@@ -272,6 +272,7 @@ def test_cli_drag_check(capsys):
     ["fish", "swim", "--duration", "-1"],
     ["fish", "swim", "--tank-scale", "0"],
     ["fish", "swim", "--video", "x.avi"],
+    ["fish", "swim", "--video", "x.gif", "--camera", "top"],
 ])
 def test_cli_bad_input_exit_2(capsys, argv):
     assert main(argv) == 2
