@@ -1,0 +1,76 @@
+"""Boids presets: the paper's eight two-type patterns (Nakamura 2013 Fig. 4-5) and the homogeneous
+grid of its Fig. 2, as plain JSON in ``controllers/boids/``.
+
+A pattern preset::
+
+    {"format": "lifelike-mj/boids-preset", "version": 1, "name": "4a", "figure": "4a",
+     "description": "...", "W_a": [[0.5, 0.01], [0.01, 0.5]], "W_c": [[0.01, 0.001], [0.001, 0.01]]}
+
+optionally with ``"settings"`` overriding ``r_s``, ``r_a``, ``r_c``, ``w_s``, ``box`` (box units).
+The grid (``fig2_grid.json``) lists the homogeneous ``w_a`` and ``w_c`` values of Fig. 2.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from lifelike_mj.boids.engine import BoidParams
+from lifelike_mj.errors import UserError
+from lifelike_mj.paths import controllers_dir
+
+FORMAT = "lifelike-mj/boids-preset"
+GRID_FORMAT = "lifelike-mj/boids-grid"
+PATTERNS = ("4a", "4b", "4c", "4d", "5a", "5b", "5c", "5d")
+_SETTINGS = ("r_s", "r_a", "r_c", "w_s", "box")
+
+
+def preset_path(name: str) -> Path:
+    return controllers_dir() / "boids" / f"{name}.json"
+
+
+def _read(ref: str | Path) -> tuple[dict, Path]:
+    p = Path(ref)
+    if p.suffix != ".json" and not p.exists():
+        p = preset_path(str(ref))
+        if not p.is_file():
+            raise UserError(f"unknown boids preset {str(ref)!r}; known presets: {', '.join(PATTERNS)} "
+                            f"(or a path to a JSON file).")
+    elif not p.is_file():
+        raise UserError(f"no boids preset file {ref}.")
+    try:
+        return json.loads(p.read_text(encoding="utf-8")), p
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise UserError(f"cannot read boids preset {p}: {e}.") from None
+
+
+def load_preset(ref: str | Path, dims: int = 3) -> BoidParams:
+    """A pattern preset by name (``4a`` ... ``5d``) or path, as :class:`BoidParams` in ``dims`` D."""
+    data, p = _read(ref)
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        raise UserError(f"{p} is not a boids preset (format {FORMAT!r} expected).")
+    if "W_a" not in data or "W_c" not in data:
+        raise UserError(f"boids preset {p} needs both W_a and W_c.")
+    settings = data.get("settings", {}) or {}
+    unknown = sorted(set(settings) - set(_SETTINGS))
+    if unknown:
+        raise UserError(f"boids preset {p} has unknown setting(s): {', '.join(unknown)}.")
+    return BoidParams(wa=data["W_a"], wc=data["W_c"], dims=dims, name=str(data.get("name", p.stem)), **settings)
+
+
+def preset_info(ref: str | Path) -> dict:
+    """The preset file's content (figure, description ...)."""
+    return _read(ref)[0]
+
+
+def load_grid(ref: str | Path = "fig2_grid") -> dict:
+    """The homogeneous grid of Fig. 2: ``{"w_a": [...], "w_c": [...]}``."""
+    data, p = _read(ref)
+    if not isinstance(data, dict) or data.get("format") != GRID_FORMAT:
+        raise UserError(f"{p} is not a boids grid (format {GRID_FORMAT!r} expected).")
+    return {"w_a": [float(x) for x in data["w_a"]], "w_c": [float(x) for x in data["w_c"]], "name": p.stem}
+
+
+def homogeneous(w_a: float, w_c: float, dims: int = 3) -> BoidParams:
+    """One type with alignment weight ``w_a`` and cohesion weight ``w_c`` (section 2)."""
+    return BoidParams(wa=((w_a,),), wc=((w_c,),), dims=dims, name=f"w_a={w_a:g}, w_c={w_c:g}")
