@@ -311,7 +311,113 @@ def cmd_fish_drag_check(args) -> None:
           f"over {r['trials']} random states")
 
 
-REPRODUCIBLE = ("butterfly", "fish")
+def _boids_params(args):
+    from lifelike_mj.boids.engine import parse_matrix
+    from lifelike_mj.boids.presets import load_preset
+
+    if args.dims not in (2, 3):
+        raise UserError(f"--dims must be 3 or 2, got {args.dims}.")
+    if (args.wa is None) != (args.wc is None):
+        raise UserError("give both --wa and --wc (or neither, and a --preset).")
+    if args.wa is not None:
+        from lifelike_mj.boids.engine import BoidParams
+
+        return BoidParams(wa=parse_matrix(args.wa, "--wa"), wc=parse_matrix(args.wc, "--wc"), dims=args.dims,
+                          name="custom")
+    return load_preset("5a" if args.preset in (None, "default") else args.preset, dims=args.dims)
+
+
+def cmd_boids_run(args) -> None:
+    from lifelike_mj.boids.experiments import classified_run, write_trajectories
+
+    params = _boids_params(args)
+    if args.n < 2:
+        raise UserError(f"--n must be at least 2, got {args.n}.")
+    if args.steps is not None and args.steps < 10:
+        raise UserError(f"--steps must be at least 10, got {args.steps}.")
+    run, m, label, reasons = classified_run(params, args.n, args.seed, args.steps, progress=not args.json)
+    out = {"label": label, "reasons": reasons, **m, "preset": params.name, "n": args.n, "seed": args.seed,
+           "steps": int(run.steps[-1]), "dims": params.dims, "wall_time_s": run.wall_time_s}
+    if args.plot:
+        from lifelike_mj.viz.boids_figures import pattern_figure
+
+        pattern_figure(run, args.plot, title=f"{params.name}: classified {label}")
+    if args.out:
+        from lifelike_mj.io import write_json
+
+        files = write_trajectories(run, args.out)
+        write_json(Path(args.out) / "measures.json", out)
+        out["files"] = [str(f) for f in files.values()]
+    _emit(args, out, f"{params.name}, n = {args.n}, seed {args.seed}, {out['steps']} steps: classified {label} "
+          f"(segregation index {m.get('segregation_index', float('nan')):.2f}, groups {m.get('n_groups')})")
+
+
+def cmd_boids_sweep(args) -> None:
+    from lifelike_mj.boids.experiments import Sweep, run_sweep
+    from lifelike_mj.boids.presets import homogeneous, load_grid
+    from lifelike_mj.io import write_json
+
+    seeds = _seeds(args.seeds)
+    if args.grid:
+        g = load_grid(args.grid)
+        sweep = Sweep(homogeneous(1.0, 0.0, dims=args.dims), ("wa", "wc"), args.n, args.steps)
+        values = [g["w_a"], g["w_c"]]
+    else:
+        if not args.x:
+            raise UserError("give --grid fig2_grid, or at least --x AXIS=START:STOP:COUNT.")
+        axes, values = [], []
+        for spec in [args.x] + ([args.y] if args.y else []):
+            name, rng = _axis(spec)
+            axes.append(name)
+            values.append(rng)
+        sweep = Sweep(_boids_params(args), tuple(axes), args.n, args.steps)
+    res = run_sweep(sweep, values, seeds, executor=args.executor, workers=args.workers, ray_address=args.ray_address)
+    if args.out:
+        out = Path(args.out)
+        write_json(out / "sweep.json", res)
+        if len(values) == 2:
+            import numpy as np
+
+            from lifelike_mj.viz.boids_figures import phase_diagram_figure
+
+            labels = np.array([[res["majority"][f"{a:g},{b:g}"] for a in values[0]] for b in values[1]])
+            phase_diagram_figure(labels, values[0], values[1], sweep.axes[0], sweep.axes[1], out / "phase_diagram.png")
+    counts = {}
+    for v in res["majority"].values():
+        counts[v] = counts.get(v, 0) + 1
+    _emit(args, res, f"{len(res['rows'])} runs over {len(res['majority'])} cells: "
+          + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
+
+
+def _seeds(text: str) -> list[int]:
+    try:
+        if "-" in text:
+            a, b = (int(x) for x in text.split("-"))
+            seeds = list(range(a, b + 1))
+        else:
+            seeds = [int(x) for x in text.split(",")]
+    except ValueError:
+        raise UserError(f"--seeds must look like 0-4 or 0,1,2, got {text!r}.") from None
+    if not seeds or min(seeds) < 0:
+        raise UserError(f"--seeds must name non-negative seeds, got {text!r}.")
+    return seeds
+
+
+def _axis(spec: str) -> tuple[str, list[float]]:
+    import numpy as np
+
+    try:
+        name, rng = spec.split("=")
+        a, b, k = rng.split(":")
+        values = [float(x) for x in np.linspace(float(a), float(b), int(k))]
+    except ValueError:
+        raise UserError(f"a sweep axis looks like wa_cross=-0.3:0.5:9 (name=start:stop:count), got {spec!r}.") from None
+    if len(values) < 1:
+        raise UserError(f"a sweep axis needs at least one value, got {spec!r}.")
+    return name, values
+
+
+REPRODUCIBLE = ("butterfly", "fish", "boids")
 
 
 def cmd_reproduce(args) -> None:
@@ -324,6 +430,10 @@ def cmd_reproduce(args) -> None:
             from lifelike_mj.fish.reproduce import reproduce_fish
 
             reproduce_fish(out)
+        elif what == "boids":
+            from lifelike_mj.boids.reproduce import reproduce_boids
+
+            reproduce_boids(out)
         else:
             from lifelike_mj.butterfly.reproduce import reproduce_all
 
@@ -332,8 +442,19 @@ def cmd_reproduce(args) -> None:
 
 
 def cmd_bench(args) -> None:
-    if args.what not in ("butterfly", "fish"):
-        raise UserError(f"no benchmark for {args.what!r} yet; available: butterfly, fish.")
+    if args.what not in ("butterfly", "fish", "boids"):
+        raise UserError(f"no benchmark for {args.what!r} yet; available: butterfly, fish, boids.")
+    if args.what == "boids":
+        from lifelike_mj.boids import bench as boids_bench
+
+        r = boids_bench.run(repeats=min(args.repeats, 3), max_n=args.max_n, mesa_python=args.mesa_python)
+        if args.out:
+            from lifelike_mj.io import write_json
+
+            write_json(args.out, r)
+        _emit(args, r, f"n = 300: {r['agent_steps_per_s_n300']:.3g} agent-steps/s; scaling exponent "
+              f"{r.get('scaling_exponent', float('nan')):.2f}; x{r.get('mesa_ratio', float('nan')):.0f} Mesa")
+        return
     if args.what == "fish":
         from lifelike_mj.fish import bench as fish_bench
 
@@ -362,8 +483,13 @@ def cmd_bench(args) -> None:
 
 
 def cmd_view(args) -> None:
-    if args.what not in ("butterfly", "fish"):
-        raise UserError(f"nothing to view for {args.what!r} yet; available: butterfly, fish.")
+    if args.what not in ("butterfly", "fish", "boids"):
+        raise UserError(f"nothing to view for {args.what!r} yet; available: butterfly, fish, boids.")
+    if args.what == "boids":
+        from lifelike_mj.viz.boids_video import view_boids
+
+        view_boids(_boids_params(args), n=args.n, seed=args.seed)
+        return
     if args.what == "fish":
         from lifelike_mj.viz.fish_video import view_fish
 
@@ -378,10 +504,17 @@ def cmd_view(args) -> None:
 
 
 def cmd_render(args) -> None:
-    if args.what not in ("butterfly", "fish"):
-        raise UserError(f"nothing to render for {args.what!r} yet; available: butterfly, fish.")
+    if args.what not in ("butterfly", "fish", "boids"):
+        raise UserError(f"nothing to render for {args.what!r} yet; available: butterfly, fish, boids.")
     if Path(args.out).suffix.lower() not in (".mp4", ".gif"):
         raise UserError(f"--out must end in .mp4 or .gif, got {args.out!r}.")
+    if args.what == "boids":
+        from lifelike_mj.viz.boids_video import render_boids
+
+        info = render_boids(args.out, _boids_params(args), n=args.n, n_steps=args.steps or 3000, seed=args.seed,
+                            fps=args.fps, width=args.width, height=args.height, camera=args.camera or "overview")
+        _emit(args, info, f"wrote {info['frames']} frames to {args.out}")
+        return
     if args.what == "fish":
         from lifelike_mj.viz.fish_video import render_fish
 
@@ -398,6 +531,15 @@ def cmd_render(args) -> None:
                             duration_s=_positive("--duration", args.duration), fps=args.fps, width=args.width,
                             height=args.height)
     _emit(args, info, f"wrote {info['frames']} frames to {args.out}")
+
+
+def _add_boids(p) -> None:
+    p.add_argument("--preset", default=None, help="pattern preset 4a ... 5d (default 5a), or a JSON file")
+    p.add_argument("--wa", help="alignment matrix 'a,b;c,d' (rows: own type), with --wc instead of a preset")
+    p.add_argument("--wc", help="cohesion matrix 'a,b;c,d'")
+    p.add_argument("--n", type=int, default=300, help="number of agents")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--dims", type=int, default=3, help="3 or 2 (section 4.3)")
 
 
 def _add_fish(p) -> None:
@@ -507,8 +649,31 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_fish_drag_check)
 
+    boids = sub.add_parser("boids", help="the heterogeneous boids of Nakamura 2013").add_subparsers(
+        dest="command", required=True, parser_class=_Parser)
+    p = boids.add_parser("run", help="one run: classified pattern and its measures")
+    _add_boids(p)
+    p.add_argument("--steps", type=int, default=None, help="steps (default: the classifier's run length)")
+    p.add_argument("--json", action="store_true")
+    p.add_argument("--plot", help="PNG of the last 5 steps in the paper's style")
+    p.add_argument("--out", help="folder for trajectories (npz, CSV) and measures")
+    p.set_defaults(func=cmd_boids_run)
+    p = boids.add_parser("sweep", help="a grid of runs, classified: the phase diagram")
+    _add_boids(p)
+    p.add_argument("--grid", help="a homogeneous grid preset (fig2_grid: the paper's Fig. 2)")
+    p.add_argument("--x", help="axis NAME=START:STOP:COUNT: wa_cross, wc_cross, wa_IJ, wc_IJ, wa, wc")
+    p.add_argument("--y", help="second axis, same form")
+    p.add_argument("--seeds", default="0-2", help="seeds, e.g. 0-4 or 0,3,7")
+    p.add_argument("--steps", type=int, default=None)
+    p.add_argument("--executor", default="process", help="serial, process (default) or ray")
+    p.add_argument("--workers", type=int, default=None)
+    p.add_argument("--ray-address", default=None)
+    p.add_argument("--out", help="folder for sweep.json and phase_diagram.png")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_boids_sweep)
+
     p = sub.add_parser("reproduce", help="run a paper's experiments and write a report")
-    p.add_argument("what", help="butterfly, fish, or all")
+    p.add_argument("what", help="butterfly, fish, boids, or all")
     p.add_argument("--out", default=None, help="output folder (default reports/WHAT; with all: OUT/WHAT)")
     _add_physics(p)
     p.set_defaults(func=cmd_reproduce)
@@ -517,6 +682,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("what", help="butterfly or fish")
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--long-minutes", type=float, default=10.0, help="fish: simulated minutes of the no-escape run")
+    p.add_argument("--max-n", type=int, default=1_000_000, help="boids: largest n of the scaling run")
+    p.add_argument("--mesa-python", default=None, help="boids: a Python interpreter that has Mesa (for the peer)")
     p.add_argument("--out", help="also write the JSON here")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_bench)
@@ -528,7 +695,15 @@ def build_parser() -> argparse.ArgumentParser:
         g = p.add_argument_group("fish")
         _add_fish(g)
         if name == "render":
-            g.add_argument("--camera", default=None, help="fish camera: side (default), oblique or follow")
+            g.add_argument("--camera", default=None,
+                           help="fish: side (default), oblique or follow; boids: overview (default), top or side")
+        g = p.add_argument_group("boids")
+        g.add_argument("--wa", help="boids: alignment matrix 'a,b;c,d' (with --wc, instead of a preset)")
+        g.add_argument("--wc", help="boids: cohesion matrix")
+        g.add_argument("--n", type=int, default=300, help="boids: number of agents")
+        g.add_argument("--dims", type=int, default=3, help="boids: 3 or 2")
+        if name == "render":
+            g.add_argument("--steps", type=int, default=None, help="boids: steps to render (default 3000)")
         _add_controller(p, required=False)
         _add_physics(p)
         p.add_argument("--config", default="paper", help="paper or rich")

@@ -89,3 +89,15 @@ def test_bad_counts_and_matrices():
     assert parse_matrix("0.5,0.1;0.2,0.3") == ((0.5, 0.1), (0.2, 0.3))
     with pytest.raises(UserError, match="unknown boids preset"):
         load_preset("6z")
+
+
+def test_numpy_all_pairs_peer_is_the_same_model():
+    """The benchmark's NumPy peer computes the model of eq. 1-9 (to rounding, one step)."""
+    from lifelike_mj.boids.bench import numpy_all_pairs_step
+
+    p = load_preset("4c")
+    x, v, t = initial_state(p, 150, seed=2, margin=0.5)
+    x2, v2 = x.copy(), v.copy()
+    numpy_all_pairs_step(x, v, t, p)
+    step_reference(x2, v2, t, p)
+    assert np.max(np.abs(v - v2)) < 1e-14 and np.max(np.abs(x - x2)) < 1e-13

@@ -181,8 +181,7 @@ def _two_sum(s, c, t):
     return u, c + ((s - (u - b)) + (t - b))
 
 
-@njit(cache=True, parallel=True)
-def _forces(x, v, types, wa, wc, c, planar, dv):
+def _forces_py(x, v, types, wa, wc, c, planar, dv):
     """dv = dt/m (F_s + F_a + F_c) of every agent (eq. 1-9), on parallel threads.
 
     Each force component is a sum over neighbours accumulated in double-double arithmetic and
@@ -279,6 +278,12 @@ def _forces(x, v, types, wa, wc, c, planar, dv):
         dv[i, 2] = dt_m * fz
 
 
+#: Below this many agents one thread is faster (no fork-join per step) and robust to a busy machine.
+PARALLEL_FROM = 2000
+_forces_par = njit(cache=True, parallel=True)(_forces_py)
+_forces_ser = njit(cache=True)(_forces_py)
+
+
 @njit(cache=True)
 def _advance(x, v, dv, c):
     """Semi-implicit update (eq. 1-2) and reflecting walls; an agent is never left outside the box
@@ -302,12 +307,17 @@ def _advance(x, v, dv, c):
 @njit(cache=True)
 def _run(x, v, types, wa, wc, c, planar, n_steps, record_every, out_x, out_v, vmax):
     """``n_steps`` steps; records every ``record_every`` steps into ``out_x``/``out_v``; returns the
-    first step (1-based) at which a speed exceeded ``vmax`` or became NaN, else 0."""
+    first step (1-based) at which a speed exceeded ``vmax`` or became NaN, else 0. The forces run on
+    all threads from :data:`PARALLEL_FROM` agents on (same result: sums do not depend on order)."""
     n = x.shape[0]
     dv = np.empty((n, 3))
     r = 0
+    par = n >= PARALLEL_FROM
     for k in range(n_steps):
-        _forces(x, v, types, wa, wc, c, planar, dv)
+        if par:
+            _forces_par(x, v, types, wa, wc, c, planar, dv)
+        else:
+            _forces_ser(x, v, types, wa, wc, c, planar, dv)
         _advance(x, v, dv, c)
         for i in range(n):
             s = v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1] + v[i, 2] * v[i, 2]

@@ -23,12 +23,20 @@ from lifelike_mj.evolve.problem import check_problem
 EXECUTORS = ("serial", "process", "ray")
 
 
-def as_fitness(values: Any, n: int) -> np.ndarray:
-    """``values`` as an ``(n,)`` float64 array; ``ValueError`` if the problem returned a different number of values."""
+def as_fitness(values: Any, n: int, outputs: int = 1) -> np.ndarray:
+    """``values`` as an ``(n,)`` float64 array, or ``(n, outputs)`` for a problem with several outputs
+    per row (``problem.n_outputs``, e.g. a parameter sweep); ``ValueError`` if the problem returned a
+    different number of values."""
     f = np.asarray(values, dtype=np.float64)
-    if f.size != n:
-        raise ValueError(f"problem.evaluate returned shape {f.shape} for {n} candidates; expected ({n},)")
-    return f.reshape(n)
+    if f.size != n * outputs:
+        want = f"({n},)" if outputs == 1 else f"({n}, {outputs})"
+        raise ValueError(f"problem.evaluate returned shape {f.shape} for {n} candidates; expected {want}")
+    return f.reshape(n) if outputs == 1 else f.reshape(n, outputs)
+
+
+def n_outputs(problem: Any) -> int:
+    """Values per row that ``problem.evaluate`` returns: its ``n_outputs`` attribute, else 1 (a fitness)."""
+    return int(getattr(problem, "n_outputs", 1))
 
 
 def _limit_threads() -> None:
@@ -42,7 +50,8 @@ def _limit_threads() -> None:
 
 
 class Evaluator:
-    """Base of all evaluators: a context manager whose call maps ``X (n, dim)`` to fitness ``(n,)``.
+    """Base of all evaluators: a context manager whose call maps ``X (n, dim)`` to fitness ``(n,)``
+    (or to ``(n, problem.n_outputs)`` values for a problem with several outputs per row).
 
     Counters: ``calls`` (batches evaluated), ``evaluations`` (rows evaluated), ``busy_s`` (wall seconds
     spent inside calls).
@@ -77,7 +86,7 @@ class Evaluator:
             self.busy_s += time.perf_counter() - t0
         self.calls += 1
         self.evaluations += n
-        return as_fitness(f, n)
+        return as_fitness(f, n, n_outputs(self.problem))
 
     def _chunks(self, X: np.ndarray) -> list[np.ndarray]:
         """Split ``X`` into ``min(workers, n)`` contiguous chunks of near-equal size."""
@@ -123,7 +132,7 @@ def _process_init(problem: Any) -> None:
 
 
 def _process_chunk(X: np.ndarray) -> np.ndarray:
-    return as_fitness(_WORKER_PROBLEM.evaluate(X), X.shape[0])
+    return as_fitness(_WORKER_PROBLEM.evaluate(X), X.shape[0], n_outputs(_WORKER_PROBLEM))
 
 
 class ProcessEvaluator(Evaluator):
@@ -178,7 +187,7 @@ def _ray_chunk(problem: Any, X: np.ndarray) -> np.ndarray:
     if not _RAY_THREADS_LIMITED:
         _limit_threads()
         _RAY_THREADS_LIMITED = True
-    return as_fitness(problem.evaluate(X), X.shape[0])
+    return as_fitness(problem.evaluate(X), X.shape[0], n_outputs(problem))
 
 
 class RayEvaluator(Evaluator):

@@ -1,0 +1,183 @@
+"""Boids experiments: one classified run, trajectories on disk, and parameter sweeps on the project's
+evaluator (serial, process pool or Ray: ``lifelike_mj.evolve.make_evaluator``).
+
+A sweep is a :class:`Sweep`: a picklable problem whose rows are ``(value_1, ..., value_m, seed)``
+and whose ``evaluate`` runs each row and returns :data:`OUTPUTS` (the pattern label's code and the
+measures that decide it), so the same seed gives the same table on every executor.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import json
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from lifelike_mj.boids.engine import N_AGENTS, BoidParams, BoidRun, simulate
+from lifelike_mj.boids.presets import PATTERNS
+from lifelike_mj.errors import UserError
+from lifelike_mj.io import atomic_path
+
+#: Labels a run can get: the eight patterns, ``other``, and ``diverged``.
+LABELS = (*PATTERNS, "other", "diverged")
+#: What a sweep row returns, in this order.
+OUTPUTS = ("label", "segregation_index", "centroid_distance", "radius_ratio", "radial_sorting_error",
+           "plane_split", "n_groups", "polarisation", "mean_speed")
+
+
+def run_settings() -> dict:
+    """Run length, measuring window and recording interval of a classified run (boids/metrics.py)."""
+    from lifelike_mj.boids import metrics
+
+    return {"n_steps": metrics.RUN_STEPS, "window": metrics.WINDOW_STEPS, "record_every": metrics.RECORD_EVERY}
+
+
+def classified_run(params: BoidParams, n: int = N_AGENTS, seed: int = 0, n_steps: int | None = None,
+                   trail_steps: int = 5, progress: bool = False) -> tuple[BoidRun, dict, str, object]:
+    """Run, measure over the late window and classify. The run records every ``record_every`` steps
+    over the window and every step over the last ``trail_steps`` (for the paper-style figure).
+    Returns ``(run, measures, label, reasons)``."""
+    from lifelike_mj.boids import metrics
+
+    s = run_settings()
+    steps = int(n_steps or s["n_steps"])
+    window = min(s["window"], steps)
+    run = simulate(params, n, steps, seed, record_every=1, record_from=steps - window, progress=progress)
+    keep = (run.steps % s["record_every"] == 0) | (run.steps >= steps - trail_steps)
+    run = replace(run, steps=run.steps[keep], positions=run.positions[keep], velocities=run.velocities[keep])
+    m = metrics.measures(run, window=window)
+    label, reasons = metrics.classify(m)
+    return run, m, label, reasons
+
+
+def write_trajectories(run: BoidRun, out_dir: str | Path) -> dict[str, Path]:
+    """``trajectories.npz`` (steps, positions, velocities, types) and a tidy ``trajectories.csv``
+    (step, agent, type, x, y, z, vx, vy, vz; z and vz are 0 in 2D), written atomically."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    npz, path = out / "trajectories.npz", out / "trajectories.csv"
+    with atomic_path(npz) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, steps=run.steps, positions=run.positions, velocities=run.velocities,
+                                types=run.types, seed=run.seed, box=run.params.box)
+    T, n, D = run.positions.shape
+    with atomic_path(path) as tmp:
+        with open(tmp, "w", newline="", encoding="utf-8") as fh:
+            w = csv.writer(fh)
+            w.writerow(["step", "agent", "type", "x", "y", "z", "vx", "vy", "vz"])
+            for k in range(T):
+                for i in range(n):
+                    p = list(run.positions[k, i]) + [0.0] * (3 - D)
+                    v = list(run.velocities[k, i]) + [0.0] * (3 - D)
+                    w.writerow([int(run.steps[k]), i, int(run.types[i])] + [f"{a:.6f}" for a in p + v])
+    return {"npz": npz, "csv": path}
+
+
+# ---- sweeps ------------------------------------------------------------------------------------------
+
+_AXES_HELP = ("wa_cross / wc_cross (both off-diagonal entries, symmetric), wa_IJ / wc_IJ (one entry, e.g. wa_01), "
+              "wa / wc (every entry: a homogeneous weight)")
+
+
+def apply_axis(params: BoidParams, axis: str, value: float) -> BoidParams:
+    """``params`` with one swept quantity set (see :data:`_AXES_HELP`)."""
+    if axis not in ("wa", "wc", "wa_cross", "wc_cross") and not (
+            len(axis) == 5 and axis[:3] in ("wa_", "wc_") and axis[3:].isdigit()):
+        raise UserError(f"unknown sweep axis {axis!r}; use {_AXES_HELP}.")
+    key = axis[:2]
+    m = np.array(getattr(params, key), dtype=float)
+    k = m.shape[0]
+    if axis in ("wa", "wc"):
+        m[:] = value
+    elif axis.endswith("cross"):
+        if k != 2:
+            raise UserError(f"{axis} needs two types, the matrix has {k}.")
+        m[0, 1] = m[1, 0] = value
+    else:
+        i, j = int(axis[3]), int(axis[4])
+        if i >= k or j >= k:
+            raise UserError(f"{axis} is outside the {k}x{k} matrix.")
+        m[i, j] = value
+    return replace(params, **{key: tuple(map(tuple, m.tolist()))})
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """A grid of runs as an ``evolve`` problem with several outputs per row (rows: axis values, then
+    the seed). ``evaluate`` is pure and deterministic, so serial, process and Ray runs agree."""
+
+    base: BoidParams
+    axes: tuple[str, ...]
+    n: int = N_AGENTS
+    n_steps: int | None = None
+
+    @property
+    def dim(self) -> int:
+        return len(self.axes) + 1
+
+    @property
+    def lower(self) -> np.ndarray:
+        return np.full(self.dim, -np.inf)
+
+    @property
+    def upper(self) -> np.ndarray:
+        return np.full(self.dim, np.inf)
+
+    maximize = True
+    n_outputs = len(OUTPUTS)
+
+    def fingerprint(self) -> str:
+        text = json.dumps({"base": repr(self.base), "axes": self.axes, "n": self.n, "steps": self.n_steps})
+        return "boids-sweep:" + hashlib.sha256(text.encode()).hexdigest()[:16]
+
+    def params_of(self, row) -> BoidParams:
+        p = self.base
+        for axis, value in zip(self.axes, row[:-1]):
+            p = apply_axis(p, axis, float(value))
+        return p
+
+    def evaluate(self, X: np.ndarray) -> np.ndarray:
+        out = np.full((len(X), len(OUTPUTS)), np.nan)
+        for r, row in enumerate(np.atleast_2d(X)):
+            try:
+                _, m, label, _ = classified_run(self.params_of(row), self.n, int(row[-1]), self.n_steps)
+            except UserError as exc:
+                if "diverged" not in str(exc):
+                    raise
+                out[r, 0] = LABELS.index("diverged")
+                continue
+            out[r, 0] = LABELS.index(label)
+            for c, key in enumerate(OUTPUTS[1:], start=1):
+                val = m.get(key, np.nan)
+                out[r, c] = float(val) if isinstance(val, (int, float)) else np.nan
+        return out
+
+
+def run_sweep(sweep: Sweep, values: list[list[float]], seeds, executor: str = "process", workers: int | None = None,
+              ray_address: str | None = None) -> dict:
+    """Evaluate every combination of ``values`` (one list per axis) and ``seeds``; returns the rows
+    (one per combination and seed) and, per grid cell, the most frequent label."""
+    import itertools
+
+    from lifelike_mj.evolve import make_evaluator
+
+    grid = list(itertools.product(*values))
+    rows = np.array([[*g, s] for g in grid for s in seeds], dtype=float)
+    with make_evaluator(sweep, executor=executor, workers=workers, ray_address=ray_address) as ev:
+        res = ev(rows)
+    table = []
+    for row, r in zip(rows, res):
+        d = {a: float(v) for a, v in zip(sweep.axes, row[:-1])}
+        d["seed"] = int(row[-1])
+        d["label"] = LABELS[int(r[0])]
+        d.update({k: (None if np.isnan(x) else float(x)) for k, x in zip(OUTPUTS[1:], r[1:])})
+        table.append(d)
+    cells = {}
+    for g in grid:
+        labs = [t["label"] for t in table if tuple(t[a] for a in sweep.axes) == tuple(float(x) for x in g)]
+        cells[g] = max(set(labs), key=lambda lab: (labs.count(lab), -LABELS.index(lab)))
+    return {"axes": list(sweep.axes), "values": [list(map(float, v)) for v in values], "seeds": list(seeds),
+            "rows": table, "majority": {",".join(f"{x:g}" for x in g): lab for g, lab in cells.items()}}

@@ -1,0 +1,136 @@
+"""``lifelike-mj reproduce boids``: Nakamura 2013's findings with objective measures.
+
+Writes into the output folder ``report.md``, ``results.json`` and the figures: Fig. 2 (the
+homogeneous grid, with the divergence checks of section 2.2), Fig. 4-5 (the eight patterns), the
+confusion table of the classifier over seeds, the robustness of the robust patterns to small changes
+of their matrices, and a phase diagram over the cross-type weights (the map the paper sketched).
+Runs go through the project's evaluator (``executor``: serial, process or ray).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from lifelike_mj.boids.engine import N_AGENTS
+from lifelike_mj.boids.experiments import LABELS, Sweep, classified_run, run_settings, run_sweep
+from lifelike_mj.boids.presets import PATTERNS, homogeneous, load_grid, load_preset
+from lifelike_mj.errors import UserError
+from lifelike_mj.io import write_json, write_text
+
+SEEDS = (0, 1, 2, 3, 4)
+ROBUST = ("4a", "4b", "4c", "5a", "5c", "5d")
+#: Small changes of a matrix: every nonzero entry of W_a (then of W_c) times these factors.
+PERTURBATIONS = (0.8, 1.2)
+
+
+def _perturbed(name: str, which: str, factor: float):
+    p = load_preset(name)
+    m = np.array(getattr(p, which)) * factor
+    return replace(p, **{which: tuple(map(tuple, m.tolist()))}, name=f"{name} {which}x{factor:g}")
+
+
+def _runs(params_list, seeds, executor, workers):
+    """Label of each (params, seed) through one Sweep per parameter set (no swept axis)."""
+    out = []
+    for p in params_list:
+        res = run_sweep(Sweep(p, ()), [], seeds, executor=executor, workers=workers)
+        out.append([r["label"] for r in res["rows"]])
+    return out
+
+
+def reproduce_boids(out: str | Path, seeds=SEEDS, executor: str = "process", workers: int | None = None,
+                    phase_steps: int = 7) -> dict:
+    from lifelike_mj.viz.boids_figures import homogeneous_grid_figure, patterns_grid_figure, phase_diagram_figure
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    settings = run_settings()
+    results: dict = {"settings": settings, "seeds": list(seeds)}
+
+    # Fig. 4-5: one classified run per pattern (seed 0), drawn in the paper's style
+    runs = {}
+    for name in PATTERNS:
+        run, m, label, _ = classified_run(load_preset(name), N_AGENTS, 0)
+        runs[f"{name} (classified {label})"] = run
+    patterns_grid_figure(runs, out / "fig4_5_patterns.png")
+
+    # confusion table over seeds
+    labels = _runs([load_preset(n) for n in PATTERNS], seeds, executor, workers)
+    confusion = {name: {lab: labs.count(lab) for lab in LABELS if labs.count(lab)} for name, labs in zip(PATTERNS, labels)}
+    results["confusion"] = confusion
+
+    # robustness of the robust patterns
+    pert = [(name, which, f) for name in ROBUST for which in ("wa", "wc") for f in PERTURBATIONS]
+    plabels = _runs([_perturbed(*x) for x in pert], seeds[:2], executor, workers)
+    results["perturbations"] = [{"preset": n, "matrix": w, "factor": f, "labels": labs}
+                                for (n, w, f), labs in zip(pert, plabels)]
+
+    # Fig. 2: the homogeneous grid, and divergence
+    g = load_grid()
+    grid_runs = {}
+    for wa in g["w_a"]:
+        for wc in g["w_c"]:
+            try:
+                run, m, _, _ = classified_run(homogeneous(wa, wc), N_AGENTS, 0)
+                grid_runs[(wa, wc)] = run
+            except UserError:
+                grid_runs[(wa, wc)] = None
+    homogeneous_grid_figure(grid_runs, out / "fig2_homogeneous.png")
+    from lifelike_mj.boids import metrics
+
+    hom = []
+    for (wa, wc), run in grid_runs.items():
+        if run is None:
+            hom.append({"w_a": wa, "w_c": wc, "diverged": True})
+            continue
+        m = metrics.measures(run, window=settings["window"])
+        hom.append({"w_a": wa, "w_c": wc, "diverged": False, **{k: m.get(k) for k in (
+            "polarisation", "mean_speed", "n_groups", "radius_of_gyration") if k in m}})
+    results["homogeneous"] = hom
+    div = []
+    for wa, wc in ((10.0, 0.01), (0.1, 1.0), (1.0, 1.0), (0.001, 1.0)):
+        try:
+            classified_run(homogeneous(wa, wc), N_AGENTS, 0)
+            div.append({"w_a": wa, "w_c": wc, "diverged": False})
+        except UserError as exc:
+            div.append({"w_a": wa, "w_c": wc, "diverged": True, "message": str(exc)})
+    results["divergence"] = div
+
+    # phase diagram over the cross-type weights, diagonal of 5a (W_a = 0.5, W_c = 0.01)
+    xa = [float(x) for x in np.linspace(-0.3, 0.5, phase_steps)]
+    yc = [float(x) for x in np.linspace(-0.01, 0.01, phase_steps)]
+    ph = run_sweep(Sweep(load_preset("5a"), ("wa_cross", "wc_cross")), [xa, yc], [0], executor=executor, workers=workers)
+    lab = np.array([[ph["majority"][f"{a:g},{b:g}"] for a in xa] for b in yc])
+    phase_diagram_figure(lab, xa, yc, "cross-type alignment w_aAB = w_aBA", "cross-type cohesion w_cAB = w_cBA",
+                         out / "phase_diagram.png")
+    results["phase_diagram"] = ph
+
+    # report
+    L = ["# Heterogeneous boids (Nakamura 2013): reproduction report", "",
+         f"n = {N_AGENTS}, box 20, R_s = 1, R_a = 2.5, R_c = 4.5, w_s = 0.05, dt = 1; runs of "
+         f"{settings['n_steps']} steps, measures averaged over the last {settings['window']} steps.", "",
+         "## Fig. 4-5: the eight patterns (seed 0)", "", "![patterns](fig4_5_patterns.png)", "",
+         f"## Confusion table (seeds {', '.join(map(str, seeds))})", "",
+         "| preset | " + " | ".join(LABELS) + " | own label |", "|---" * (len(LABELS) + 2) + "|"]
+    for name in PATTERNS:
+        c = confusion[name]
+        L.append(f"| {name} | " + " | ".join(str(c.get(lab, 0)) for lab in LABELS) + f" | {c.get(name, 0)}/{len(seeds)} |")
+    L += ["", "## Robust patterns under small changes of their matrices (seeds 0, 1)", "",
+          "| preset | matrix | factor | labels |", "|---|---|---|---|"]
+    for r in results["perturbations"]:
+        L.append(f"| {r['preset']} | {r['matrix']} | {r['factor']:g} | {', '.join(r['labels'])} |")
+    L += ["", "## Fig. 2: homogeneous boids", "", "![Fig. 2](fig2_homogeneous.png)", "",
+          "| w_a | w_c | diverged | polarisation | mean speed | groups |", "|---|---|---|---|---|---|"]
+    for h in hom:
+        L.append(f"| {h['w_a']:g} | {h['w_c']:g} | {h['diverged']} | {h.get('polarisation', '')} | "
+                 f"{h.get('mean_speed', '')} | {h.get('n_groups', '')} |")
+    L += ["", "Divergence (section 2.2):", ""]
+    for d in div:
+        L.append(f"* w_a = {d['w_a']:g}, w_c = {d['w_c']:g}: {'diverged: ' + d['message'] if d['diverged'] else 'no'}")
+    L += ["", "## Phase diagram over the cross-type weights (diagonal of 5a)", "", "![phase](phase_diagram.png)", ""]
+    write_text(out / "report.md", "\n".join(L))
+    write_json(out / "results.json", results)
+    return results
