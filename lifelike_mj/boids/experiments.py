@@ -24,8 +24,8 @@ from lifelike_mj.io import atomic_path
 #: Labels a run can get: the eight patterns, ``other``, and ``diverged``.
 LABELS = (*PATTERNS, "other", "diverged")
 #: What a sweep row returns, in this order.
-OUTPUTS = ("label", "segregation_index", "centroid_distance", "radius_ratio", "radial_sorting_error",
-           "plane_split", "n_groups", "polarisation", "mean_speed")
+OUTPUTS = ("label", "paper_picture", "segregation_index", "centroid_distance", "radius_ratio",
+           "radial_sorting_error", "plane_split", "n_groups", "polarisation", "speed")
 
 
 def run_settings() -> dict:
@@ -143,14 +143,15 @@ class Sweep:
         out = np.full((len(X), len(OUTPUTS)), np.nan)
         for r, row in enumerate(np.atleast_2d(X)):
             try:
-                _, m, label, _ = classified_run(self.params_of(row), self.n, int(row[-1]), self.n_steps)
+                _, m, label, reasons = classified_run(self.params_of(row), self.n, int(row[-1]), self.n_steps)
             except UserError as exc:
                 if "diverged" not in str(exc):
                     raise
                 out[r, 0] = LABELS.index("diverged")
                 continue
             out[r, 0] = LABELS.index(label)
-            for c, key in enumerate(OUTPUTS[1:], start=1):
+            out[r, 1] = 1.0 if reasons.get("paper_picture") else 0.0
+            for c, key in enumerate(OUTPUTS[2:], start=2):
                 val = m.get(key, np.nan)
                 out[r, c] = float(val) if isinstance(val, (int, float)) else np.nan
         return out
@@ -173,7 +174,8 @@ def run_sweep(sweep: Sweep, values: list[list[float]], seeds, executor: str = "p
         d = {a: float(v) for a, v in zip(sweep.axes, row[:-1])}
         d["seed"] = int(row[-1])
         d["label"] = LABELS[int(r[0])]
-        d.update({k: (None if np.isnan(x) else float(x)) for k, x in zip(OUTPUTS[1:], r[1:])})
+        d["paper_picture"] = bool(r[1] == 1.0)
+        d.update({k: (None if np.isnan(x) else float(x)) for k, x in zip(OUTPUTS[2:], r[2:])})
         table.append(d)
     cells = {}
     for g in grid:

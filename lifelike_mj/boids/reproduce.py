@@ -33,12 +33,8 @@ def _perturbed(name: str, which: str, factor: float):
 
 
 def _runs(params_list, seeds, executor, workers):
-    """Label of each (params, seed) through one Sweep per parameter set (no swept axis)."""
-    out = []
-    for p in params_list:
-        res = run_sweep(Sweep(p, ()), [], seeds, executor=executor, workers=workers)
-        out.append([r["label"] for r in res["rows"]])
-    return out
+    """Rows (label, paper_picture, measures) of each (params, seed), one Sweep per parameter set."""
+    return [run_sweep(Sweep(p, ()), [], seeds, executor=executor, workers=workers)["rows"] for p in params_list]
 
 
 def reproduce_boids(out: str | Path, seeds=SEEDS, executor: str = "process", workers: int | None = None,
@@ -58,15 +54,20 @@ def reproduce_boids(out: str | Path, seeds=SEEDS, executor: str = "process", wor
     patterns_grid_figure(runs, out / "fig4_5_patterns.png")
 
     # confusion table over seeds
-    labels = _runs([load_preset(n) for n in PATTERNS], seeds, executor, workers)
-    confusion = {name: {lab: labs.count(lab) for lab in LABELS if labs.count(lab)} for name, labs in zip(PATTERNS, labels)}
+    rows = _runs([load_preset(n) for n in PATTERNS], seeds, executor, workers)
+    confusion, pictures = {}, {}
+    for name, rr in zip(PATTERNS, rows):
+        labs = [r["label"] for r in rr]
+        confusion[name] = {lab: labs.count(lab) for lab in LABELS if labs.count(lab)}
+        pictures[name] = sum(1 for r in rr if r["label"] == name and r["paper_picture"])
     results["confusion"] = confusion
+    results["confusion_rows"] = dict(zip(PATTERNS, rows))
 
     # robustness of the robust patterns
     pert = [(name, which, f) for name in ROBUST for which in ("wa", "wc") for f in PERTURBATIONS]
-    plabels = _runs([_perturbed(*x) for x in pert], seeds[:2], executor, workers)
-    results["perturbations"] = [{"preset": n, "matrix": w, "factor": f, "labels": labs}
-                                for (n, w, f), labs in zip(pert, plabels)]
+    prows = _runs([_perturbed(*x) for x in pert], seeds[:2], executor, workers)
+    results["perturbations"] = [{"preset": n, "matrix": w, "factor": f, "labels": [r["label"] for r in rr]}
+                                for (n, w, f), rr in zip(pert, prows)]
 
     # Fig. 2: the homogeneous grid, and divergence
     g = load_grid()
@@ -88,7 +89,7 @@ def reproduce_boids(out: str | Path, seeds=SEEDS, executor: str = "process", wor
             continue
         m = metrics.measures(run, window=settings["window"])
         hom.append({"w_a": wa, "w_c": wc, "diverged": False, **{k: m.get(k) for k in (
-            "polarisation", "mean_speed", "n_groups", "radius_of_gyration") if k in m}})
+            "polarisation", "speed", "n_groups", "nn_distance", "radius_of_gyration") if k in m}})
     results["homogeneous"] = hom
     div = []
     for wa, wc in ((10.0, 0.01), (0.1, 1.0), (1.0, 1.0), (0.001, 1.0)):
@@ -114,19 +115,26 @@ def reproduce_boids(out: str | Path, seeds=SEEDS, executor: str = "process", wor
          f"{settings['n_steps']} steps, measures averaged over the last {settings['window']} steps.", "",
          "## Fig. 4-5: the eight patterns (seed 0)", "", "![patterns](fig4_5_patterns.png)", "",
          f"## Confusion table (seeds {', '.join(map(str, seeds))})", "",
-         "| preset | " + " | ".join(LABELS) + " | own label |", "|---" * (len(LABELS) + 2) + "|"]
+         "| preset | " + " | ".join(LABELS) + " | own label | own label, paper's picture |",
+         "|---" * (len(LABELS) + 3) + "|"]
     for name in PATTERNS:
         c = confusion[name]
-        L.append(f"| {name} | " + " | ".join(str(c.get(lab, 0)) for lab in LABELS) + f" | {c.get(name, 0)}/{len(seeds)} |")
+        L.append(f"| {name} | " + " | ".join(str(c.get(lab, 0)) for lab in LABELS)
+                 + f" | {c.get(name, 0)}/{len(seeds)} | {pictures[name]}/{len(seeds)} |")
     L += ["", "## Robust patterns under small changes of their matrices (seeds 0, 1)", "",
           "| preset | matrix | factor | labels |", "|---|---|---|---|"]
     for r in results["perturbations"]:
         L.append(f"| {r['preset']} | {r['matrix']} | {r['factor']:g} | {', '.join(r['labels'])} |")
     L += ["", "## Fig. 2: homogeneous boids", "", "![Fig. 2](fig2_homogeneous.png)", "",
-          "| w_a | w_c | diverged | polarisation | mean speed | groups |", "|---|---|---|---|---|---|"]
+          "| w_a | w_c | diverged | polarisation | mean speed | groups | nearest-neighbour distance |",
+          "|---|---|---|---|---|---|---|"]
+
+    def f3(x):
+        return "" if x is None else f"{x:.3g}"
+
     for h in hom:
-        L.append(f"| {h['w_a']:g} | {h['w_c']:g} | {h['diverged']} | {h.get('polarisation', '')} | "
-                 f"{h.get('mean_speed', '')} | {h.get('n_groups', '')} |")
+        L.append(f"| {h['w_a']:g} | {h['w_c']:g} | {h['diverged']} | {f3(h.get('polarisation'))} | "
+                 f"{f3(h.get('speed'))} | {h.get('n_groups', '')} | {f3(h.get('nn_distance'))} |")
     L += ["", "Divergence (section 2.2):", ""]
     for d in div:
         L.append(f"* w_a = {d['w_a']:g}, w_c = {d['w_c']:g}: {'diverged: ' + d['message'] if d['diverged'] else 'no'}")
