@@ -154,15 +154,11 @@ def cmd_fly(args) -> None:
     if traj.diverged_step >= 0:
         raise UserError(f"the flight diverged (runaway speed) at step {traj.diverged_step}.")
     if args.out:
-        from lifelike_mj.io import atomic_path, write_json, write_text
+        from lifelike_mj.io import write_json, write_npz, write_text
         from lifelike_mj.viz.flight import fig_flight
 
         out = Path(args.out)
-        import numpy as np
-
-        with atomic_path(out / "trajectory.npz") as tmp:
-            with open(tmp, "wb") as fh:
-                np.savez_compressed(fh, **traj.to_npz_dict())
+        write_npz(out / "trajectory.npz", **traj.to_npz_dict())
         write_text(out / "trajectory.csv", traj.to_csv())
         fig_flight(traj, out / "flight.png", f"{summary['controller']} on the {args.backend} backend")
         write_json(out / "summary.json", summary)

@@ -19,7 +19,7 @@ import numpy as np
 from lifelike_mj.boids.engine import N_AGENTS, BoidParams, BoidRun, simulate
 from lifelike_mj.boids.presets import PATTERNS
 from lifelike_mj.errors import UserError
-from lifelike_mj.io import atomic_path
+from lifelike_mj.io import atomic_path, write_npz
 
 #: Labels a run can get: the eight patterns, ``other``, and ``diverged``.
 LABELS = (*PATTERNS, "other", "diverged")
@@ -59,10 +59,8 @@ def write_trajectories(run: BoidRun, out_dir: str | Path) -> dict[str, Path]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     npz, path = out / "trajectories.npz", out / "trajectories.csv"
-    with atomic_path(npz) as tmp:
-        with open(tmp, "wb") as fh:
-            np.savez_compressed(fh, steps=run.steps, positions=run.positions, velocities=run.velocities,
-                                types=run.types, seed=run.seed, box=run.params.box)
+    write_npz(npz, steps=run.steps, positions=run.positions, velocities=run.velocities, types=run.types,
+              seed=run.seed, box=run.params.box)
     T, n, D = run.positions.shape
     with atomic_path(path) as tmp:
         with open(tmp, "w", newline="", encoding="utf-8") as fh:

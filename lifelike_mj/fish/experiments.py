@@ -40,7 +40,7 @@ from lifelike_mj.fish.sim import (
     SwimResult,
     swim,
 )
-from lifelike_mj.io import atomic_path
+from lifelike_mj.io import atomic_path, write_npz
 from lifelike_mj.paths import models_dir
 from lifelike_mj.physics.callbacks import passive_callback
 
@@ -78,11 +78,9 @@ def write_tracks(result: SwimResult, out_dir: str | Path) -> dict[str, Path]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     npz, csv_path = out / "tracks.npz", out / "tracks.csv"
-    with atomic_path(npz) as tmp:
-        with open(tmp, "wb") as fh:
-            np.savez_compressed(fh, times_s=result.times_s, positions=result.positions, quats=result.quats,
-                                mu=(result.mu % 4).astype(np.int8), avoiding=result.mu >= 4,
-                                tank_m=np.array(result.tank_m), seed=result.seed)
+    write_npz(npz, times_s=result.times_s, positions=result.positions, quats=result.quats,
+              mu=(result.mu % 4).astype(np.int8), avoiding=result.mu >= 4, tank_m=np.array(result.tank_m),
+              seed=result.seed)
     T, F = result.mu.shape
     with atomic_path(csv_path) as tmp:
         with open(tmp, "w", newline="", encoding="utf-8") as fh:
