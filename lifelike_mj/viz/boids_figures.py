@@ -31,20 +31,19 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch, Rectangle
 
 from lifelike_mj.errors import UserError
-from lifelike_mj.io import atomic_path
+from lifelike_mj.viz.figures import _new_figure as _figure
+from lifelike_mj.viz.figures import _png_path, _save
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
 
     from lifelike_mj.boids.engine import BoidRun
 
-DPI = 120
 #: Steps of motion in a trail (the paper's figures: 5 steps).
 TRAIL_STEPS = 5
 #: Colours of the types: A red, B yellow-green (the paper's), then more (as the 3D scene's).
@@ -78,23 +77,9 @@ def type_colour(k: int) -> str:
 
 
 def _new_figure(width_in: float, height_in: float) -> Figure:
-    fig = Figure(figsize=(width_in, height_in), layout="constrained")
+    fig = _figure(width_in, height_in)
     fig.get_layout_engine().set(w_pad=0.06, h_pad=0.08)  # inches: keep titles clear of the edge
-    FigureCanvasAgg(fig)
     return fig
-
-
-def _png_path(path: str | os.PathLike, what: str) -> Path:
-    p = Path(path)
-    if p.suffix.lower() != ".png":
-        raise UserError(f"cannot write {p.name}: the {what} is a .png file.")
-    return p
-
-
-def _save(fig: Figure, path: Path) -> Path:
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=DPI)
-    return path
 
 
 def _plane(run: BoidRun, plane: str) -> tuple[int, int, int | None, float]:

@@ -18,6 +18,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from lifelike_mj.butterfly.params import ButterflyParams
+from lifelike_mj.errors import UserError
 from lifelike_mj.io import atomic_path
 
 DPI = 120
@@ -29,6 +30,14 @@ def _new_figure(width_in: float, height_in: float) -> Figure:
     fig = Figure(figsize=(width_in, height_in), layout="constrained")
     FigureCanvasAgg(fig)
     return fig
+
+
+def _png_path(path: str | os.PathLike, what: str) -> Path:
+    """``path`` as a Path; a :class:`UserError` unless it names a ``.png`` file."""
+    p = Path(path)
+    if p.suffix.lower() != ".png":
+        raise UserError(f"cannot write {p.name}: the {what} is a .png file.")
+    return p
 
 
 def _save(fig: Figure, path: str | os.PathLike) -> Path:

@@ -21,17 +21,15 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import atomic_path
+from lifelike_mj.viz.figures import _new_figure, _png_path, _save
 
 if TYPE_CHECKING:  # pragma: no cover
     from lifelike_mj.fish.params import FishParams
     from lifelike_mj.fish.sim import SwimResult
 
-DPI = 120
 #: The paper's four motion patterns (Satoi 2015 section 5.1.1), in the order of its figures.
 PATTERN_ORDER = ("NB-ND", "NB-D", "B-ND", "B-D")
 _PATTERN_COLOURS = {"NB-ND": "tab:gray", "NB-D": "tab:green", "B-ND": "tab:orange", "B-D": "tab:blue"}
@@ -42,26 +40,6 @@ PATTERN_MEASURES = (
     ("accel_kurtosis", "excess kurtosis of the side-view\nacceleration (24 fps)", "expected: B-* above NB-*"),
     ("turn_entropy", "entropy of turning angles\nover 0.25 s (bits)", "expected: *-D above *-ND"),
 )
-
-
-def _new_figure(width_in: float, height_in: float) -> Figure:
-    fig = Figure(figsize=(width_in, height_in), layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
-
-
-def _png_path(path: str | os.PathLike, what: str) -> Path:
-    p = Path(path)
-    if p.suffix.lower() != ".png":
-        raise UserError(f"cannot write {p.name}: the {what} is a .png file.")
-    return p
-
-
-def _save(fig: Figure, path: Path) -> Path:
-    """Write ``fig`` as a PNG to ``path`` atomically; return the path."""
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=DPI)
-    return path
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
