@@ -35,7 +35,7 @@ import numpy as np
 
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import atomic_path
-from lifelike_mj.viz.video import _WRITERS, _check_size, _Offscreen, _video_target
+from lifelike_mj.viz.video import _check_size, _Offscreen, _positive, _video_target, _write_frames
 from lifelike_mj.viz.viewer import FRAME_S, MAX_CATCH_UP_S, has_display
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -49,12 +49,6 @@ DEFAULT_STEPS_PER_FRAME = 5
 DEFAULT_STEPS = 3000
 #: Engine steps per wall-clock second in the viewer by default (5 per refresh at 30 Hz).
 VIEW_STEPS_PER_S = 150.0
-
-
-def _positive(name: str, v: Any) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not (math.isfinite(v) and v > 0):
-        raise UserError(f"{name} must be a positive number, got {v!r}.")
-    return float(v)
 
 
 def _count(name: str, v: Any, low: int) -> int:
@@ -166,44 +160,21 @@ def render_boids(out_path: str | Path, params: BoidParams, n: int = 300, n_steps
     run = _Run(params, n, seed)
     cam = run.camera(camera)
     m, d = run.model, run.data
-    sim_s = render_s = encode_s = 0.0
-    renderer = None
-    bar = None
-    if progress:
-        from tqdm import tqdm
+    t0 = time.perf_counter()
+    run.advance(warmup)
+    warm_s = time.perf_counter() - t0
+    renderer = _renderer(run, width, height)
 
-        bar = tqdm(total=n_frames, unit="frame", desc=f"render boids {params.name or ''}".rstrip(), leave=False)
+    def draw(j: int) -> np.ndarray:
+        renderer.update(m, d, cam)
+        return renderer.draw()
+
     try:
-        t0 = time.perf_counter()
-        run.advance(warmup)
-        sim_s += time.perf_counter() - t0
-        renderer = _renderer(run, width, height)
-        with atomic_path(out) as tmp:
-            writer = _WRITERS[suffix](tmp, fps)
-            try:
-                for j in range(n_frames):
-                    t0 = time.perf_counter()
-                    run.advance(warmup + j * spf)
-                    t1 = time.perf_counter()
-                    renderer.update(m, d, cam)
-                    frame = renderer.draw()
-                    t2 = time.perf_counter()
-                    writer.add(frame)
-                    t3 = time.perf_counter()
-                    sim_s += t1 - t0
-                    render_s += t2 - t1
-                    encode_s += t3 - t2
-                    if bar is not None:
-                        bar.update(1)
-            finally:
-                t0 = time.perf_counter()
-                writer.close()
-                encode_s += time.perf_counter() - t0
+        t = _write_frames(out, suffix, fps, n_frames, lambda j: run.advance(warmup + j * spf), draw,
+                          f"render boids {params.name or ''}".rstrip(), progress)
     finally:
-        if renderer is not None:
-            renderer.close()
-        if bar is not None:
-            bar.close()
+        renderer.close()
+    sim_s, render_s, encode_s = warm_s + t["sim_s"], t["render_s"], t["encode_s"]
     wall = time.perf_counter() - t_start
     return {
         "path": str(out),

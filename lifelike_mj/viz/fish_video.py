@@ -36,13 +36,12 @@ import math
 import statistics
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from lifelike_mj.errors import UserError
-from lifelike_mj.io import atomic_path
-from lifelike_mj.viz.video import _WRITERS, _check_size, _Offscreen, _video_target
+from lifelike_mj.viz.video import _check_size, _Offscreen, _positive, _video_target, _write_frames
 from lifelike_mj.viz.viewer import FRAME_S, MAX_CATCH_UP_S, has_display
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -59,12 +58,6 @@ FOLLOW_ELEVATION_DEG = -5.0
 FOLLOW_SMOOTH_S = 0.5
 #: Closest the ``follow`` camera comes to the tank's mid-plane beyond the front glass (m).
 FOLLOW_GLASS_CLEARANCE_M = 0.1
-
-
-def _positive(name: str, v: Any) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not (math.isfinite(v) and v > 0):
-        raise UserError(f"{name} must be a positive number, got {v!r}.")
-    return float(v)
 
 
 def _check_camera(camera: str) -> None:
@@ -201,41 +194,20 @@ def render_fish(out_path: str | Path, params: FishParams, n_fish: int = 10, dura
     cam = _Camera(sw, camera, width, height, follow_fish)
     renderer = _renderer(sw, width, height)
     m, d = sw.scene.model, sw.data
-    sim_s = render_s = encode_s = 0.0
-    bar = None
-    if progress:
-        from tqdm import tqdm
 
-        bar = tqdm(total=n_frames, unit="frame", desc="render fish", leave=False)
+    def advance(j: int) -> None:
+        _advance(sw, int(steps[j]))
+
+    def draw(j: int) -> np.ndarray:
+        cam.aim(d, None if j == 0 else int(steps[j] - steps[j - 1]) * params.control_dt_s)
+        renderer.update(m, d, cam.cam)
+        return renderer.draw()
+
     try:
-        with atomic_path(out) as tmp:
-            writer = _WRITERS[suffix](tmp, fps)
-            try:
-                prev = first
-                for j, k in enumerate(steps):
-                    t0 = time.perf_counter()
-                    _advance(sw, int(k))
-                    t1 = time.perf_counter()
-                    cam.aim(d, None if j == 0 else (int(k) - prev) * params.control_dt_s)
-                    renderer.update(m, d, cam.cam)
-                    frame = renderer.draw()
-                    t2 = time.perf_counter()
-                    writer.add(frame)
-                    t3 = time.perf_counter()
-                    sim_s += t1 - t0
-                    render_s += t2 - t1
-                    encode_s += t3 - t2
-                    prev = int(k)
-                    if bar is not None:
-                        bar.update(1)
-            finally:
-                t0 = time.perf_counter()
-                writer.close()
-                encode_s += time.perf_counter() - t0
+        t = _write_frames(out, suffix, fps, n_frames, advance, draw, "render fish", progress)
     finally:
         renderer.close()
-        if bar is not None:
-            bar.close()
+    sim_s, render_s, encode_s = t["sim_s"], t["render_s"], t["encode_s"]
     wall = time.perf_counter() - t_start
     return {
         "path": str(out),

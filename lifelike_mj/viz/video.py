@@ -29,6 +29,7 @@ import os
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -382,6 +383,50 @@ def _check_size(width: int, height: int, what: str) -> None:
     for name, v in (("width", width), ("height", height)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 8 <= v <= 4096:
             raise UserError(f"{what} {name} must be a whole number of pixels between 8 and 4096, got {v!r}.")
+
+
+def _positive(name: str, v: Any) -> float:
+    """``v`` as a float; :class:`UserError` unless it is a finite number > 0."""
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not (math.isfinite(v) and v > 0):
+        raise UserError(f"{name} must be a positive number, got {v!r}.")
+    return float(v)
+
+
+def _write_frames(out: Path, suffix: str, fps: float, n_frames: int, advance: Callable[[int], None],
+                  draw: Callable[[int], np.ndarray], desc: str = "render", progress: bool = False) -> dict[str, float]:
+    """Write ``n_frames`` frames to ``out`` (atomically; nothing left on an error): frame ``j`` is
+    ``advance(j)`` (the simulation) then ``draw(j)`` (an RGB image), then encoding. Returns the wall
+    seconds of each part: ``{"sim_s", "render_s", "encode_s"}``."""
+    sim_s = render_s = encode_s = 0.0
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=n_frames, unit="frame", desc=desc, leave=False)
+    try:
+        with atomic_path(out) as tmp:
+            writer = _WRITERS[suffix](tmp, fps)
+            try:
+                for j in range(n_frames):
+                    t0 = time.perf_counter()
+                    advance(j)
+                    t1 = time.perf_counter()
+                    frame = draw(j)
+                    t2 = time.perf_counter()
+                    writer.add(frame)
+                    sim_s += t1 - t0
+                    render_s += t2 - t1
+                    encode_s += time.perf_counter() - t2
+                    if bar is not None:
+                        bar.update(1)
+            finally:
+                t0 = time.perf_counter()
+                writer.close()
+                encode_s += time.perf_counter() - t0
+    finally:
+        if bar is not None:
+            bar.close()
+    return {"sim_s": sim_s, "render_s": render_s, "encode_s": encode_s}
 
 
 def _video_target(out_path: str | Path, width: int, height: int) -> tuple[Path, str]:
