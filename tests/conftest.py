@@ -27,6 +27,45 @@ def gl_backend():
     return backend
 
 
+@pytest.fixture
+def stand_in_viewer(monkeypatch):
+    """Replace ``mujoco.viewer.launch_passive`` by a window-less stand-in; yields the list of the
+    stand-ins opened (each counts its ``sync`` calls and has a real ``cam`` and ``opt``)."""
+    import contextlib
+
+    import mujoco
+    import mujoco.viewer
+
+    class StandInViewer:
+        def __init__(self, m, d):
+            self.m, self.d, self.syncs = m, d, 0
+            self.cam, self.opt = mujoco.MjvCamera(), mujoco.MjvOption()
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+        def lock(self):
+            return contextlib.nullcontext()
+
+        def is_running(self):
+            return True
+
+        def sync(self):
+            self.syncs += 1
+
+    opened = []
+
+    def launch_passive(m, d, **kwargs):
+        opened.append(StandInViewer(m, d))
+        return opened[-1]
+
+    monkeypatch.setattr(mujoco.viewer, "launch_passive", launch_passive)
+    return opened
+
+
 def gif_frames(path) -> list[np.ndarray]:
     """The frames of a GIF as float RGB arrays."""
     with Image.open(path) as im:

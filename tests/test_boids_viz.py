@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import contextlib
-
 import mujoco
 import numpy as np
 import pytest
@@ -243,43 +241,16 @@ def test_view_boids_without_display_raises_user_error(monkeypatch):
         boids_video.view_boids(load_preset("4a"), n=20, duration_steps=5)
 
 
-def test_view_boids_loop_with_a_stand_in_viewer(monkeypatch):
+def test_view_boids_loop_with_a_stand_in_viewer(monkeypatch, stand_in_viewer):
     """The viewer loop (camera set-up, stepping by the clock, stop after ``duration_steps``) on a fake window."""
     import mujoco.viewer
 
-    class FakeViewer:
-        def __init__(self, m, d):
-            self.m, self.d, self.syncs = m, d, 0
-            self.cam, self.opt = mujoco.MjvCamera(), mujoco.MjvOption()
-
-        def __enter__(self):
-            return self
-
-        def __exit__(self, *exc):
-            return False
-
-        def lock(self):
-            return contextlib.nullcontext()
-
-        def is_running(self):
-            return True
-
-        def sync(self):
-            self.syncs += 1
-
-    opened = []
-
-    def launch_passive(m, d, **kwargs):
-        opened.append(FakeViewer(m, d))
-        return opened[-1]
-
     monkeypatch.setattr(boids_video, "has_display", lambda: True)
-    monkeypatch.setattr(mujoco.viewer, "launch_passive", launch_passive)
     boids_video.view_boids(load_preset("4a"), n=20, seed=0, steps_per_s=2000.0, duration_steps=20, warmup_steps=10)
-    (v,) = opened
+    (v,) = stand_in_viewer
     assert v.syncs >= 1 and v.cam.type == mujoco.mjtCamera.mjCAMERA_FREE and v.cam.distance > 20.0
     assert v.cam.elevation < -10.0  # from above
     boids_video.view_boids(BoidParams(dims=2), n=20, steps_per_s=2000.0, duration_steps=5, camera="top")
-    assert opened[-1].cam.elevation == -90.0
+    assert stand_in_viewer[-1].cam.elevation == -90.0
     with pytest.raises(UserError, match="viewer camera"):
         boids_video.view_boids(load_preset("4a"), camera="side")

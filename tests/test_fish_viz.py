@@ -151,46 +151,18 @@ def test_view_fish_without_display_raises_user_error(monkeypatch, params):
         fish_video.view_fish(params, n_fish=2, duration_s=0.1)
 
 
-def test_view_fish_loop_with_a_stand_in_viewer(monkeypatch, params):
+def test_view_fish_loop_with_a_stand_in_viewer(monkeypatch, params, stand_in_viewer):
     """The viewer loop (camera set-up, real-time stepping, stop at ``duration_s``) on a fake window."""
-    import contextlib
 
     import mujoco
     import mujoco.viewer
 
-    class FakeViewer:
-        def __init__(self, m, d):
-            self.m, self.d, self.syncs = m, d, 0
-            self.cam, self.opt = mujoco.MjvCamera(), mujoco.MjvOption()
-
-        def __enter__(self):
-            return self
-
-        def __exit__(self, *exc):
-            return False
-
-        def lock(self):
-            return contextlib.nullcontext()
-
-        def is_running(self):
-            return True
-
-        def sync(self):
-            self.syncs += 1
-
-    opened = []
-
-    def launch_passive(m, d, **kwargs):
-        opened.append(FakeViewer(m, d))
-        return opened[-1]
-
     monkeypatch.setattr(fish_video, "has_display", lambda: True)
-    monkeypatch.setattr(mujoco.viewer, "launch_passive", launch_passive)
     fish_video.view_fish(params, n_fish=2, seed=0, duration_s=0.1, camera="follow")
-    (v,) = opened
+    (v,) = stand_in_viewer
     assert v.syncs >= 1 and v.cam.type == mujoco.mjtCamera.mjCAMERA_TRACKING and v.cam.azimuth == 90.0
     fish_video.view_fish(params, n_fish=2, seed=0, duration_s=0.05)
-    assert opened[-1].cam.type == mujoco.mjtCamera.mjCAMERA_FREE and opened[-1].cam.distance > 5.0
+    assert stand_in_viewer[-1].cam.type == mujoco.mjtCamera.mjCAMERA_FREE and stand_in_viewer[-1].cam.distance > 5.0
     with pytest.raises(UserError, match="viewer camera"):
         fish_video.view_fish(params, camera="oblique")
 
