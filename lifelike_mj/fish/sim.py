@@ -204,15 +204,15 @@ TURN_FLIP = 0.3
 
 
 @njit(cache=False)
-def _look(vm, vd, pos, R, head, dist_m, ang, away):
+def _look(vm, vd, pos, R, head, dist_m, ang, away, scratch, gid):
     """Five rays (ahead, left, right, up, down at ``ang`` rad) from the snout; returns True when
     one hits, within ``dist_m``, a surface that the fish is heading into (at more than
     ``asin(APPROACH_MIN)`` to it: a wall the fish swims along is no threat), and writes the
-    weighted sum of those hit normals to ``away``."""
-    pnt = np.empty(3)
-    vec = np.empty(3)
-    nrm = np.empty(3)
-    gid = np.empty(1, dtype=np.int32)
+    weighted sum of those hit normals to ``away``. ``scratch`` (9,) and ``gid`` (1,) int32 are
+    work arrays of the caller (the ray's point, direction and hit normal, and the hit geom)."""
+    pnt = scratch[0:3]
+    vec = scratch[3:6]
+    nrm = scratch[6:9]
     for a in range(3):
         pnt[a] = pos[a] + R[3 * a] * head
         away[a] = 0.0
@@ -246,11 +246,13 @@ def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n):
     """One control step for all fish: look, choose the MU, set the push (module docstring)."""
     R = np.empty(9)
     away = np.empty(3)
+    scratch = np.empty(9)
+    gid = np.empty(1, dtype=np.int32)
     for i in range(n):
         base = U_FISH + FISH_BLOCK * i
         qa = int(ud[base])
         _rotmat(qpos[qa + 3 : qa + 7], R)
-        if _look(vm, vd, qpos[qa : qa + 3], R, c[C_HEAD], c[C_VIS], c[C_VANG], away):
+        if _look(vm, vd, qpos[qa : qa + 3], R, c[C_HEAD], c[C_VIS], c[C_VANG], away, scratch, gid):
             nn = math.sqrt(away[0] ** 2 + away[1] ** 2 + away[2] ** 2)
             if nn > 0:
                 fresh = state[i, S_AVOID_T] <= 0.0
