@@ -438,10 +438,10 @@ class BoidRun:
 
 
 def simulate(params: BoidParams, n: int = N_AGENTS, n_steps: int = 3000, seed: int = 0, record_every: int = 1,
-             record_from: int = 0, progress: bool = False) -> BoidRun:
+             record_from: int = 0, progress: bool = False, extra_steps=()) -> BoidRun:
     """Run ``n_steps`` steps from :func:`initial_state`; record the state every ``record_every``
-    steps from step ``record_from`` on (step 0 = the initial state). Raises :class:`UserError` if
-    the run diverges (section 2.2: w_a >= 10 or w_c >= 1)."""
+    steps from step ``record_from`` on (step 0 = the initial state), and at the ``extra_steps``.
+    Raises :class:`UserError` if the run diverges (section 2.2: w_a >= 10 or w_c >= 1)."""
     import time
 
     if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or n_steps < 1:
@@ -454,7 +454,8 @@ def simulate(params: BoidParams, n: int = N_AGENTS, n_steps: int = 3000, seed: i
     wa, wc, c = params.arrays()
     planar = params.dims == 2
     D = params.dims
-    rec_steps = [s for s in range(0, int(n_steps) + 1, record_every) if s >= record_from]
+    rec_steps = sorted({s for s in range(0, int(n_steps) + 1, record_every) if s >= record_from}
+                       | {int(s) for s in extra_steps if 0 <= s <= n_steps})
     X = np.empty((len(rec_steps), n, 3))
     V = np.empty((len(rec_steps), n, 3))
     r = 0

@@ -45,9 +45,8 @@ def classified_run(params: BoidParams, n: int = N_AGENTS, seed: int = 0, n_steps
     s = run_settings()
     steps = int(n_steps or s["n_steps"])
     window = min(s["window"], steps)
-    run = simulate(params, n, steps, seed, record_every=1, record_from=steps - window, progress=progress)
-    keep = (run.steps % s["record_every"] == 0) | (run.steps >= steps - trail_steps)
-    run = replace(run, steps=run.steps[keep], positions=run.positions[keep], velocities=run.velocities[keep])
+    run = simulate(params, n, steps, seed, record_every=s["record_every"], record_from=steps - window, progress=progress,
+                   extra_steps=range(steps - trail_steps, steps + 1))
     m = metrics.measures(run, window=window)
     label, reasons = metrics.classify(m)
     return run, m, label, reasons
