@@ -17,17 +17,19 @@ then ``x += dt v``. Units are the paper's (lengths in its box units, time in ste
 
 :func:`step_grid` finds neighbours with a uniform grid of cells no smaller than ``R_c`` (cell
 lists, counting sort), so the cost grows linearly with ``n`` at fixed density; forces of all agents
-are computed from the old state on parallel threads, then all agents move: the result does not
-depend on the number of threads; sums are accumulated in double-double and rounded once, so they do
-not depend on the order of the neighbours either. :func:`step_reference` is the same model over all
-pairs in plain Python with exactly rounded sums (kept for the tests).
+are computed from the old state (on parallel threads from :data:`PARALLEL_FROM` agents), then all
+agents move. Every sum adds its terms in ascending order of the neighbour's index, as the plain
+all-pairs reference :func:`step_reference` does (kept for the tests), so the two agree bit for bit
+and the result does not depend on the number of threads.
 """
 
 from __future__ import annotations
 
 import math
+import types as pytypes
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 from numba import njit, prange
 
@@ -143,145 +145,330 @@ def initial_state(params: BoidParams, n: int, seed: int, margin: float | None = 
 # ---- the compiled cell-list step -----------------------------------------------------------------
 # Positions and velocities are (n, 3) inside the compiled code; in 2D the z column is 0 and stays 0
 # (no force has a z component, the z walls are off, the grid has one layer of cells).
+#
+# Each force component of agent i is summed exactly as the plain reference sums it: its terms in
+# ascending order of the neighbour's index j, one rounding per addition. The engine gets that order
+# by turning the loops round. For each column of cells (fixed x and y cell), the agents j of the 3 x 3
+# columns around it are listed in ascending index order (the column's "halo", built by one pass over
+# the agents in index order), and each j is applied at once to all the column's agents i within one
+# cell of it in z. That inner loop over i is branch-free (a term outside its zone is multiplied by 0
+# and adds nothing: s + 0 = s exactly, and a sum that starts at +0 never becomes -0), so the compiler
+# vectorises it. Separation, a few neighbours per agent, uses a finer grid and sorts each agent's
+# separation neighbours by index.
+
+#: The fine grid of the separation zone has at most this many cells, or 8 per agent if more.
+FINE_CELLS_MIN = 1 << 16
 
 
 @njit(cache=True)
-def _grid(x, box, r_c, planar):
-    """Cells no smaller than R_c: ``(ncell_xy, ncell_z, cell_size, order, start, cell)`` with a
-    counting sort (agents by cell, by index within a cell)."""
+def _grid(x, size_min, planar, max_cells):
+    """A uniform grid over the agents' bounding box, cells at least ``size_min`` wide (a hair more,
+    so that rounding never puts two agents closer than ``size_min`` two cells apart), at most
+    ``max_cells`` cells: ``(ncx, ncy, ncz, cell, start, pos)``. The agents are counting-sorted by
+    cell (x, then y, then z), by index within a cell: agent ``i`` is at sorted position ``pos[i]``,
+    cell ``c`` holds the sorted positions ``start[c] .. start[c + 1] - 1``."""
     n = x.shape[0]
-    nc = max(1, int(box / r_c))
-    nz = 1 if planar else nc
-    size = box / nc
+    lo = np.zeros(3)
+    inv = np.zeros(3)
+    nn = np.ones(3, dtype=np.int64)
+    for a in range(2 if planar else 3):
+        lo[a] = x[:, a].min()
+        ext = x[:, a].max() - lo[a]
+        nn[a] = max(1, int(ext / (size_min * (1.0 + 1e-9))))
+    while nn[0] * nn[1] * nn[2] > max_cells:
+        nn[np.argmax(nn)] -= 1
+    for a in range(2 if planar else 3):
+        ext = x[:, a].max() - lo[a]
+        if ext > 0.0:
+            inv[a] = nn[a] / ext
+    ncx, ncy, ncz = nn[0], nn[1], nn[2]
     cell = np.empty(n, dtype=np.int64)
     for i in range(n):
-        qx = min(max(int(x[i, 0] / size), 0), nc - 1)
-        qy = min(max(int(x[i, 1] / size), 0), nc - 1)
-        qz = 0 if planar else min(max(int(x[i, 2] / size), 0), nc - 1)
-        cell[i] = (qx * nc + qy) * nz + qz
-    ncells = nc * nc * nz
+        qx = min(int((x[i, 0] - lo[0]) * inv[0]), ncx - 1)
+        qy = min(int((x[i, 1] - lo[1]) * inv[1]), ncy - 1)
+        qz = 0 if planar else min(int((x[i, 2] - lo[2]) * inv[2]), ncz - 1)
+        cell[i] = (qx * ncy + qy) * ncz + qz
+    ncells = ncx * ncy * ncz
     start = np.zeros(ncells + 1, dtype=np.int64)
     for i in range(n):
         start[cell[i] + 1] += 1
-    for c in range(ncells):
-        start[c + 1] += start[c]
+    for k in range(ncells):
+        start[k + 1] += start[k]
     fill = start[:-1].copy()
-    order = np.empty(n, dtype=np.int64)
+    pos = np.empty(n, dtype=np.int64)
     for i in range(n):
-        order[fill[cell[i]]] = i
+        pos[i] = fill[cell[i]]
         fill[cell[i]] += 1
-    return nc, nz, order, start, cell
+    return ncx, ncy, ncz, cell, start, pos
 
 
-@njit(cache=True, inline="always")
-def _two_sum(s, c, t):
-    """Add ``t`` to the double-double accumulator ``(s, c)`` (Knuth's TwoSum; error-free)."""
-    u = s + t
-    b = u - s
-    return u, c + ((s - (u - b)) + (t - b))
-
-
-def _forces_py(x, v, types, wa, wc, c, planar, dv):
-    """dv = dt/m (F_s + F_a + F_c) of every agent (eq. 1-9), on parallel threads.
-
-    Each force component is a sum over neighbours accumulated in double-double arithmetic and
-    rounded once: its value does not depend on the order in which the neighbours are visited
-    (cells, threads), and equals the all-pairs reference, which sums the same terms exactly
-    (``math.fsum``), except when the exact sum lies within ~1e-27 (relative) of a rounding
-    boundary. The agents are copied in cell order first, so that a cell's agents are contiguous."""
+@njit(cache=True)
+def _prepare(x, v, types, wa, wc, c, planar, nchunks):
+    """Everything the pair loops read: the R_c grid, the agents' state in sorted order (rows x, y, z),
+    per-position weight columns (``wcs[t, p]``: the weight of the agent at ``p`` for a neighbour of
+    type ``t``), the halo lists, ``nchunks`` ranges of sorted positions of about equal work, and the
+    fine grid of the separation zone."""
     n = x.shape[0]
-    r_s, r_a, r_c, w_s, box, dt_m = c[0], c[1], c[2], c[3], c[4], c[5]
-    r_s2, r_a2, r_c2 = r_s * r_s, r_a * r_a, r_c * r_c
-    nc, nz, order, start, cell = _grid(x, box, r_c, planar)
-    xs = np.empty((n, 3))
-    vs = np.empty((n, 3))
+    ncx, ncy, nz, cell, start, pos = _grid(x, c[2], planar, 1 << 40)
+    k = wa.shape[0]
+    xs = np.empty((3, n))
+    vs = np.empty((3, n))
+    cs = np.empty(n, dtype=np.int64)
     ts = np.empty(n, dtype=np.int64)
-    for q in range(n):
-        j = order[q]
+    wcs = np.empty((k, n))
+    was = np.empty((k, n))
+    for i in range(n):
+        p = pos[i]
         for a in range(3):
-            xs[q, a] = x[j, a]
-            vs[q, a] = v[j, a]
-        ts[q] = types[j]
-    for p in prange(n):
-        i = order[p]
-        sx = sy = sz = ax = ay = az = cx = cy = cz = 0.0  # separation, alignment, cohesion sums
-        esx = esy = esz = eax = eay = eaz = ecx = ecy = ecz = 0.0  # their error terms
-        na = 0
-        nci = 0
-        ti = ts[p]
-        xi0, xi1, xi2 = xs[p, 0], xs[p, 1], xs[p, 2]
-        vi0, vi1, vi2 = vs[p, 0], vs[p, 1], vs[p, 2]
-        ci = cell[i]
-        qz = ci % nz
-        qy = (ci // nz) % nc
-        qx = ci // (nz * nc)
-        for dxc in range(-1, 2):
-            bx = qx + dxc
-            if bx < 0 or bx >= nc:
+            xs[a, p] = x[i, a]
+            vs[a, p] = v[i, a]
+        cs[p] = cell[i]
+        ts[p] = types[i]
+        for t in range(k):
+            wcs[t, p] = wc[types[i], t]
+            was[t, p] = wa[types[i], t]
+    # halo lists: for each occupied column (fixed x and y cell), the sorted positions of the agents
+    # of the occupied columns around it (3 x 3), in ascending agent index (the order of the sums)
+    ncol = ncx * ncy
+    occupied = np.zeros(ncol, dtype=np.int64)
+    for i in range(n):
+        occupied[cell[i] // nz] += 1
+    around = np.empty((ncol, 9), dtype=np.int64)  # the occupied columns around each column
+    naround = np.zeros(ncol, dtype=np.int64)
+    hstart = np.zeros(ncol + 1, dtype=np.int64)
+    for q in range(ncol):
+        if occupied[q] == 0:
+            continue
+        qx, qy = q // ncy, q % ncy
+        for bx in range(max(qx - 1, 0), min(qx + 2, ncx)):
+            for by in range(max(qy - 1, 0), min(qy + 2, ncy)):
+                b = bx * ncy + by
+                if occupied[b] > 0:
+                    around[q, naround[q]] = b
+                    naround[q] += 1
+                    hstart[b + 1] += occupied[q]
+    for q in range(ncol):
+        hstart[q + 1] += hstart[q]
+    fill = hstart[:-1].copy()
+    halo = np.empty(hstart[ncol], dtype=np.int64)
+    for i in range(n):
+        q = cell[i] // nz
+        for s in range(naround[q]):
+            b = around[q, s]
+            halo[fill[b]] = pos[i]
+            fill[b] += 1
+    # chunks of equal work: an agent's work is its column's halo length
+    total = 0
+    for q in range(ncol):
+        total += occupied[q] * (hstart[q + 1] - hstart[q])
+    bounds = np.full(nchunks + 1, n, dtype=np.int64)
+    bounds[0] = 0
+    done = 0
+    kk = 1
+    for p in range(n):
+        while kk < nchunks and done * nchunks >= kk * total:
+            bounds[kk] = p
+            kk += 1
+        q = cs[p] // nz
+        done += hstart[q + 1] - hstart[q]
+    # the fine grid of the separation zone, its agents in fine cell order
+    fx, fy, fz, fcell, fstart, fpos = _grid(x, c[0], planar, max(FINE_CELLS_MIN, 8 * n))
+    forder = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        forder[fpos[i]] = i
+    return nz, start, pos, cs, ts, xs, vs, wcs, was, hstart, halo, bounds, fx, fy, fz, fcell, fstart, forder
+
+
+def _pairs_body(bounds, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc):
+    """Cohesion and alignment sums and neighbour counts of the agents at sorted positions
+    ``bounds[k] .. bounds[k + 1] - 1`` for each chunk ``k`` (chunks on parallel threads: they write
+    disjoint positions). ``acc`` rows: cohesion x, y, z, alignment x, y, z, N_c + 1, N_a + 1 (an agent
+    meets itself once, with zero terms).
+
+    A neighbour j is applied to the agents of the column in its own and the adjacent z cells. Two
+    consecutive halo agents j < k in the same or adjacent z cells are applied in one pass (first
+    j's term, then k's: the order of the sums is kept), which halves the loads and stores of the
+    sums. A run of agents may be lengthened within the column (to a multiple of 8, for whole vector
+    iterations): an agent out of j's zones gets zero terms, in its right place in the order."""
+    xs0, xs1, xs2 = xs[0], xs[1], xs[2]
+    vs0, vs1, vs2 = vs[0], vs[1], vs[2]
+    cx, cy, cz, ax, ay, az, ncn, nan = acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7]
+    for part in prange(bounds.shape[0] - 1):
+        p0, p1 = bounds[part], bounds[part + 1]
+        if p0 >= p1:
+            continue
+        for q in range(cs[p0] // nz, cs[p1 - 1] // nz + 1):
+            a = max(start[q * nz], p0)
+            b = min(start[q * nz + nz], p1)
+            if a >= b:
                 continue
-            for dyc in range(-1, 2):
-                by = qy + dyc
-                if by < 0 or by >= nc:
+            h = hstart[q]
+            h1 = hstart[q + 1]
+            while h < h1:
+                pj = halo[h]
+                qj = cs[pj] % nz
+                pk = pj
+                qk = qj
+                on = 0.0  # 1 when a second agent k is applied in this pass
+                if h + 1 < h1 and abs(cs[halo[h + 1]] % nz - qj) <= 1:
+                    pk = halo[h + 1]
+                    qk = cs[pk] % nz
+                    on = 1.0
+                h += 2 if on > 0.0 else 1
+                r0 = max(start[q * nz + max(min(qj, qk) - 1, 0)], a)
+                r1 = min(start[q * nz + min(max(qj, qk) + 1, nz - 1) + 1], b)
+                if r0 >= r1:
                     continue
-                z0 = max(qz - 1, 0)
-                z1 = min(qz + 1, nz - 1)
-                # the cells (bx, by, z0..z1) are consecutive: one contiguous run of agents
-                c0 = (bx * nc + by) * nz
-                for q in range(start[c0 + z0], start[c0 + z1 + 1]):
-                    ex = xi0 - xs[q, 0]
-                    ey = xi1 - xs[q, 1]
-                    ez = xi2 - xs[q, 2]
-                    d2 = ex * ex + ey * ey + ez * ez
-                    if d2 >= r_c2 or q == p:
-                        continue
-                    nci += 1
-                    w = wc[ti, ts[q]]
-                    cx, ecx = _two_sum(cx, ecx, -(w * ex))
-                    cy, ecy = _two_sum(cy, ecy, -(w * ey))
-                    cz, ecz = _two_sum(cz, ecz, -(w * ez))
-                    if d2 < r_a2:
-                        na += 1
-                        w = wa[ti, ts[q]]
-                        ax, eax = _two_sum(ax, eax, w * (vs[q, 0] - vi0))
-                        ay, eay = _two_sum(ay, eay, w * (vs[q, 1] - vi1))
-                        az, eaz = _two_sum(az, eaz, w * (vs[q, 2] - vi2))
-                        if d2 < r_s2 and d2 > 0.0:
-                            w = w_s / math.sqrt(d2)
-                            sx, esx = _two_sum(sx, esx, w * ex)
-                            sy, esy = _two_sum(sy, esy, w * ey)
-                            sz, esz = _two_sum(sz, esz, w * ez)
-        # wall avoidance: a wall closer than R_s pushes w_s along its inward normal (a term of F_s)
-        if xi0 < r_s:
-            sx, esx = _two_sum(sx, esx, w_s)
-        if box - xi0 < r_s:
-            sx, esx = _two_sum(sx, esx, -w_s)
-        if xi1 < r_s:
-            sy, esy = _two_sum(sy, esy, w_s)
-        if box - xi1 < r_s:
-            sy, esy = _two_sum(sy, esy, -w_s)
-        if not planar:
-            if xi2 < r_s:
-                sz, esz = _two_sum(sz, esz, w_s)
-            if box - xi2 < r_s:
-                sz, esz = _two_sum(sz, esz, -w_s)
-        fx, fy, fz = sx + esx, sy + esy, sz + esz
-        if na > 0:
-            fx += (ax + eax) / na
-            fy += (ay + eay) / na
-            fz += (az + eaz) / na
-        if nci > 0:
-            fx += (cx + ecx) / nci
-            fy += (cy + ecy) / nci
-            fz += (cz + ecz) / nci
-        dv[i, 0] = dt_m * fx
-        dv[i, 1] = dt_m * fy
-        dv[i, 2] = dt_m * fz
+                r1 = min(r1 + (r0 - r1) % 8, b)
+                r0 = max(r0 - (r0 - r1) % 8, a)
+                xj0, xj1, xj2 = xs0[pj], xs1[pj], xs2[pj]
+                xk0, xk1, xk2 = xs0[pk], xs1[pk], xs2[pk]
+                vj0, vj1, vj2 = vs0[pj], vs1[pj], vs2[pj]
+                vk0, vk1, vk2 = vs0[pk], vs1[pk], vs2[pk]
+                wcj, wck = wcs[ts[pj]], wcs[ts[pk]]
+                waj, wak = was[ts[pj]], was[ts[pk]]
+                # unsigned indices (no negative-index wraparound) let the loops vectorise
+                for p in range(np.uint64(r0), np.uint64(r1)):
+                    ex = xs0[p] - xj0
+                    ey = xs1[p] - xj1
+                    ez = xs2[p] - xj2
+                    fx = xs0[p] - xk0
+                    fy = xs1[p] - xk1
+                    fz = xs2[p] - xk2
+                    m = 1.0 if ex * ex + ey * ey + ez * ez < r_c2 else 0.0
+                    mk = on if fx * fx + fy * fy + fz * fz < r_c2 else 0.0
+                    ncn[p] += m + mk
+                    w = wcj[p] * m
+                    wk = wck[p] * mk
+                    cx[p] = (cx[p] + -(w * ex)) + -(wk * fx)
+                    cy[p] = (cy[p] + -(w * ey)) + -(wk * fy)
+                    cz[p] = (cz[p] + -(w * ez)) + -(wk * fz)
+                for p in range(np.uint64(r0), np.uint64(r1)):
+                    ex = xs0[p] - xj0
+                    ey = xs1[p] - xj1
+                    ez = xs2[p] - xj2
+                    fx = xs0[p] - xk0
+                    fy = xs1[p] - xk1
+                    fz = xs2[p] - xk2
+                    m = 1.0 if ex * ex + ey * ey + ez * ez < r_a2 else 0.0
+                    mk = on if fx * fx + fy * fy + fz * fz < r_a2 else 0.0
+                    nan[p] += m + mk
+                    w = waj[p] * m
+                    wk = wak[p] * mk
+                    vp = vs0[p]
+                    ax[p] = (ax[p] + w * (vj0 - vp)) + wk * (vk0 - vp)
+                    vp = vs1[p]
+                    ay[p] = (ay[p] + w * (vj1 - vp)) + wk * (vk1 - vp)
+                    vp = vs2[p]
+                    az[p] = (az[p] + w * (vj2 - vp)) + wk * (vk2 - vp)
+
+
+def _separation_body(x, nchunks, fncx, fncy, fncz, fcell, fstart, forder, r_s, w_s, sep):
+    """Separation sums (eq. 3 with f = 1, summed) of every agent: its neighbours within R_s, found
+    on the fine grid, are sorted by index and their terms summed in that order. The agents are split
+    into ``nchunks`` index ranges on parallel threads."""
+    n = x.shape[0]
+    r_s2 = r_s * r_s
+    for k in prange(nchunks):
+        buf = np.empty(n, dtype=np.int64)
+        for i in range(k * n // nchunks, (k + 1) * n // nchunks):
+            ci = fcell[i]
+            qz = ci % fncz
+            qy = (ci // fncz) % fncy
+            qx = ci // (fncz * fncy)
+            m = 0
+            for bx in range(max(qx - 1, 0), min(qx + 2, fncx)):
+                for by in range(max(qy - 1, 0), min(qy + 2, fncy)):
+                    c0 = (bx * fncy + by) * fncz
+                    for p in range(fstart[c0 + max(qz - 1, 0)], fstart[c0 + min(qz + 1, fncz - 1) + 1]):
+                        j = forder[p]
+                        ex = x[i, 0] - x[j, 0]
+                        ey = x[i, 1] - x[j, 1]
+                        ez = x[i, 2] - x[j, 2]
+                        d2 = ex * ex + ey * ey + ez * ez
+                        if 0.0 < d2 < r_s2 and j != i:
+                            # insertion into buf[0:m], kept in ascending index order
+                            s = m
+                            while s > 0 and buf[s - 1] > j:
+                                buf[s] = buf[s - 1]
+                                s -= 1
+                            buf[s] = j
+                            m += 1
+            sx = sy = sz = 0.0
+            for s in range(m):
+                j = buf[s]
+                ex = x[i, 0] - x[j, 0]
+                ey = x[i, 1] - x[j, 1]
+                ez = x[i, 2] - x[j, 2]
+                w = w_s / math.sqrt(ex * ex + ey * ey + ez * ez)
+                sx += w * ex
+                sy += w * ey
+                sz += w * ez
+            sep[0, i] = sx
+            sep[1, i] = sy
+            sep[2, i] = sz
+
+
+@njit(cache=True)
+def _combine(x, pos, acc, sep, c, planar, dv):
+    """dv = dt/m (F_s + F_a + F_c) (eq. 1-2): separation plus wall avoidance (a wall closer than
+    R_s adds w_s along its inward normal, after the neighbours' terms), then the alignment and
+    cohesion averages (eq. 6-9)."""
+    n = x.shape[0]
+    r_s, w_s, box, dt_m = c[0], c[3], c[4], c[5]
+    for i in range(n):
+        p = pos[i]
+        na = acc[7, p] - 1.0
+        nc = acc[6, p] - 1.0
+        for a in range(3):
+            f = sep[a, i]
+            if a < 2 or not planar:
+                if x[i, a] < r_s:
+                    f += w_s
+                if box - x[i, a] < r_s:
+                    f += -w_s
+            if na > 0.0:
+                f += acc[3 + a, p] / na
+            if nc > 0.0:
+                f += acc[a, p] / nc
+            dv[i, a] = dt_m * f
+
+
+def _named(f, name: str):
+    """A copy of ``f`` under another name. numba's cache files are named after the function, so a
+    serial and a parallel compilation of one body need two names, or they share one file (and a
+    run gets whichever was compiled first)."""
+    g = pytypes.FunctionType(f.__code__, f.__globals__, name, f.__defaults__, f.__closure__)
+    g.__qualname__ = name
+    return g
 
 
 #: Below this many agents one thread is faster (no fork-join per step) and robust to a busy machine.
 PARALLEL_FROM = 2000
-_forces_par = njit(cache=True, parallel=True)(_forces_py)
-_forces_ser = njit(cache=True)(_forces_py)
+_pairs_ser = njit(cache=True)(_named(_pairs_body, "_pairs_ser"))
+_pairs_par = njit(cache=True, parallel=True)(_named(_pairs_body, "_pairs_par"))
+_separation_ser = njit(cache=True)(_named(_separation_body, "_separation_ser"))
+_separation_par = njit(cache=True, parallel=True)(_named(_separation_body, "_separation_par"))
+
+
+@njit(cache=True)
+def _forces(x, v, types, wa, wc, c, planar, dv, nchunks):
+    """dv = dt/m (F_s + F_a + F_c) of every agent (eq. 1-9), split into ``nchunks`` parts on parallel
+    threads if ``nchunks > 1`` (the result is the same: each sum's order is fixed by the agents'
+    indices)."""
+    n = x.shape[0]
+    par = nchunks > 1
+    (nz, start, pos, cs, ts, xs, vs, wcs, was, hstart, halo, bounds,
+     fx, fy, fz, fcell, fstart, forder) = _prepare(x, v, types, wa, wc, c, planar, nchunks)
+    acc = np.zeros((8, n))
+    sep = np.empty((3, n))
+    if par:
+        _pairs_par(bounds, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, c[2] * c[2], c[1] * c[1], acc)
+        _separation_par(x, nchunks, fx, fy, fz, fcell, fstart, forder, c[0], c[3], sep)
+    else:
+        _pairs_ser(bounds, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, c[2] * c[2], c[1] * c[1], acc)
+        _separation_ser(x, nchunks, fx, fy, fz, fcell, fstart, forder, c[0], c[3], sep)
+    _combine(x, pos, acc, sep, c, planar, dv)
 
 
 @njit(cache=True)
@@ -305,29 +492,24 @@ def _advance(x, v, dv, c):
 
 
 @njit(cache=True)
-def _run(x, v, types, wa, wc, c, planar, n_steps, record_every, out_x, out_v, vmax):
-    """``n_steps`` steps; records every ``record_every`` steps into ``out_x``/``out_v``; returns the
-    first step (1-based) at which a speed exceeded ``vmax`` or became NaN, else 0. The forces run on
-    all threads from :data:`PARALLEL_FROM` agents on (same result: sums do not depend on order)."""
+def _run(x, v, types, wa, wc, c, planar, n_steps, vmax, nchunks):
+    """``n_steps`` steps; returns the first step (1-based) at which a speed exceeded ``vmax`` or
+    became NaN, else 0. The forces are split into ``nchunks`` parts on parallel threads."""
     n = x.shape[0]
     dv = np.empty((n, 3))
-    r = 0
-    par = n >= PARALLEL_FROM
     for k in range(n_steps):
-        if par:
-            _forces_par(x, v, types, wa, wc, c, planar, dv)
-        else:
-            _forces_ser(x, v, types, wa, wc, c, planar, dv)
+        _forces(x, v, types, wa, wc, c, planar, dv, nchunks)
         _advance(x, v, dv, c)
         for i in range(n):
             s = v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1] + v[i, 2] * v[i, 2]
             if not (s <= vmax * vmax):
                 return k + 1
-        if record_every > 0 and (k + 1) % record_every == 0:
-            out_x[r] = x
-            out_v[r] = v
-            r += 1
     return 0
+
+
+def _nchunks(n: int) -> int:
+    """One part below :data:`PARALLEL_FROM` agents, else one per numba thread."""
+    return 1 if n < PARALLEL_FROM else max(1, numba.get_num_threads())
 
 
 def _as3(a: np.ndarray) -> np.ndarray:
@@ -340,9 +522,8 @@ def step_grid(x: np.ndarray, v: np.ndarray, types: np.ndarray, params: BoidParam
     engine. Raises :class:`UserError` when the run diverges."""
     x3, v3 = _as3(x), _as3(v)
     wa, wc, c = params.arrays()
-    empty = np.zeros((0, x3.shape[0], 3))
-    bad = _run(x3, v3, np.asarray(types, dtype=np.int64), wa, wc, c, params.dims == 2, int(n_steps), 0, empty, empty,
-               diverged_speed(params))
+    bad = _run(x3, v3, np.asarray(types, dtype=np.int64), wa, wc, c, params.dims == 2, int(n_steps),
+               diverged_speed(params), _nchunks(len(x3)))
     x[...] = x3[:, : x.shape[1]]
     v[...] = v3[:, : v.shape[1]]
     if bad:
@@ -366,13 +547,13 @@ def divergence_message(params: BoidParams, step: int) -> str:
 
 def step_reference(x: np.ndarray, v: np.ndarray, types: np.ndarray, params: BoidParams) -> None:
     """One step over all pairs in plain Python: the definition the engine is tested against. Each
-    force component is the exactly rounded sum (``math.fsum``) of its terms (eq. 3-5, 7, 9, and the
-    walls as separation terms)."""
+    force component is the plain floating-point sum of its terms, neighbours in ascending index
+    order, then the wall terms (eq. 3-5, 7, 9)."""
     n, D = x.shape
     wa, wc = np.array(params.wa), np.array(params.wc)
     dv = np.zeros((n, D))
     for i in range(n):
-        fs, fa, fc = [[] for _ in range(D)], [[] for _ in range(D)], [[] for _ in range(D)]
+        fs, fa, fc = [0.0] * D, [0.0] * D, [0.0] * D
         na = nc = 0
         for j in range(n):
             if j == i:
@@ -385,27 +566,27 @@ def step_reference(x: np.ndarray, v: np.ndarray, types: np.ndarray, params: Boid
                 nc += 1
                 w = wc[types[i], types[j]]
                 for a in range(D):
-                    fc[a].append(-(w * xi[a]))
+                    fc[a] += -(w * xi[a])
                 if d2 < params.r_a * params.r_a:
                     na += 1
                     w = wa[types[i], types[j]]
                     for a in range(D):
-                        fa[a].append(w * (v[j, a] - v[i, a]))
+                        fa[a] += w * (v[j, a] - v[i, a])
                     if 0.0 < d2 < params.r_s * params.r_s:
                         w = params.w_s / math.sqrt(d2)
                         for a in range(D):
-                            fs[a].append(w * xi[a])
+                            fs[a] += w * xi[a]
         for a in range(D):
             if x[i, a] < params.r_s:
-                fs[a].append(params.w_s)
+                fs[a] += params.w_s
             if params.box - x[i, a] < params.r_s:
-                fs[a].append(-params.w_s)
+                fs[a] += -params.w_s
         for a in range(D):
-            f = math.fsum(fs[a])
+            f = fs[a]
             if na:
-                f += math.fsum(fa[a]) / na
+                f += fa[a] / na
             if nc:
-                f += math.fsum(fc[a]) / nc
+                f += fc[a] / nc
             dv[i, a] = params.dt / params.mass * f
     v += dv
     x += params.dt * v
@@ -472,8 +653,7 @@ def simulate(params: BoidParams, n: int = N_AGENTS, n_steps: int = 3000, seed: i
         while done < n_steps:
             target = rec_steps[r] if r < len(rec_steps) else int(n_steps)
             k = target - done
-            empty = np.zeros((0, n, 3))
-            bad = _run(x3, v3, types, wa, wc, c, planar, k, 0, empty, empty, diverged_speed(params))
+            bad = _run(x3, v3, types, wa, wc, c, planar, k, diverged_speed(params), _nchunks(n))
             if bad:
                 raise UserError(divergence_message(params, done + bad))
             done += k
