@@ -26,7 +26,6 @@ and the result does not depend on the number of threads.
 from __future__ import annotations
 
 import math
-import types as pytypes
 from dataclasses import dataclass, field
 
 import numba
@@ -274,16 +273,22 @@ def _prepare(x, v, types, wa, wc, c, planar, nchunks):
     # the fine grid of the separation zone, its agents in fine cell order
     fx, fy, fz, fcell, fstart, fpos = _grid(x, c[0], planar, max(FINE_CELLS_MIN, 8 * n))
     forder = np.empty(n, dtype=np.int64)
+    fxs = np.empty((3, n))
+    fcs = np.empty(n, dtype=np.int64)
     for i in range(n):
-        forder[fpos[i]] = i
-    return nz, start, pos, cs, ts, xs, vs, wcs, was, hstart, halo, bounds, fx, fy, fz, fcell, fstart, forder
+        p = fpos[i]
+        forder[p] = i
+        fcs[p] = fcell[i]
+        for a in range(3):
+            fxs[a, p] = x[i, a]
+    return nz, start, pos, cs, ts, xs, vs, wcs, was, hstart, halo, bounds, fx, fy, fz, fcs, fstart, forder, fxs
 
 
-def _pairs_body(bounds, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc):
-    """Cohesion and alignment sums and neighbour counts of the agents at sorted positions
-    ``bounds[k] .. bounds[k + 1] - 1`` for each chunk ``k`` (chunks on parallel threads: they write
-    disjoint positions). ``acc`` rows: cohesion x, y, z, alignment x, y, z, N_c + 1, N_a + 1 (an agent
-    meets itself once, with zero terms).
+@njit(cache=True)
+def _pairs_chunk(p0, p1, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc):
+    """Cohesion and alignment sums and neighbour counts of the agents at sorted positions ``p0 ..
+    p1 - 1`` (chunks on parallel threads write disjoint positions). ``acc`` rows: cohesion x, y, z,
+    alignment x, y, z, N_c + 1, N_a + 1 (an agent meets itself once, with zero terms).
 
     A neighbour j is applied to the agents of the column in its own and the adjacent z cells. Two
     consecutive halo agents j < k in the same or adjacent z cells are applied in one pass (first
@@ -293,10 +298,7 @@ def _pairs_body(bounds, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2,
     xs0, xs1, xs2 = xs[0], xs[1], xs[2]
     vs0, vs1, vs2 = vs[0], vs[1], vs[2]
     cx, cy, cz, ax, ay, az, ncn, nan = acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7]
-    for part in prange(bounds.shape[0] - 1):
-        p0, p1 = bounds[part], bounds[part + 1]
-        if p0 >= p1:
-            continue
+    if p0 < p1:
         for q in range(cs[p0] // nz, cs[p1 - 1] // nz + 1):
             a = max(start[q * nz], p0)
             b = min(start[q * nz + nz], p1)
@@ -363,43 +365,59 @@ def _pairs_body(bounds, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2,
                     az[p] = (az[p] + w * (vj2 - vp)) + wk * (vk2 - vp)
 
 
-def _separation_body(x, nchunks, fncx, fncy, fncz, fcell, fstart, forder, r_s, w_s, sep):
-    """Separation sums (eq. 3 with f = 1, summed) of every agent: its neighbours within R_s, found
-    on the fine grid, are sorted by index and their terms summed in that order. The agents are split
-    into ``nchunks`` index ranges on parallel threads."""
-    n = x.shape[0]
+@njit(cache=True)
+def _separation_chunk(s0, s1, fncx, fncy, fncz, fcs, fstart, forder, fxs, r_s, w_s, sep):
+    """Separation sums (eq. 3 with f = 1, summed) of the agents at fine sorted positions ``s0 .. s1 -
+    1``: each agent's neighbours within R_s, found on the fine grid, are sorted by index and their
+    terms summed in that order. Cell by cell: the (at most 9) runs of neighbouring cells are found
+    once per cell."""
     r_s2 = r_s * r_s
-    for k in prange(nchunks):
-        buf = np.empty(n, dtype=np.int64)
-        for i in range(k * n // nchunks, (k + 1) * n // nchunks):
-            ci = fcell[i]
-            qz = ci % fncz
-            qy = (ci // fncz) % fncy
-            qx = ci // (fncz * fncy)
+    n = fxs.shape[1]
+    buf = np.empty(n, dtype=np.int64)  # fine positions of one agent's separation neighbours
+    lo = np.empty(9, dtype=np.int64)
+    hi = np.empty(9, dtype=np.int64)
+    if s0 >= s1:
+        return
+    for q in range(fcs[s0], fcs[s1 - 1] + 1):
+        a0 = max(fstart[q], s0)
+        a1 = min(fstart[q + 1], s1)
+        if a0 >= a1:
+            continue
+        qz = q % fncz
+        qy = (q // fncz) % fncy
+        qx = q // (fncz * fncy)
+        nr = 0
+        for bx in range(max(qx - 1, 0), min(qx + 2, fncx)):
+            for by in range(max(qy - 1, 0), min(qy + 2, fncy)):
+                c0 = (bx * fncy + by) * fncz
+                lo[nr] = fstart[c0 + max(qz - 1, 0)]
+                hi[nr] = fstart[c0 + min(qz + 1, fncz - 1) + 1]
+                nr += 1
+        for pa in range(a0, a1):
+            i = forder[pa]
+            xi0, xi1, xi2 = fxs[0, pa], fxs[1, pa], fxs[2, pa]
             m = 0
-            for bx in range(max(qx - 1, 0), min(qx + 2, fncx)):
-                for by in range(max(qy - 1, 0), min(qy + 2, fncy)):
-                    c0 = (bx * fncy + by) * fncz
-                    for p in range(fstart[c0 + max(qz - 1, 0)], fstart[c0 + min(qz + 1, fncz - 1) + 1]):
-                        j = forder[p]
-                        ex = x[i, 0] - x[j, 0]
-                        ey = x[i, 1] - x[j, 1]
-                        ez = x[i, 2] - x[j, 2]
-                        d2 = ex * ex + ey * ey + ez * ez
-                        if 0.0 < d2 < r_s2 and j != i:
-                            # insertion into buf[0:m], kept in ascending index order
-                            s = m
-                            while s > 0 and buf[s - 1] > j:
-                                buf[s] = buf[s - 1]
-                                s -= 1
-                            buf[s] = j
-                            m += 1
+            for r in range(nr):
+                for pb in range(lo[r], hi[r]):
+                    ex = xi0 - fxs[0, pb]
+                    ey = xi1 - fxs[1, pb]
+                    ez = xi2 - fxs[2, pb]
+                    d2 = ex * ex + ey * ey + ez * ez
+                    if 0.0 < d2 < r_s2:
+                        # insertion into buf[0:m], kept in ascending agent index
+                        j = forder[pb]
+                        s = m
+                        while s > 0 and forder[buf[s - 1]] > j:
+                            buf[s] = buf[s - 1]
+                            s -= 1
+                        buf[s] = pb
+                        m += 1
             sx = sy = sz = 0.0
             for s in range(m):
-                j = buf[s]
-                ex = x[i, 0] - x[j, 0]
-                ey = x[i, 1] - x[j, 1]
-                ez = x[i, 2] - x[j, 2]
+                pb = buf[s]
+                ex = xi0 - fxs[0, pb]
+                ey = xi1 - fxs[1, pb]
+                ez = xi2 - fxs[2, pb]
                 w = w_s / math.sqrt(ex * ex + ey * ey + ez * ez)
                 sx += w * ex
                 sy += w * ey
@@ -434,21 +452,20 @@ def _combine(x, pos, acc, sep, c, planar, dv):
             dv[i, a] = dt_m * f
 
 
-def _named(f, name: str):
-    """A copy of ``f`` under another name. numba's cache files are named after the function, so a
-    serial and a parallel compilation of one body need two names, or they share one file (and a
-    run gets whichever was compiled first)."""
-    g = pytypes.FunctionType(f.__code__, f.__globals__, name, f.__defaults__, f.__closure__)
-    g.__qualname__ = name
-    return g
-
-
-#: Below this many agents one thread is faster (no fork-join per step) and robust to a busy machine.
+#: Below this many agents one thread is as fast (see docs/performance.md) and robust to a busy machine.
 PARALLEL_FROM = 2000
-_pairs_ser = njit(cache=True)(_named(_pairs_body, "_pairs_ser"))
-_pairs_par = njit(cache=True, parallel=True)(_named(_pairs_body, "_pairs_par"))
-_separation_ser = njit(cache=True)(_named(_separation_body, "_separation_ser"))
-_separation_par = njit(cache=True, parallel=True)(_named(_separation_body, "_separation_par"))
+
+
+@njit(cache=True, parallel=True)
+def _chunks_parallel(bounds, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc,
+                     fncx, fncy, fncz, fcs, fstart, forder, fxs, r_s, w_s, sep):
+    """The pair and separation sums, chunk ``k`` of each on thread ``k``."""
+    nchunks = bounds.shape[0] - 1
+    n = fxs.shape[1]
+    for k in prange(nchunks):
+        _pairs_chunk(bounds[k], bounds[k + 1], nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc)
+        _separation_chunk(k * n // nchunks, (k + 1) * n // nchunks, fncx, fncy, fncz, fcs, fstart, forder, fxs,
+                          r_s, w_s, sep)
 
 
 @njit(cache=True)
@@ -457,17 +474,17 @@ def _forces(x, v, types, wa, wc, c, planar, dv, nchunks):
     threads if ``nchunks > 1`` (the result is the same: each sum's order is fixed by the agents'
     indices)."""
     n = x.shape[0]
-    par = nchunks > 1
     (nz, start, pos, cs, ts, xs, vs, wcs, was, hstart, halo, bounds,
-     fx, fy, fz, fcell, fstart, forder) = _prepare(x, v, types, wa, wc, c, planar, nchunks)
+     fx, fy, fz, fcs, fstart, forder, fxs) = _prepare(x, v, types, wa, wc, c, planar, nchunks)
     acc = np.zeros((8, n))
     sep = np.empty((3, n))
-    if par:
-        _pairs_par(bounds, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, c[2] * c[2], c[1] * c[1], acc)
-        _separation_par(x, nchunks, fx, fy, fz, fcell, fstart, forder, c[0], c[3], sep)
+    r_c2, r_a2 = c[2] * c[2], c[1] * c[1]
+    if nchunks > 1:
+        _chunks_parallel(bounds, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc,
+                         fx, fy, fz, fcs, fstart, forder, fxs, c[0], c[3], sep)
     else:
-        _pairs_ser(bounds, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, c[2] * c[2], c[1] * c[1], acc)
-        _separation_ser(x, nchunks, fx, fy, fz, fcell, fstart, forder, c[0], c[3], sep)
+        _pairs_chunk(0, n, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc)
+        _separation_chunk(0, n, fx, fy, fz, fcs, fstart, forder, fxs, c[0], c[3], sep)
     _combine(x, pos, acc, sep, c, planar, dv)
 
 
