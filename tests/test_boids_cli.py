@@ -1,5 +1,5 @@
 """Boids commands and sweeps: JSON keys, trajectories on disk, one-sentence errors, and the same
-sweep table on the serial and the process-pool evaluator."""
+sweep table on the serial, the process-pool and the Ray evaluator."""
 
 from __future__ import annotations
 
@@ -68,3 +68,16 @@ def test_sweep_same_table_on_serial_and_process():
     b = run_sweep(sweep, [[0.5, -0.2]], [0, 1], executor="process", workers=2)
     assert a["rows"] == b["rows"] and len(a["rows"]) == 4
     assert set(a["rows"][0]) >= set(OUTPUTS) | {"seed", "wa_cross"}
+
+
+def test_sweep_same_table_on_ray():
+    """The sweep on the project's Ray evaluator (the one the evolution uses) gives the serial table."""
+    ray = pytest.importorskip("ray")
+    sweep = Sweep(load_preset("4c"), ("wc_cross",), n=80, n_steps=200)
+    a = run_sweep(sweep, [[0.002, 0.006]], [3], executor="serial")
+    ray.init(num_cpus=2, include_dashboard=False)
+    try:
+        b = run_sweep(sweep, [[0.002, 0.006]], [3], executor="ray", workers=2)
+    finally:
+        ray.shutdown()
+    assert a["rows"] == b["rows"] and len(a["rows"]) == 2

@@ -21,7 +21,8 @@ def test_grid_engine_equals_all_pairs_reference_over_100_steps(dims):
         step_grid(x, v, t, p)
         step_reference(x2, v2, t, p)
         worst = max(worst, float(np.max(np.abs(x - x2))), float(np.max(np.abs(v - v2))))
-    assert worst <= 1e-12
+    # the issue asks for 1e-12; both sum each force in ascending neighbour index, so they agree exactly
+    assert worst == 0.0
 
 
 def test_three_types_and_walls_equal_the_reference():
@@ -34,7 +35,22 @@ def test_three_types_and_walls_equal_the_reference():
     for _ in range(40):
         step_grid(x, v, t, p)
         step_reference(x2, v2, t, p)
-    assert np.max(np.abs(x - x2)) <= 1e-12 and set(np.unique(t)) == {0, 1, 2}
+    assert np.array_equal(x, x2) and np.array_equal(v, v2) and set(np.unique(t)) == {0, 1, 2}
+
+
+@pytest.mark.parametrize("dims", [3, 2])
+def test_result_does_not_depend_on_the_number_of_threads(monkeypatch, dims):
+    """The parallel path (chunks on all threads) gives the serial path's run bit for bit."""
+    from lifelike_mj.boids import engine
+
+    p = load_preset("5a", dims=dims)
+    runs = []
+    for parallel_from in (10**9, 0):
+        monkeypatch.setattr(engine, "PARALLEL_FROM", parallel_from)
+        x, v, t = initial_state(p, 400, seed=2)
+        step_grid(x, v, t, p, 120)
+        runs.append((x, v))
+    assert np.array_equal(runs[0][0], runs[1][0]) and np.array_equal(runs[0][1], runs[1][1])
 
 
 def test_same_seed_same_run_and_recording():
