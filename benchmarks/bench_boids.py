@@ -25,6 +25,10 @@ def main() -> None:
     write_json(args.out, r)
     print("| measure | median | goal |\n|---|---|---|")
     print(f"| n = 300, 3D, preset {r['preset']}, agent-steps per s | {r['agent_steps_per_s_n300']:.3g} | >= 2e6 |")
+    print(f"| n = 300, 3D, same, all {r['threads']} threads | {r['agent_steps_per_s_n300_all_threads']:.3g} | |")
+    whole = r["agent_steps_per_s_n300_whole_runs"]
+    print(f"| n = 300, whole 10,000-step runs of the eight patterns, median (min-max) | "
+          f"{r['agent_steps_per_s_n300_whole_runs_median']:.3g} ({min(whole.values()):.3g}-{max(whole.values()):.3g}) | |")
     print(f"| n = 300, 2D, agent-steps per s | {r['agent_steps_per_s_n300_2d']:.3g} | |")
     print(f"| NumPy all-pairs peer, n = 300, 3D | {r['numpy_all_pairs_agent_steps_per_s_n300']:.3g} "
           f"(engine x{r['numpy_ratio']:.1f}) | |")

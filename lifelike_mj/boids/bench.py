@@ -17,10 +17,12 @@ import sys
 import time
 from dataclasses import replace
 
+import numba
 import numpy as np
 
-from lifelike_mj.boids.engine import BOX, N_AGENTS, BoidParams, initial_state, step_grid
-from lifelike_mj.boids.presets import load_preset
+from lifelike_mj.boids import engine
+from lifelike_mj.boids.engine import BOX, N_AGENTS, BoidParams, initial_state, simulate, step_grid
+from lifelike_mj.boids.presets import PATTERNS, load_preset
 from lifelike_mj.machine import machine_info
 
 #: Steps timed from the random start in the scaling runs.
@@ -43,14 +45,23 @@ print(json.dumps({"agent_steps_per_s": statistics.median(rates), "samples": rate
 """
 
 
-def _rate(params: BoidParams, n: int, steps: int, warmup: int, repeats: int, seed: int = 0) -> list[float]:
-    x, v, t = initial_state(params, n, seed)
-    step_grid(x, v, t, params, warmup)
-    rates = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        step_grid(x, v, t, params, steps)
-        rates.append(n * steps / (time.perf_counter() - t0))
+def _rate(params: BoidParams, n: int, steps: int, warmup: int, repeats: int, seed: int = 0,
+          parallel: bool | None = None) -> list[float]:
+    """Agent-steps per second over ``steps`` steps after ``warmup`` steps, ``repeats`` times; with
+    ``parallel`` True (False) the forces run on all threads (one thread) whatever ``n``."""
+    saved = engine.PARALLEL_FROM
+    if parallel is not None:
+        engine.PARALLEL_FROM = 0 if parallel else 1 << 62
+    try:
+        x, v, t = initial_state(params, n, seed)
+        step_grid(x, v, t, params, warmup)
+        rates = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            step_grid(x, v, t, params, steps)
+            rates.append(n * steps / (time.perf_counter() - t0))
+    finally:
+        engine.PARALLEL_FROM = saved
     return rates
 
 
@@ -102,10 +113,26 @@ def _mesa(n: int, width: float, vision: float, steps: int, repeats: int, mesa_py
 def run(repeats: int = 3, max_n: int = 1_000_000, mesa_python: str | None = None, preset: str = "5a") -> dict:
     base = load_preset(preset)
     out: dict = {"preset": preset}
-    # n = 300, the paper's settings, 3D, once the flock has formed (after 1,000 steps)
-    r300 = _rate(base, N_AGENTS, 2000, 1000, repeats)
+    # n = 300, the paper's settings, 3D, once the flock has formed (after 1,000 steps): the default
+    # path (one thread at this size), and the same on all threads, timed in turn
+    r300, r300_par = [], []
+    for _ in range(repeats):
+        r300 += _rate(base, N_AGENTS, 2000, 1000, 1)
+        r300_par += _rate(base, N_AGENTS, 2000, 1000, 1, parallel=True)
     out["agent_steps_per_s_n300"] = statistics.median(r300)
     out["n300_samples"] = r300
+    out["agent_steps_per_s_n300_all_threads"] = statistics.median(r300_par)
+    out["n300_all_threads_samples"] = r300_par
+    out["threads"] = numba.get_num_threads()
+    # whole runs of the paper (10,000 steps from the random start, seed 0), each of the eight patterns
+    whole = {}
+    for name in PATTERNS:
+        p = load_preset(name)
+        t0 = time.perf_counter()
+        simulate(p, N_AGENTS, 10_000, seed=0, record_every=10_000)
+        whole[name] = N_AGENTS * 10_000 / (time.perf_counter() - t0)
+    out["agent_steps_per_s_n300_whole_runs"] = whole
+    out["agent_steps_per_s_n300_whole_runs_median"] = statistics.median(whole.values())
     # scaling at the paper's density: the box grows as n^(1/3); the first 20 steps from the random
     # start (the flocks have not formed yet, so every n is timed at the same density), repeated
     # from the same start until at least 3e6 agent-steps are timed

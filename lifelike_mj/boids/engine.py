@@ -160,26 +160,37 @@ FINE_CELLS_MIN = 1 << 16
 
 
 @njit(cache=True)
-def _grid(x, size_min, planar, max_cells):
-    """A uniform grid over the agents' bounding box, cells at least ``size_min`` wide (a hair more,
-    so that rounding never puts two agents closer than ``size_min`` two cells apart), at most
-    ``max_cells`` cells: ``(ncx, ncy, ncz, cell, start, pos)``. The agents are counting-sorted by
-    cell (x, then y, then z), by index within a cell: agent ``i`` is at sorted position ``pos[i]``,
-    cell ``c`` holds the sorted positions ``start[c] .. start[c + 1] - 1``."""
-    n = x.shape[0]
+def _bbox(x, planar):
+    """The agents' bounding box: ``(lo, ext)``, each (3,) (z: 0 in 2D)."""
     lo = np.zeros(3)
+    hi = np.zeros(3)
+    d = 2 if planar else 3
+    for a in range(d):
+        lo[a] = hi[a] = x[0, a]
+    for i in range(1, x.shape[0]):
+        for a in range(d):
+            lo[a] = min(lo[a], x[i, a])
+            hi[a] = max(hi[a], x[i, a])
+    return lo, hi - lo
+
+
+@njit(cache=True)
+def _grid(x, lo, ext, size_min, planar, max_cells):
+    """A uniform grid over the box ``lo .. lo + ext`` holding the agents, cells at least ``size_min``
+    wide (a hair more, so that rounding never puts two agents closer than ``size_min`` two cells
+    apart), at most ``max_cells`` cells: ``(ncx, ncy, ncz, cell, start, pos)``. The agents are
+    counting-sorted by cell (x, then y, then z), by index within a cell: agent ``i`` is at sorted
+    position ``pos[i]``, cell ``c`` holds the sorted positions ``start[c] .. start[c + 1] - 1``."""
+    n = x.shape[0]
     inv = np.zeros(3)
     nn = np.ones(3, dtype=np.int64)
     for a in range(2 if planar else 3):
-        lo[a] = x[:, a].min()
-        ext = x[:, a].max() - lo[a]
-        nn[a] = max(1, int(ext / (size_min * (1.0 + 1e-9))))
+        nn[a] = max(1, int(ext[a] / (size_min * (1.0 + 1e-9))))
     while nn[0] * nn[1] * nn[2] > max_cells:
         nn[np.argmax(nn)] -= 1
     for a in range(2 if planar else 3):
-        ext = x[:, a].max() - lo[a]
-        if ext > 0.0:
-            inv[a] = nn[a] / ext
+        if ext[a] > 0.0:
+            inv[a] = nn[a] / ext[a]
     ncx, ncy, ncz = nn[0], nn[1], nn[2]
     cell = np.empty(n, dtype=np.int64)
     for i in range(n):
@@ -208,7 +219,8 @@ def _prepare(x, v, types, wa, wc, c, planar, nchunks):
     type ``t``), the halo lists, ``nchunks`` ranges of sorted positions of about equal work, and the
     fine grid of the separation zone."""
     n = x.shape[0]
-    ncx, ncy, nz, cell, start, pos = _grid(x, c[2], planar, 1 << 40)
+    lo, ext = _bbox(x, planar)
+    ncx, ncy, nz, cell, start, pos = _grid(x, lo, ext, c[2], planar, 1 << 40)
     k = wa.shape[0]
     xs = np.empty((3, n))
     vs = np.empty((3, n))
@@ -271,7 +283,7 @@ def _prepare(x, v, types, wa, wc, c, planar, nchunks):
         q = cs[p] // nz
         done += hstart[q + 1] - hstart[q]
     # the fine grid of the separation zone, its agents in fine cell order
-    fx, fy, fz, fcell, fstart, fpos = _grid(x, c[0], planar, max(FINE_CELLS_MIN, 8 * n))
+    fx, fy, fz, fcell, fstart, fpos = _grid(x, lo, ext, c[0], planar, max(FINE_CELLS_MIN, 8 * n))
     forder = np.empty(n, dtype=np.int64)
     fxs = np.empty((3, n))
     fcs = np.empty(n, dtype=np.int64)
