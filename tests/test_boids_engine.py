@@ -25,6 +25,25 @@ def test_grid_engine_equals_all_pairs_reference_over_100_steps(dims):
     assert worst == 0.0
 
 
+@pytest.mark.parametrize("dims", [3, 2])
+def test_sparse_path_equals_the_reference(dims):
+    """Sparse cells (a few agents each) take the engine's other path (plain loops, separation summed
+    in the same pass); it too equals the reference bit for bit."""
+    from dataclasses import replace
+
+    from lifelike_mj.boids import engine
+
+    p = replace(load_preset("5a", dims=dims), box=34.0)
+    x, v, t = initial_state(p, 400, seed=5)
+    wa, wc, c = p.arrays()
+    assert engine._prepare(engine._as3(x), engine._as3(v), t, wa, wc, c, dims == 2, 1)[0]  # the sparse path
+    x2, v2 = x.copy(), v.copy()
+    for _ in range(12):
+        step_grid(x, v, t, p)
+        step_reference(x2, v2, t, p)
+    assert np.array_equal(x, x2) and np.array_equal(v, v2)
+
+
 def test_three_types_and_walls_equal_the_reference():
     """k = 3 types, agents started near the walls (wall avoidance and reflection both act)."""
     p = BoidParams(wa=((0.5, 0.1, 0.0), (0.1, 0.5, 0.2), (0.0, 0.3, 0.5)),
@@ -38,12 +57,15 @@ def test_three_types_and_walls_equal_the_reference():
     assert np.array_equal(x, x2) and np.array_equal(v, v2) and set(np.unique(t)) == {0, 1, 2}
 
 
-@pytest.mark.parametrize("dims", [3, 2])
-def test_result_does_not_depend_on_the_number_of_threads(monkeypatch, dims):
-    """The parallel path (chunks on all threads) gives the serial path's run bit for bit."""
+@pytest.mark.parametrize("dims,box", [(3, 20.0), (2, 20.0), (3, 40.0)])
+def test_result_does_not_depend_on_the_number_of_threads(monkeypatch, dims, box):
+    """The parallel path (chunks on all threads) gives the serial path's run bit for bit (box 40: the
+    sparse path)."""
+    from dataclasses import replace
+
     from lifelike_mj.boids import engine
 
-    p = load_preset("5a", dims=dims)
+    p = replace(load_preset("5a", dims=dims), box=box)
     runs = []
     for parallel_from in (10**9, 0):
         monkeypatch.setattr(engine, "PARALLEL_FROM", parallel_from)

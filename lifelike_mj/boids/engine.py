@@ -155,8 +155,9 @@ def initial_state(params: BoidParams, n: int, seed: int, margin: float | None = 
 # vectorises it. Separation, a few neighbours per agent, uses a finer grid and sorts each agent's
 # separation neighbours by index.
 
-#: The fine grid of the separation zone has at most this many cells, or 8 per agent if more.
-FINE_CELLS_MIN = 1 << 16
+#: The fine grid of the separation zone has at most this many cells, or 2 per agent if more (a
+#: bigger grid is mostly empty cells and cache misses at large n).
+FINE_CELLS_MIN = 1 << 12
 
 
 @njit(cache=True)
@@ -213,6 +214,49 @@ def _grid(x, lo, ext, size_min, planar, max_cells):
 
 
 @njit(cache=True)
+def _fill_chunk(k, nchunks, cols, x, v, types, wa, wc, nz, cell, pos, order, naround, around, hstart,
+                fcell, forder, xs, vs, cs, zs, ts, wcs, was, halo, fxs, fcs, fine):
+    """Part ``k`` of ``nchunks`` of the copies in sorted order (gathered: sequential writes, much
+    faster than scattering at large n) and of the halo lists (columns ``cols[k] .. cols[k + 1] - 1``,
+    filled by one pass over the agents in index order)."""
+    n = x.shape[0]
+    for p in range(k * n // nchunks, (k + 1) * n // nchunks):
+        i = order[p]
+        for a in range(3):
+            xs[a, p] = x[i, a]
+            vs[a, p] = v[i, a]
+        cs[p] = cell[i]
+        zs[p] = cell[i] % nz
+        ts[p] = types[i]
+        for t in range(wa.shape[0]):
+            wcs[t, p] = wc[types[i], t]
+            was[t, p] = wa[types[i], t]
+        if fine:
+            i = forder[p]
+            fcs[p] = fcell[i]
+            for a in range(3):
+                fxs[a, p] = x[i, a]
+    q0, q1 = cols[k], cols[k + 1]
+    fill = hstart[q0:q1].copy()
+    for i in range(n):
+        q = cell[i] // nz
+        for s in range(naround[q]):
+            b = around[q, s]
+            if q0 <= b < q1:
+                halo[fill[b - q0]] = pos[i]
+                fill[b - q0] += 1
+
+
+@njit(cache=True, parallel=True)
+def _fill_parallel(nchunks, cols, x, v, types, wa, wc, nz, cell, pos, order, naround, around, hstart,
+                   fcell, forder, xs, vs, cs, zs, ts, wcs, was, halo, fxs, fcs, fine):
+    """:func:`_fill_chunk`, part ``k`` on thread ``k``."""
+    for k in prange(nchunks):
+        _fill_chunk(k, nchunks, cols, x, v, types, wa, wc, nz, cell, pos, order, naround, around, hstart,
+                    fcell, forder, xs, vs, cs, zs, ts, wcs, was, halo, fxs, fcs, fine)
+
+
+@njit(cache=True)
 def _prepare(x, v, types, wa, wc, c, planar, nchunks):
     """Everything the pair loops read: the R_c grid, the agents' state in sorted order (rows x, y, z),
     per-position weight columns (``wcs[t, p]``: the weight of the agent at ``p`` for a neighbour of
@@ -222,22 +266,9 @@ def _prepare(x, v, types, wa, wc, c, planar, nchunks):
     lo, ext = _bbox(x, planar)
     ncx, ncy, nz, cell, start, pos = _grid(x, lo, ext, c[2], planar, 1 << 40)
     k = wa.shape[0]
-    xs = np.empty((3, n))
-    vs = np.empty((3, n))
-    cs = np.empty(n, dtype=np.int64)
-    ts = np.empty(n, dtype=np.int64)
-    wcs = np.empty((k, n))
-    was = np.empty((k, n))
+    order = np.empty(n, dtype=np.int64)
     for i in range(n):
-        p = pos[i]
-        for a in range(3):
-            xs[a, p] = x[i, a]
-            vs[a, p] = v[i, a]
-        cs[p] = cell[i]
-        ts[p] = types[i]
-        for t in range(k):
-            wcs[t, p] = wc[types[i], t]
-            was[t, p] = wa[types[i], t]
+        order[pos[i]] = i
     # halo lists: for each occupied column (fixed x and y cell), the sorted positions of the agents
     # of the occupied columns around it (3 x 3), in ascending agent index (the order of the sums)
     ncol = ncx * ncy
@@ -260,18 +291,52 @@ def _prepare(x, v, types, wa, wc, c, planar, nchunks):
                     hstart[b + 1] += occupied[q]
     for q in range(ncol):
         hstart[q + 1] += hstart[q]
-    fill = hstart[:-1].copy()
-    halo = np.empty(hstart[ncol], dtype=np.int64)
-    for i in range(n):
-        q = cell[i] // nz
-        for s in range(naround[q]):
-            b = around[q, s]
-            halo[fill[b]] = pos[i]
-            fill[b] += 1
-    # chunks of equal work: an agent's work is its column's halo length
+    # chunks of equal work: an agent's work is its column's halo length; the halo lists are
+    # filled in chunks of columns of equal length
     total = 0
     for q in range(ncol):
         total += occupied[q] * (hstart[q + 1] - hstart[q])
+    cols = np.full(nchunks + 1, ncol, dtype=np.int64)
+    cols[0] = 0
+    kk = 1
+    for q in range(ncol):
+        while kk < nchunks and hstart[q] * nchunks >= kk * hstart[ncol]:
+            cols[kk] = q
+            kk += 1
+    # sparse (runs of agents shorter than SHORT_RUN on average): every pass takes the plain loop,
+    # which adds the separation terms too; else the separation runs on a fine grid
+    ncells_occupied = 0
+    for q in range(ncol * nz):
+        if start[q + 1] > start[q]:
+            ncells_occupied += 1
+    sparse = n * min(3, nz) < SHORT_RUN * ncells_occupied
+    # the fine grid of the separation zone, its agents in fine cell order
+    if sparse:
+        fx, fy, fz = 1, 1, 1
+        fcell = np.zeros(n, dtype=np.int64)
+        fstart = np.zeros(2, dtype=np.int64)
+        fpos = np.arange(n)
+    else:
+        fx, fy, fz, fcell, fstart, fpos = _grid(x, lo, ext, c[0], planar, max(FINE_CELLS_MIN, 2 * n))
+    forder = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        forder[fpos[i]] = i
+    xs = np.empty((3, n))
+    vs = np.empty((3, n))
+    cs = np.empty(n, dtype=np.int64)
+    zs = np.empty(n, dtype=np.int64)
+    ts = np.empty(n, dtype=np.int64)
+    wcs = np.empty((k, n))
+    was = np.empty((k, n))
+    halo = np.empty(hstart[ncol], dtype=np.int64)
+    fxs = np.empty((3, n))
+    fcs = np.empty(n, dtype=np.int64)
+    if nchunks > 1:
+        _fill_parallel(nchunks, cols, x, v, types, wa, wc, nz, cell, pos, order, naround, around, hstart,
+                       fcell, forder, xs, vs, cs, zs, ts, wcs, was, halo, fxs, fcs, not sparse)
+    else:
+        _fill_chunk(0, 1, cols, x, v, types, wa, wc, nz, cell, pos, order, naround, around, hstart,
+                    fcell, forder, xs, vs, cs, zs, ts, wcs, was, halo, fxs, fcs, not sparse)
     bounds = np.full(nchunks + 1, n, dtype=np.int64)
     bounds[0] = 0
     done = 0
@@ -282,25 +347,22 @@ def _prepare(x, v, types, wa, wc, c, planar, nchunks):
             kk += 1
         q = cs[p] // nz
         done += hstart[q + 1] - hstart[q]
-    # the fine grid of the separation zone, its agents in fine cell order
-    fx, fy, fz, fcell, fstart, fpos = _grid(x, lo, ext, c[0], planar, max(FINE_CELLS_MIN, 8 * n))
-    forder = np.empty(n, dtype=np.int64)
-    fxs = np.empty((3, n))
-    fcs = np.empty(n, dtype=np.int64)
-    for i in range(n):
-        p = fpos[i]
-        forder[p] = i
-        fcs[p] = fcell[i]
-        for a in range(3):
-            fxs[a, p] = x[i, a]
-    return nz, start, pos, cs, ts, xs, vs, wcs, was, hstart, halo, bounds, fx, fy, fz, fcs, fstart, forder, fxs
+    return (sparse, nz, start, order, cs, zs, ts, xs, vs, wcs, was, hstart, halo, bounds,
+            fx, fy, fz, fcs, fstart, forder, fxs)
+
+
+#: Runs of fewer agents than this take a plain loop: the vector loop's set-up (run-time alias checks
+#: of its 16 arrays) costs more than it saves on a short run (measured; docs/performance.md).
+SHORT_RUN = 24
 
 
 @njit(cache=True)
-def _pairs_chunk(p0, p1, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc):
+def _pairs_chunk(p0, p1, nz, start, cs, zs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc, sparse, r_s2,
+                 w_s):
     """Cohesion and alignment sums and neighbour counts of the agents at sorted positions ``p0 ..
     p1 - 1`` (chunks on parallel threads write disjoint positions). ``acc`` rows: cohesion x, y, z,
-    alignment x, y, z, N_c + 1, N_a + 1 (an agent meets itself once, with zero terms).
+    alignment x, y, z, N_c + 1, N_a + 1 (an agent meets itself once, with zero terms), and, if
+    ``sparse``, separation x, y, z (every pass then takes the plain loop, which adds them too).
 
     A neighbour j is applied to the agents of the column in its own and the adjacent z cells. Two
     consecutive halo agents j < k in the same or adjacent z cells are applied in one pass (first
@@ -310,6 +372,7 @@ def _pairs_chunk(p0, p1, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2
     xs0, xs1, xs2 = xs[0], xs[1], xs[2]
     vs0, vs1, vs2 = vs[0], vs[1], vs[2]
     cx, cy, cz, ax, ay, az, ncn, nan = acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7]
+    sx, sy, sz = acc[8], acc[9], acc[10]
     if p0 < p1:
         for q in range(cs[p0] // nz, cs[p1 - 1] // nz + 1):
             a = max(start[q * nz], p0)
@@ -320,27 +383,74 @@ def _pairs_chunk(p0, p1, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2
             h1 = hstart[q + 1]
             while h < h1:
                 pj = halo[h]
-                qj = cs[pj] % nz
+                qj = zs[pj]
                 pk = pj
                 qk = qj
                 on = 0.0  # 1 when a second agent k is applied in this pass
-                if h + 1 < h1 and abs(cs[halo[h + 1]] % nz - qj) <= 1:
+                if h + 1 < h1 and abs(zs[halo[h + 1]] - qj) <= 1:
                     pk = halo[h + 1]
-                    qk = cs[pk] % nz
+                    qk = zs[pk]
                     on = 1.0
                 h += 2 if on > 0.0 else 1
                 r0 = max(start[q * nz + max(min(qj, qk) - 1, 0)], a)
                 r1 = min(start[q * nz + min(max(qj, qk) + 1, nz - 1) + 1], b)
                 if r0 >= r1:
                     continue
-                r1 = min(r1 + (r0 - r1) % 8, b)
-                r0 = max(r0 - (r0 - r1) % 8, a)
                 xj0, xj1, xj2 = xs0[pj], xs1[pj], xs2[pj]
                 xk0, xk1, xk2 = xs0[pk], xs1[pk], xs2[pk]
                 vj0, vj1, vj2 = vs0[pj], vs1[pj], vs2[pj]
                 vk0, vk1, vk2 = vs0[pk], vs1[pk], vs2[pk]
-                wcj, wck = wcs[ts[pj]], wcs[ts[pk]]
-                waj, wak = was[ts[pj]], was[ts[pk]]
+                tj, tk = ts[pj], ts[pk]  # (rows of wcs/was indexed in place: a row view costs reference counting)
+                if sparse or r1 - r0 < SHORT_RUN:
+                    # a short run (sparse cells): a plain loop, whose set-up costs less than the
+                    # vector loop's (signed indices keep the compiler from vectorising it)
+                    for p in range(r0, r1):
+                        ex = xs0[p] - xj0
+                        ey = xs1[p] - xj1
+                        ez = xs2[p] - xj2
+                        d2 = ex * ex + ey * ey + ez * ez
+                        if d2 < r_c2:
+                            ncn[p] += 1.0
+                            w = wcs[tj, p]
+                            cx[p] += -(w * ex)
+                            cy[p] += -(w * ey)
+                            cz[p] += -(w * ez)
+                            if d2 < r_a2:
+                                nan[p] += 1.0
+                                w = was[tj, p]
+                                ax[p] += w * (vj0 - vs0[p])
+                                ay[p] += w * (vj1 - vs1[p])
+                                az[p] += w * (vj2 - vs2[p])
+                                if sparse and d2 < r_s2 and d2 > 0.0:
+                                    w = w_s / math.sqrt(d2)
+                                    sx[p] += w * ex
+                                    sy[p] += w * ey
+                                    sz[p] += w * ez
+                        if on > 0.0:
+                            ex = xs0[p] - xk0
+                            ey = xs1[p] - xk1
+                            ez = xs2[p] - xk2
+                            d2 = ex * ex + ey * ey + ez * ez
+                            if d2 < r_c2:
+                                ncn[p] += 1.0
+                                w = wcs[tk, p]
+                                cx[p] += -(w * ex)
+                                cy[p] += -(w * ey)
+                                cz[p] += -(w * ez)
+                                if d2 < r_a2:
+                                    nan[p] += 1.0
+                                    w = was[tk, p]
+                                    ax[p] += w * (vk0 - vs0[p])
+                                    ay[p] += w * (vk1 - vs1[p])
+                                    az[p] += w * (vk2 - vs2[p])
+                                    if sparse and d2 < r_s2 and d2 > 0.0:
+                                        w = w_s / math.sqrt(d2)
+                                        sx[p] += w * ex
+                                        sy[p] += w * ey
+                                        sz[p] += w * ez
+                    continue
+                r1 = min(r1 + (r0 - r1) % 8, b)
+                r0 = max(r0 - (r0 - r1) % 8, a)
                 # unsigned indices (no negative-index wraparound) let the loops vectorise
                 for p in range(np.uint64(r0), np.uint64(r1)):
                     ex = xs0[p] - xj0
@@ -352,8 +462,8 @@ def _pairs_chunk(p0, p1, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2
                     m = 1.0 if ex * ex + ey * ey + ez * ez < r_c2 else 0.0
                     mk = on if fx * fx + fy * fy + fz * fz < r_c2 else 0.0
                     ncn[p] += m + mk
-                    w = wcj[p] * m
-                    wk = wck[p] * mk
+                    w = wcs[tj, p] * m
+                    wk = wcs[tk, p] * mk
                     cx[p] = (cx[p] + -(w * ex)) + -(wk * fx)
                     cy[p] = (cy[p] + -(w * ey)) + -(wk * fy)
                     cz[p] = (cz[p] + -(w * ez)) + -(wk * fz)
@@ -367,8 +477,8 @@ def _pairs_chunk(p0, p1, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2
                     m = 1.0 if ex * ex + ey * ey + ez * ez < r_a2 else 0.0
                     mk = on if fx * fx + fy * fy + fz * fz < r_a2 else 0.0
                     nan[p] += m + mk
-                    w = waj[p] * m
-                    wk = wak[p] * mk
+                    w = was[tj, p] * m
+                    wk = was[tk, p] * mk
                     vp = vs0[p]
                     ax[p] = (ax[p] + w * (vj0 - vp)) + wk * (vk0 - vp)
                     vp = vs1[p]
@@ -440,22 +550,23 @@ def _separation_chunk(s0, s1, fncx, fncy, fncz, fcs, fstart, forder, fxs, r_s, w
 
 
 @njit(cache=True)
-def _combine(x, pos, acc, sep, c, planar, dv):
+def _combine(xs, order, acc, sep, c, planar, dv, sparse):
     """dv = dt/m (F_s + F_a + F_c) (eq. 1-2): separation plus wall avoidance (a wall closer than
     R_s adds w_s along its inward normal, after the neighbours' terms), then the alignment and
-    cohesion averages (eq. 6-9)."""
-    n = x.shape[0]
+    cohesion averages (eq. 6-9). In sorted order (``xs``: positions in sorted order, ``order[p]``: the
+    agent at sorted position p)."""
+    n = xs.shape[1]
     r_s, w_s, box, dt_m = c[0], c[3], c[4], c[5]
-    for i in range(n):
-        p = pos[i]
+    for p in range(n):
+        i = order[p]
         na = acc[7, p] - 1.0
         nc = acc[6, p] - 1.0
         for a in range(3):
-            f = sep[a, i]
+            f = acc[8 + a, p] if sparse else sep[a, i]
             if a < 2 or not planar:
-                if x[i, a] < r_s:
+                if xs[a, p] < r_s:
                     f += w_s
-                if box - x[i, a] < r_s:
+                if box - xs[a, p] < r_s:
                     f += -w_s
             if na > 0.0:
                 f += acc[3 + a, p] / na
@@ -469,15 +580,17 @@ PARALLEL_FROM = 2000
 
 
 @njit(cache=True, parallel=True)
-def _chunks_parallel(bounds, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc,
+def _chunks_parallel(bounds, nz, start, cs, zs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc, sparse,
                      fncx, fncy, fncz, fcs, fstart, forder, fxs, r_s, w_s, sep):
     """The pair and separation sums, chunk ``k`` of each on thread ``k``."""
     nchunks = bounds.shape[0] - 1
     n = fxs.shape[1]
     for k in prange(nchunks):
-        _pairs_chunk(bounds[k], bounds[k + 1], nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc)
-        _separation_chunk(k * n // nchunks, (k + 1) * n // nchunks, fncx, fncy, fncz, fcs, fstart, forder, fxs,
-                          r_s, w_s, sep)
+        _pairs_chunk(bounds[k], bounds[k + 1], nz, start, cs, zs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2,
+                     acc, sparse, r_s * r_s, w_s)
+        if not sparse:
+            _separation_chunk(k * n // nchunks, (k + 1) * n // nchunks, fncx, fncy, fncz, fcs, fstart, forder, fxs,
+                              r_s, w_s, sep)
 
 
 @njit(cache=True)
@@ -486,18 +599,20 @@ def _forces(x, v, types, wa, wc, c, planar, dv, nchunks):
     threads if ``nchunks > 1`` (the result is the same: each sum's order is fixed by the agents'
     indices)."""
     n = x.shape[0]
-    (nz, start, pos, cs, ts, xs, vs, wcs, was, hstart, halo, bounds,
+    (sparse, nz, start, order, cs, zs, ts, xs, vs, wcs, was, hstart, halo, bounds,
      fx, fy, fz, fcs, fstart, forder, fxs) = _prepare(x, v, types, wa, wc, c, planar, nchunks)
-    acc = np.zeros((8, n))
+    acc = np.zeros((11, n))
     sep = np.empty((3, n))
     r_c2, r_a2 = c[2] * c[2], c[1] * c[1]
     if nchunks > 1:
-        _chunks_parallel(bounds, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc,
+        _chunks_parallel(bounds, nz, start, cs, zs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc, sparse,
                          fx, fy, fz, fcs, fstart, forder, fxs, c[0], c[3], sep)
     else:
-        _pairs_chunk(0, n, nz, start, cs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc)
-        _separation_chunk(0, n, fx, fy, fz, fcs, fstart, forder, fxs, c[0], c[3], sep)
-    _combine(x, pos, acc, sep, c, planar, dv)
+        _pairs_chunk(0, n, nz, start, cs, zs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc, sparse,
+                     c[0] * c[0], c[3])
+        if not sparse:
+            _separation_chunk(0, n, fx, fy, fz, fcs, fstart, forder, fxs, c[0], c[3], sep)
+    _combine(xs, order, acc, sep, c, planar, dv, sparse)
 
 
 @njit(cache=True)
