@@ -405,44 +405,27 @@ def _pairs_chunk(p0, p1, nz, start, cs, zs, ts, hstart, halo, xs, vs, wcs, was, 
                     # a short run (sparse cells): a plain loop, whose set-up costs less than the
                     # vector loop's (signed indices keep the compiler from vectorising it)
                     for p in range(r0, r1):
-                        ex = xs0[p] - xj0
-                        ey = xs1[p] - xj1
-                        ez = xs2[p] - xj2
-                        d2 = ex * ex + ey * ey + ez * ez
-                        if d2 < r_c2:
-                            ncn[p] += 1.0
-                            w = wcs[tj, p]
-                            cx[p] += -(w * ex)
-                            cy[p] += -(w * ey)
-                            cz[p] += -(w * ez)
-                            if d2 < r_a2:
-                                nan[p] += 1.0
-                                w = was[tj, p]
-                                ax[p] += w * (vj0 - vs0[p])
-                                ay[p] += w * (vj1 - vs1[p])
-                                az[p] += w * (vj2 - vs2[p])
-                                if sparse and d2 < r_s2 and d2 > 0.0:
-                                    w = w_s / math.sqrt(d2)
-                                    sx[p] += w * ex
-                                    sy[p] += w * ey
-                                    sz[p] += w * ez
-                        if on > 0.0:
-                            ex = xs0[p] - xk0
-                            ey = xs1[p] - xk1
-                            ez = xs2[p] - xk2
+                        for u in range(2 if on > 0.0 else 1):  # j's terms, then k's
+                            if u == 0:
+                                y0, y1, y2, u0, u1, u2, tu = xj0, xj1, xj2, vj0, vj1, vj2, tj
+                            else:
+                                y0, y1, y2, u0, u1, u2, tu = xk0, xk1, xk2, vk0, vk1, vk2, tk
+                            ex = xs0[p] - y0
+                            ey = xs1[p] - y1
+                            ez = xs2[p] - y2
                             d2 = ex * ex + ey * ey + ez * ez
                             if d2 < r_c2:
                                 ncn[p] += 1.0
-                                w = wcs[tk, p]
+                                w = wcs[tu, p]
                                 cx[p] += -(w * ex)
                                 cy[p] += -(w * ey)
                                 cz[p] += -(w * ez)
                                 if d2 < r_a2:
                                     nan[p] += 1.0
-                                    w = was[tk, p]
-                                    ax[p] += w * (vk0 - vs0[p])
-                                    ay[p] += w * (vk1 - vs1[p])
-                                    az[p] += w * (vk2 - vs2[p])
+                                    w = was[tu, p]
+                                    ax[p] += w * (u0 - vs0[p])
+                                    ay[p] += w * (u1 - vs1[p])
+                                    az[p] += w * (u2 - vs2[p])
                                     if sparse and d2 < r_s2 and d2 > 0.0:
                                         w = w_s / math.sqrt(d2)
                                         sx[p] += w * ex
