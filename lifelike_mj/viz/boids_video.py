@@ -35,7 +35,7 @@ import numpy as np
 
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import atomic_path
-from lifelike_mj.viz.video import _check_size, _Offscreen, _positive, _video_target, _write_frames
+from lifelike_mj.viz.video import _check_size, _Offscreen, _positive, _video_report, _video_target, _write_frames
 from lifelike_mj.viz.viewer import FRAME_S, MAX_CATCH_UP_S, has_display
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -174,16 +174,8 @@ def render_boids(out_path: str | Path, params: BoidParams, n: int = 300, n_steps
                           f"render boids {params.name or ''}".rstrip(), progress)
     finally:
         renderer.close()
-    sim_s, render_s, encode_s = warm_s + t["sim_s"], t["render_s"], t["encode_s"]
-    wall = time.perf_counter() - t_start
     return {
-        "path": str(out),
-        "frames": n_frames,
-        "fps": fps,
-        "width": width,
-        "height": height,
-        "camera": camera,
-        "seconds": n_frames / fps,
+        **_video_report(out, n_frames, fps, width, height, camera, renderer.backend, t, t_start, warm_s),
         "n": run.n,
         "seed": run.seed,
         "preset": params.name,
@@ -191,14 +183,7 @@ def render_boids(out_path: str | Path, params: BoidParams, n: int = 300, n_steps
         "first_step": warmup,
         "last_step": run.step,
         "steps_per_frame": spf,
-        "gl_backend": renderer.backend,
-        "sim_s": sim_s,
-        "render_s": render_s,
-        "encode_s": encode_s,
-        "wall_s": wall,
-        "render_fps": n_frames / render_s if render_s > 0 else float("inf"),
     }
-
 
 def render_frame(params: BoidParams, step: int = 3000, n: int = 300, seed: int = 0, camera: str = "overview",
                  width: int = 640, height: int = 480) -> np.ndarray:

@@ -41,7 +41,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from lifelike_mj.errors import UserError
-from lifelike_mj.viz.video import _check_size, _Offscreen, _positive, _video_target, _write_frames
+from lifelike_mj.viz.video import _check_size, _Offscreen, _positive, _video_report, _video_target, _write_frames
 from lifelike_mj.viz.viewer import FRAME_S, MAX_CATCH_UP_S, has_display
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -207,28 +207,13 @@ def render_fish(out_path: str | Path, params: FishParams, n_fish: int = 10, dura
         t = _write_frames(out, suffix, fps, n_frames, advance, draw, "render fish", progress)
     finally:
         renderer.close()
-    sim_s, render_s, encode_s = t["sim_s"], t["render_s"], t["encode_s"]
-    wall = time.perf_counter() - t_start
     return {
-        "path": str(out),
-        "frames": n_frames,
-        "fps": fps,
-        "width": width,
-        "height": height,
-        "camera": camera,
-        "seconds": n_frames / fps,
+        **_video_report(out, n_frames, fps, width, height, camera, renderer.backend, t, t_start),
         "n_fish": int(sw.scene.n),
         "seed": int(sw.seed),
         "preset": params.name,
-        "gl_backend": renderer.backend,
-        "sim_s": sim_s,
-        "render_s": render_s,
-        "encode_s": encode_s,
-        "wall_s": wall,
-        "render_fps": n_frames / render_s if render_s > 0 else float("inf"),
         "start_s": first * params.control_dt_s,
     }
-
 
 def render_frame(params: FishParams, t_s: float = 5.0, n_fish: int = 10, seed: int = 0, size=None,
                  camera: str = "side", width: int = 640, height: int = 480, follow_fish: int = 0) -> np.ndarray:

@@ -429,6 +429,30 @@ def _write_frames(out: Path, suffix: str, fps: float, n_frames: int, advance: Ca
     return {"sim_s": sim_s, "render_s": render_s, "encode_s": encode_s}
 
 
+def _video_report(out: Path, n_frames: int, fps: float, width: int, height: int, camera: str, gl_backend: str,
+                  times: dict[str, float], t_start: float, warm_s: float = 0.0) -> dict:
+    """The keys every rendered video reports: the file, frames, size, camera, and the wall seconds of
+    simulation (``warm_s`` of warm-up added), rendering and encoding (``times``: from
+    :func:`_write_frames`), the whole call since ``t_start`` (a ``time.perf_counter()``), and the
+    rendering rate."""
+    sim_s, render_s, encode_s = warm_s + times["sim_s"], times["render_s"], times["encode_s"]
+    return {
+        "path": str(out),
+        "frames": n_frames,
+        "fps": fps,
+        "width": width,
+        "height": height,
+        "camera": camera,
+        "seconds": n_frames / fps,
+        "gl_backend": gl_backend,
+        "sim_s": sim_s,
+        "render_s": render_s,
+        "encode_s": encode_s,
+        "wall_s": time.perf_counter() - t_start,
+        "render_fps": n_frames / render_s if render_s > 0 else float("inf"),
+    }
+
+
 def _video_target(out_path: str | Path, width: int, height: int) -> tuple[Path, str]:
     """The video's path and its lower-case suffix (a key of ``_WRITERS``); :class:`UserError` for another
     suffix, a size outside 8-4096 pixels, or an odd size for an MP4."""
