@@ -136,15 +136,23 @@ def accel_histogram(accel: np.ndarray, bins: int = 41, limit: float | None = Non
     return np.histogram(a, bins=bins, range=(-limit, limit))
 
 
-def skewness(x: np.ndarray) -> float:
-    """Sample skewness g1 = m3 / m2^1.5 with population central moments; nan for < 3 samples or no spread."""
+def _centred(x: np.ndarray, min_n: int) -> tuple[np.ndarray, float] | None:
+    """The finite samples' deviations from their mean and the population variance m2; None for
+    fewer than ``min_n`` samples or no spread."""
     a = _finite(x)
-    if a.size < 3:
-        return float("nan")
+    if a.size < min_n:
+        return None
     d = a - a.mean()
     m2 = float(np.mean(d * d))
-    if m2 <= 0:
+    return (d, m2) if m2 > 0 else None
+
+
+def skewness(x: np.ndarray) -> float:
+    """Sample skewness g1 = m3 / m2^1.5 with population central moments; nan for < 3 samples or no spread."""
+    c = _centred(x, 3)
+    if c is None:
         return float("nan")
+    d, m2 = c
     return float(np.mean(d**3) / m2**1.5)
 
 
@@ -180,13 +188,10 @@ def kurtosis(x: np.ndarray) -> float:
     Non-finite samples are ignored; nan for fewer than 4 samples or zero variance. Heavy-tailed
     acceleration (rare bursts among long coasts) gives large positive values.
     """
-    a = _finite(x)
-    if a.size < 4:
+    c = _centred(x, 4)
+    if c is None:
         return float("nan")
-    d = a - a.mean()
-    m2 = float(np.mean(d * d))
-    if m2 <= 0:
-        return float("nan")
+    d, m2 = c
     return float(np.mean(d**4) / (m2 * m2) - 3.0)
 
 
