@@ -434,7 +434,8 @@ def _pairs_chunk(p0, p1, nz, start, cs, zs, ts, hstart, halo, xs, vs, wcs, was, 
                     continue
                 r1 = min(r1 + (r0 - r1) % 8, b)
                 r0 = max(r0 - (r0 - r1) % 8, a)
-                # unsigned indices (no negative-index wraparound) let the loops vectorise
+                # unsigned indices (no negative-index wraparound) let the loops vectorise; cohesion and
+                # alignment stay two loops (fewer arrays each): one fused loop measured slower
                 for p in range(np.uint64(r0), np.uint64(r1)):
                     ex = xs0[p] - xj0
                     ey = xs1[p] - xj1
