@@ -310,17 +310,16 @@ def _prepare(x, v, types, wa, wc, c, planar, nchunks):
         if start[q + 1] > start[q]:
             ncells_occupied += 1
     sparse = n * min(3, nz) < SHORT_RUN * ncells_occupied
-    # the fine grid of the separation zone, its agents in fine cell order
-    if sparse:
-        fx, fy, fz = 1, 1, 1
-        fcell = np.zeros(n, dtype=np.int64)
-        fstart = np.zeros(2, dtype=np.int64)
-        fpos = np.arange(n)
-    else:
+    # the fine grid of the separation zone, its agents in fine cell order (none if sparse)
+    nf = 0 if sparse else n
+    fx = fy = fz = 1
+    fcell = np.zeros(nf, dtype=np.int64)
+    fstart = np.zeros(2, dtype=np.int64)
+    forder = np.empty(nf, dtype=np.int64)
+    if not sparse:
         fx, fy, fz, fcell, fstart, fpos = _grid(x, lo, ext, c[0], planar, max(FINE_CELLS_MIN, 2 * n))
-    forder = np.empty(n, dtype=np.int64)
-    for i in range(n):
-        forder[fpos[i]] = i
+        for i in range(n):
+            forder[fpos[i]] = i
     xs = np.empty((3, n))
     vs = np.empty((3, n))
     cs = np.empty(n, dtype=np.int64)
@@ -329,8 +328,8 @@ def _prepare(x, v, types, wa, wc, c, planar, nchunks):
     wcs = np.empty((k, n))
     was = np.empty((k, n))
     halo = np.empty(hstart[ncol], dtype=np.int64)
-    fxs = np.empty((3, n))
-    fcs = np.empty(n, dtype=np.int64)
+    fxs = np.empty((3, nf))
+    fcs = np.empty(nf, dtype=np.int64)
     if nchunks > 1:
         _fill_parallel(nchunks, cols, x, v, types, wa, wc, nz, cell, pos, order, naround, around, hstart,
                        fcell, forder, xs, vs, cs, zs, ts, wcs, was, halo, fxs, fcs, not sparse)
