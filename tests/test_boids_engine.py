@@ -26,22 +26,38 @@ def test_grid_engine_equals_all_pairs_reference_over_100_steps(dims):
 
 
 @pytest.mark.parametrize("dims", [3, 2])
-def test_sparse_path_equals_the_reference(dims):
-    """Sparse cells (a few agents each) take the engine's other path (plain loops, separation summed
-    in the same pass); it too equals the reference bit for bit."""
+def test_many_sparse_cells_equal_the_reference(dims):
+    """A wide box: many columns of cells with a few agents each (short runs, neighbours across
+    several columns); the engine still equals the reference bit for bit."""
     from dataclasses import replace
 
     from lifelike_mj.boids import engine
 
     p = replace(load_preset("5a", dims=dims), box=34.0)
     x, v, t = initial_state(p, 400, seed=5)
-    wa, wc, c = p.arrays()
-    assert engine._prepare(engine._as3(x), engine._as3(v), t, wa, wc, c, dims == 2, 1)[0]  # the sparse path
+    ncx, ncy = engine._grid(engine._as3(x), t, 2, *engine._bbox(engine._as3(x), dims == 2), p.r_c, dims == 2,
+                            1 << 40)[:2]
+    assert ncx * ncy >= 25
     x2, v2 = x.copy(), v.copy()
     for _ in range(12):
         step_grid(x, v, t, p)
         step_reference(x2, v2, t, p)
     assert np.array_equal(x, x2) and np.array_equal(v, v2)
+
+
+def test_fixed_point_sums_differ_from_float_sums_by_rounding_only():
+    """The fixed-point sums change a step by no more than float64 rounding does: one step of a formed
+    flock (about 190 neighbours each) against a plain floating-point all-pairs step (NumPy)."""
+    from lifelike_mj.boids.bench import numpy_all_pairs_step
+
+    p = load_preset("4c")
+    r = simulate(p, 300, 400, seed=1, record_every=400)
+    x, v = r.positions[-1].copy(), r.velocities[-1].copy()
+    x2, v2 = x.copy(), v.copy()
+    step_grid(x, v, r.types, p)
+    numpy_all_pairs_step(x2, v2, r.types, p)
+    speed = float(np.max(np.abs(v2)))
+    assert np.max(np.abs(v - v2)) <= 8 * np.finfo(float).eps * speed
 
 
 def test_three_types_and_walls_equal_the_reference():
@@ -139,3 +155,56 @@ def test_numpy_all_pairs_peer_is_the_same_model():
     numpy_all_pairs_step(x, v, t, p)
     step_reference(x2, v2, t, p)
     assert np.max(np.abs(v - v2)) < 1e-14 and np.max(np.abs(x - x2)) < 1e-13
+
+
+def test_fixed_point_scale_is_safe_and_as_fine_as_its_rule_allows():
+    """_scale(top, n): no sum of n terms of magnitude <= top can overflow int64 (n top s < 2^62), the
+    largest values lose no bits below n = 512 (top s < 2^53), and 2 s breaks one of the two bounds
+    with top and n rounded up to powers of two."""
+    from hypothesis import given
+    from hypothesis import strategies as st
+
+    from lifelike_mj.boids.engine import _scale
+
+    @given(st.floats(min_value=1e-200, max_value=1e200), st.integers(min_value=1, max_value=2**40))
+    def check(top, n):
+        s = _scale(top, n)
+        assert np.frexp(s)[0] == 0.5  # a power of two
+        assert top * s < 2.0**53 and n * top * s < 2.0**62
+        top2, n2 = 2.0 ** np.frexp(top)[1], 2 ** n.bit_length()  # rounded up
+        assert top2 * 2 * s > 2.0**53 or n2 * top2 * 2 * s > 2.0**62
+        if n < 512:
+            assert np.spacing(top) >= 1.0 / s  # the float64 spacing of top, or finer
+
+    check()
+    assert _scale(0.0, 10) == 1.0
+
+
+def test_cached_compiled_code_runs_and_gives_the_same_run(tmp_path):
+    """Compiled once, then loaded from numba's cache in a new process (serial and parallel paths):
+    no crash (a cached function calling a parallel one can crash, numba issue 8578) and the same
+    numbers."""
+    import os
+    import subprocess
+    import sys
+
+    code = (
+        "import numpy as np\n"
+        "from dataclasses import replace\n"
+        "from lifelike_mj.boids.engine import initial_state, step_grid, PARALLEL_FROM\n"
+        "from lifelike_mj.boids.presets import load_preset\n"
+        "out = []\n"
+        "for n, box in ((300, 20.0), (PARALLEL_FROM + 100, 40.0)):\n"
+        "    p = replace(load_preset('4c'), box=box)\n"
+        "    x, v, t = initial_state(p, n, 1)\n"
+        "    step_grid(x, v, t, p, 3)\n"
+        "    out.append(x.tobytes().hex()[:64] + v.tobytes().hex()[-64:])\n"
+        "print(' '.join(out))\n"
+    )
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), NUMBA_NUM_THREADS="2")
+    runs = [subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600)
+            for _ in range(2)]
+    for r in runs:
+        assert r.returncode == 0, r.stderr[-2000:]
+    assert runs[0].stdout == runs[1].stdout and runs[0].stdout.strip()
+    assert any((tmp_path / "cache").rglob("*.nbc"))

@@ -18,9 +18,11 @@ then ``x += dt v``. Units are the paper's (lengths in its box units, time in ste
 :func:`step_grid` finds neighbours with a uniform grid of cells no smaller than ``R_c`` (cell
 lists, counting sort), so the cost grows linearly with ``n`` at fixed density; forces of all agents
 are computed from the old state (on parallel threads from :data:`PARALLEL_FROM` agents), then all
-agents move. Every sum adds its terms in ascending order of the neighbour's index, as the plain
-all-pairs reference :func:`step_reference` does (kept for the tests), so the two agree bit for bit
-and the result does not depend on the number of threads.
+agents move. Every sum is an exact sum of 64-bit fixed-point values (positions, velocities and
+separation terms rounded to a power-of-two quantum chosen so that nothing can overflow: for the
+paper's 300 agents, the float64 spacing of the largest values), so its value does not depend on the
+order of its terms: the engine adds them in the order that vectorises, on any number of threads,
+and equals the plain all-pairs reference :func:`step_reference` (kept for the tests) bit for bit.
 """
 
 from __future__ import annotations
@@ -145,19 +147,42 @@ def initial_state(params: BoidParams, n: int, seed: int, margin: float | None = 
 # Positions and velocities are (n, 3) inside the compiled code; in 2D the z column is 0 and stays 0
 # (no force has a z component, the z walls are off, the grid has one layer of cells).
 #
-# Each force component of agent i is summed exactly as the plain reference sums it: its terms in
-# ascending order of the neighbour's index j, one rounding per addition. The engine gets that order
-# by turning the loops round. For each column of cells (fixed x and y cell), the agents j of the 3 x 3
-# columns around it are listed in ascending index order (the column's "halo", built by one pass over
-# the agents in index order), and each j is applied at once to all the column's agents i within one
-# cell of it in z. That inner loop over i is branch-free (a term outside its zone is multiplied by 0
-# and adds nothing: s + 0 = s exactly, and a sum that starts at +0 never becomes -0), so the compiler
-# vectorises it. Separation, a few neighbours per agent, uses a finer grid and sorts each agent's
-# separation neighbours by index.
+# Every sum of a force (eq. 3, 7, 9) is accumulated in 64-bit fixed point, so that its value does not
+# depend on the order of its terms: the engine may add them in whatever order is fastest (vectorised,
+# on any number of threads) and still equal the all-pairs reference bit for bit. A value y enters a
+# sum as the integer Q(y) = trunc(y * s), s a power of two chosen by :func:`_scale` from the largest
+# |y| and n so that no sum can overflow. For the paper's n = 300 the quantum 1 / s is the float64
+# spacing of the largest values (2^-48 box units for positions in a box of 20: nothing is lost at
+# 16-20); the difference from plain floating-point sums is at the level of their own rounding
+# (tested: a few float64 epsilons after one step).
+#
+# The alignment and cohesion sums are kept per neighbour type t: ``S_t = sum Q(y_j)`` over the
+# neighbours of type t in the zone and their number ``N_t``; ``sum_j (y_j - y_i)`` over them is then
+# the exact integer ``S_t - N_t Q(y_i)``, weighted by ``W[t_i, t]`` after conversion (eq. 6-9).
+# The agents are sorted by (column of R_c cells, type, z cell): the agents of one type in three
+# adjacent z cells of a column are one contiguous run, and each agent's neighbours are at most 9 k
+# runs, which the compiler vectorises (a branch-free loop: a term outside its zone is masked to 0).
+# Separation (a few neighbours each) runs on a finer grid of cells of R_s, each pair once.
 
 #: The fine grid of the separation zone has at most this many cells, or 2 per agent if more (a
 #: bigger grid is mostly empty cells and cache misses at large n).
 FINE_CELLS_MIN = 1 << 12
+
+
+@njit(cache=True)
+def _scale(top, n):
+    """The fixed-point scale of a sum of at most ``n`` terms of magnitude at most ``top``: the power of
+    two ``s = 2^(min(53, 62 - b) - e)``, where ``2^(e-1) <= top < 2^e`` and ``2^(b-1) <= n < 2^b``.
+    Then ``top * s < 2^53`` (below n = 512 agents the quantum ``1 / s`` is the float64 spacing of
+    the largest values: nothing is lost) and ``n * top * s < 2^62`` (no sum of n terms, nor the
+    difference of two, reaches 2^63)."""
+    if not top > 0.0:
+        return 1.0
+    e = math.frexp(top)[1]
+    b = 0
+    while n >> b:
+        b += 1
+    return math.ldexp(1.0, min(53, 62 - b) - e)
 
 
 @njit(cache=True)
@@ -176,12 +201,13 @@ def _bbox(x, planar):
 
 
 @njit(cache=True)
-def _grid(x, lo, ext, size_min, planar, max_cells):
+def _grid(x, types, k, lo, ext, size_min, planar, max_cells):
     """A uniform grid over the box ``lo .. lo + ext`` holding the agents, cells at least ``size_min``
     wide (a hair more, so that rounding never puts two agents closer than ``size_min`` two cells
-    apart), at most ``max_cells`` cells: ``(ncx, ncy, ncz, cell, start, pos)``. The agents are
-    counting-sorted by cell (x, then y, then z), by index within a cell: agent ``i`` is at sorted
-    position ``pos[i]``, cell ``c`` holds the sorted positions ``start[c] .. start[c + 1] - 1``."""
+    apart), at most ``max_cells`` cells: ``(ncx, ncy, ncz, start, pos)``. The agents are
+    counting-sorted by the key (x cell, y cell, type, z cell) (``k = 1``: no type), by index within a
+    key: agent ``i`` is at sorted position ``pos[i]``, key ``c`` holds the sorted positions
+    ``start[c] .. start[c + 1] - 1``."""
     n = x.shape[0]
     inv = np.zeros(3)
     nn = np.ones(3, dtype=np.int64)
@@ -193,368 +219,264 @@ def _grid(x, lo, ext, size_min, planar, max_cells):
         if ext[a] > 0.0:
             inv[a] = nn[a] / ext[a]
     ncx, ncy, ncz = nn[0], nn[1], nn[2]
-    cell = np.empty(n, dtype=np.int64)
+    key = np.empty(n, dtype=np.int64)
     for i in range(n):
         qx = min(int((x[i, 0] - lo[0]) * inv[0]), ncx - 1)
         qy = min(int((x[i, 1] - lo[1]) * inv[1]), ncy - 1)
         qz = 0 if planar else min(int((x[i, 2] - lo[2]) * inv[2]), ncz - 1)
-        cell[i] = (qx * ncy + qy) * ncz + qz
-    ncells = ncx * ncy * ncz
-    start = np.zeros(ncells + 1, dtype=np.int64)
+        t = types[i] if k > 1 else 0
+        key[i] = ((qx * ncy + qy) * k + t) * ncz + qz
+    nkeys = ncx * ncy * k * ncz
+    start = np.zeros(nkeys + 1, dtype=np.int64)
     for i in range(n):
-        start[cell[i] + 1] += 1
-    for k in range(ncells):
-        start[k + 1] += start[k]
+        start[key[i] + 1] += 1
+    for c in range(nkeys):
+        start[c + 1] += start[c]
     fill = start[:-1].copy()
     pos = np.empty(n, dtype=np.int64)
     for i in range(n):
-        pos[i] = fill[cell[i]]
-        fill[cell[i]] += 1
-    return ncx, ncy, ncz, cell, start, pos
+        pos[i] = fill[key[i]]
+        fill[key[i]] += 1
+    return ncx, ncy, ncz, start, pos
 
 
 @njit(cache=True)
-def _fill_chunk(k, nchunks, cols, x, v, types, wa, wc, nz, cell, pos, order, naround, around, hstart,
-                fcell, forder, xs, vs, cs, zs, ts, wcs, was, halo, fxs, fcs, fine):
-    """Part ``k`` of ``nchunks`` of the copies in sorted order (gathered: sequential writes, much
-    faster than scattering at large n) and of the halo lists (columns ``cols[k] .. cols[k + 1] - 1``,
-    filled by one pass over the agents in index order)."""
+def _max_abs(a):
+    m = 0.0
+    for i in range(a.shape[0]):
+        for b in range(a.shape[1]):
+            m = max(m, abs(a[i, b]))
+    return m
+
+
+@njit(cache=True)
+def _scales(x, v, w_s):
+    """The fixed-point scales of the cohesion (positions), alignment (velocities) and separation
+    (terms at most |w_s|) sums of this state."""
     n = x.shape[0]
-    for p in range(k * n // nchunks, (k + 1) * n // nchunks):
-        i = order[p]
-        for a in range(3):
-            xs[a, p] = x[i, a]
-            vs[a, p] = v[i, a]
-        cs[p] = cell[i]
-        zs[p] = cell[i] % nz
-        ts[p] = types[i]
-        for t in range(wa.shape[0]):
-            wcs[t, p] = wc[types[i], t]
-            was[t, p] = wa[types[i], t]
-        if fine:
-            i = forder[p]
-            fcs[p] = fcell[i]
-            for a in range(3):
-                fxs[a, p] = x[i, a]
-    q0, q1 = cols[k], cols[k + 1]
-    fill = hstart[q0:q1].copy()
-    for i in range(n):
-        q = cell[i] // nz
-        for s in range(naround[q]):
-            b = around[q, s]
-            if q0 <= b < q1:
-                halo[fill[b - q0]] = pos[i]
-                fill[b - q0] += 1
-
-
-@njit(cache=True, parallel=True)
-def _fill_parallel(nchunks, cols, x, v, types, wa, wc, nz, cell, pos, order, naround, around, hstart,
-                   fcell, forder, xs, vs, cs, zs, ts, wcs, was, halo, fxs, fcs, fine):
-    """:func:`_fill_chunk`, part ``k`` on thread ``k``."""
-    for k in prange(nchunks):
-        _fill_chunk(k, nchunks, cols, x, v, types, wa, wc, nz, cell, pos, order, naround, around, hstart,
-                    fcell, forder, xs, vs, cs, zs, ts, wcs, was, halo, fxs, fcs, fine)
+    return _scale(_max_abs(x), n), _scale(_max_abs(v), n), _scale(abs(w_s), n)
 
 
 @njit(cache=True)
-def _prepare(x, v, types, wa, wc, c, planar, nchunks):
-    """Everything the pair loops read: the R_c grid, the agents' state in sorted order (rows x, y, z),
-    per-position weight columns (``wcs[t, p]``: the weight of the agent at ``p`` for a neighbour of
-    type ``t``), the halo lists, ``nchunks`` ranges of sorted positions of about equal work, and the
-    fine grid of the separation zone."""
+def _prepare(x, v, types, k, c, planar, nchunks, s_x, s_v):
+    """Everything the sum loops read: the R_c grid (sorted by column, type, z), the agents' state in
+    sorted order (``xs`` rows x, y, z; ``qx``, ``qv`` the fixed-point positions and velocities), the
+    fine grid of the separation zone (``fmain``: fine order -> sorted order, ``fxs``: positions in fine
+    order), and ``nchunks`` ranges of R_c cells (column-major, z minor) of about equal numbers of
+    agents."""
     n = x.shape[0]
     lo, ext = _bbox(x, planar)
-    ncx, ncy, nz, cell, start, pos = _grid(x, lo, ext, c[2], planar, 1 << 40)
-    k = wa.shape[0]
+    ncx, ncy, nz, start, pos = _grid(x, types, k, lo, ext, c[2], planar, 1 << 40)
     order = np.empty(n, dtype=np.int64)
     for i in range(n):
         order[pos[i]] = i
-    # halo lists: for each occupied column (fixed x and y cell), the sorted positions of the agents
-    # of the occupied columns around it (3 x 3), in ascending agent index (the order of the sums)
-    ncol = ncx * ncy
-    occupied = np.zeros(ncol, dtype=np.int64)
-    for i in range(n):
-        occupied[cell[i] // nz] += 1
-    around = np.empty((ncol, 9), dtype=np.int64)  # the occupied columns around each column
-    naround = np.zeros(ncol, dtype=np.int64)
-    hstart = np.zeros(ncol + 1, dtype=np.int64)
-    for q in range(ncol):
-        if occupied[q] == 0:
-            continue
-        qx, qy = q // ncy, q % ncy
-        for bx in range(max(qx - 1, 0), min(qx + 2, ncx)):
-            for by in range(max(qy - 1, 0), min(qy + 2, ncy)):
-                b = bx * ncy + by
-                if occupied[b] > 0:
-                    around[q, naround[q]] = b
-                    naround[q] += 1
-                    hstart[b + 1] += occupied[q]
-    for q in range(ncol):
-        hstart[q + 1] += hstart[q]
-    # chunks of equal work: an agent's work is its column's halo length; the halo lists are
-    # filled in chunks of columns of equal length
-    total = 0
-    for q in range(ncol):
-        total += occupied[q] * (hstart[q + 1] - hstart[q])
-    cols = np.full(nchunks + 1, ncol, dtype=np.int64)
-    cols[0] = 0
-    kk = 1
-    for q in range(ncol):
-        while kk < nchunks and hstart[q] * nchunks >= kk * hstart[ncol]:
-            cols[kk] = q
-            kk += 1
-    # sparse (runs of agents shorter than SHORT_RUN on average): every pass takes the plain loop,
-    # which adds the separation terms too; else the separation runs on a fine grid
-    ncells_occupied = 0
-    for q in range(ncol * nz):
-        if start[q + 1] > start[q]:
-            ncells_occupied += 1
-    sparse = n * min(3, nz) < SHORT_RUN * ncells_occupied
-    # the fine grid of the separation zone, its agents in fine cell order (none if sparse)
-    nf = 0 if sparse else n
-    fx = fy = fz = 1
-    fcell = np.zeros(nf, dtype=np.int64)
-    fstart = np.zeros(2, dtype=np.int64)
-    forder = np.empty(nf, dtype=np.int64)
-    if not sparse:
-        fx, fy, fz, fcell, fstart, fpos = _grid(x, lo, ext, c[0], planar, max(FINE_CELLS_MIN, 2 * n))
-        for i in range(n):
-            forder[fpos[i]] = i
     xs = np.empty((3, n))
-    vs = np.empty((3, n))
-    cs = np.empty(n, dtype=np.int64)
-    zs = np.empty(n, dtype=np.int64)
+    qx = np.empty((3, n), dtype=np.int64)
+    qv = np.empty((3, n), dtype=np.int64)
     ts = np.empty(n, dtype=np.int64)
-    wcs = np.empty((k, n))
-    was = np.empty((k, n))
-    halo = np.empty(hstart[ncol], dtype=np.int64)
-    fxs = np.empty((3, nf))
-    fcs = np.empty(nf, dtype=np.int64)
-    if nchunks > 1:
-        _fill_parallel(nchunks, cols, x, v, types, wa, wc, nz, cell, pos, order, naround, around, hstart,
-                       fcell, forder, xs, vs, cs, zs, ts, wcs, was, halo, fxs, fcs, not sparse)
-    else:
-        _fill_chunk(0, 1, cols, x, v, types, wa, wc, nz, cell, pos, order, naround, around, hstart,
-                    fcell, forder, xs, vs, cs, zs, ts, wcs, was, halo, fxs, fcs, not sparse)
-    bounds = np.full(nchunks + 1, n, dtype=np.int64)
-    bounds[0] = 0
-    done = 0
-    kk = 1
-    for p in range(n):
-        while kk < nchunks and done * nchunks >= kk * total:
-            bounds[kk] = p
-            kk += 1
-        q = cs[p] // nz
-        done += hstart[q + 1] - hstart[q]
-    return (sparse, nz, start, order, cs, zs, ts, xs, vs, wcs, was, hstart, halo, bounds,
-            fx, fy, fz, fcs, fstart, forder, fxs)
-
-
-#: Runs of fewer agents than this take a plain loop: the vector loop's set-up (run-time alias checks
-#: of its 16 arrays) costs more than it saves on a short run (measured; docs/performance.md).
-SHORT_RUN = 24
-
-
-@njit(cache=True)
-def _pairs_chunk(p0, p1, nz, start, cs, zs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc, sparse, r_s2,
-                 w_s):
-    """Cohesion and alignment sums and neighbour counts of the agents at sorted positions ``p0 ..
-    p1 - 1`` (chunks on parallel threads write disjoint positions). ``acc`` rows: cohesion x, y, z,
-    alignment x, y, z, N_c + 1, N_a + 1 (an agent meets itself once, with zero terms), and, if
-    ``sparse``, separation x, y, z (every pass then takes the plain loop, which adds them too).
-
-    A neighbour j is applied to the agents of the column in its own and the adjacent z cells. Two
-    consecutive halo agents j < k in the same or adjacent z cells are applied in one pass (first
-    j's term, then k's: the order of the sums is kept), which halves the loads and stores of the
-    sums. A run of agents may be lengthened within the column (to a multiple of 8, for whole vector
-    iterations): an agent out of j's zones gets zero terms, in its right place in the order."""
-    xs0, xs1, xs2 = xs[0], xs[1], xs[2]
-    vs0, vs1, vs2 = vs[0], vs[1], vs[2]
-    cx, cy, cz, ax, ay, az, ncn, nan = acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7]
-    sx, sy, sz = acc[8], acc[9], acc[10]
-    if p0 < p1:
-        for q in range(cs[p0] // nz, cs[p1 - 1] // nz + 1):
-            a = max(start[q * nz], p0)
-            b = min(start[q * nz + nz], p1)
-            if a >= b:
-                continue
-            h = hstart[q]
-            h1 = hstart[q + 1]
-            while h < h1:
-                pj = halo[h]
-                qj = zs[pj]
-                pk = pj
-                qk = qj
-                on = 0.0  # 1 when a second agent k is applied in this pass
-                if h + 1 < h1 and abs(zs[halo[h + 1]] - qj) <= 1:
-                    pk = halo[h + 1]
-                    qk = zs[pk]
-                    on = 1.0
-                h += 2 if on > 0.0 else 1
-                r0 = max(start[q * nz + max(min(qj, qk) - 1, 0)], a)
-                r1 = min(start[q * nz + min(max(qj, qk) + 1, nz - 1) + 1], b)
-                if r0 >= r1:
-                    continue
-                xj0, xj1, xj2 = xs0[pj], xs1[pj], xs2[pj]
-                xk0, xk1, xk2 = xs0[pk], xs1[pk], xs2[pk]
-                vj0, vj1, vj2 = vs0[pj], vs1[pj], vs2[pj]
-                vk0, vk1, vk2 = vs0[pk], vs1[pk], vs2[pk]
-                tj, tk = ts[pj], ts[pk]  # (rows of wcs/was indexed in place: a row view costs reference counting)
-                if sparse or r1 - r0 < SHORT_RUN:
-                    # a short run (sparse cells): a plain loop, whose set-up costs less than the
-                    # vector loop's (signed indices keep the compiler from vectorising it)
-                    for p in range(r0, r1):
-                        for u in range(2 if on > 0.0 else 1):  # j's terms, then k's
-                            if u == 0:
-                                y0, y1, y2, u0, u1, u2, tu = xj0, xj1, xj2, vj0, vj1, vj2, tj
-                            else:
-                                y0, y1, y2, u0, u1, u2, tu = xk0, xk1, xk2, vk0, vk1, vk2, tk
-                            ex = xs0[p] - y0
-                            ey = xs1[p] - y1
-                            ez = xs2[p] - y2
-                            d2 = ex * ex + ey * ey + ez * ez
-                            if d2 < r_c2:
-                                ncn[p] += 1.0
-                                w = wcs[tu, p]
-                                cx[p] += -(w * ex)
-                                cy[p] += -(w * ey)
-                                cz[p] += -(w * ez)
-                                if d2 < r_a2:
-                                    nan[p] += 1.0
-                                    w = was[tu, p]
-                                    ax[p] += w * (u0 - vs0[p])
-                                    ay[p] += w * (u1 - vs1[p])
-                                    az[p] += w * (u2 - vs2[p])
-                                    if sparse and d2 < r_s2 and d2 > 0.0:
-                                        w = w_s / math.sqrt(d2)
-                                        sx[p] += w * ex
-                                        sy[p] += w * ey
-                                        sz[p] += w * ez
-                    continue
-                r1 = min(r1 + (r0 - r1) % 8, b)
-                r0 = max(r0 - (r0 - r1) % 8, a)
-                # unsigned indices (no negative-index wraparound) let the loops vectorise; cohesion and
-                # alignment stay two loops (fewer arrays each): one fused loop measured slower
-                for p in range(np.uint64(r0), np.uint64(r1)):
-                    ex = xs0[p] - xj0
-                    ey = xs1[p] - xj1
-                    ez = xs2[p] - xj2
-                    fx = xs0[p] - xk0
-                    fy = xs1[p] - xk1
-                    fz = xs2[p] - xk2
-                    m = 1.0 if ex * ex + ey * ey + ez * ez < r_c2 else 0.0
-                    mk = on if fx * fx + fy * fy + fz * fz < r_c2 else 0.0
-                    ncn[p] += m + mk
-                    w = wcs[tj, p] * m
-                    wk = wcs[tk, p] * mk
-                    cx[p] = (cx[p] + -(w * ex)) + -(wk * fx)
-                    cy[p] = (cy[p] + -(w * ey)) + -(wk * fy)
-                    cz[p] = (cz[p] + -(w * ez)) + -(wk * fz)
-                for p in range(np.uint64(r0), np.uint64(r1)):
-                    ex = xs0[p] - xj0
-                    ey = xs1[p] - xj1
-                    ez = xs2[p] - xj2
-                    fx = xs0[p] - xk0
-                    fy = xs1[p] - xk1
-                    fz = xs2[p] - xk2
-                    m = 1.0 if ex * ex + ey * ey + ez * ez < r_a2 else 0.0
-                    mk = on if fx * fx + fy * fy + fz * fz < r_a2 else 0.0
-                    nan[p] += m + mk
-                    w = was[tj, p] * m
-                    wk = was[tk, p] * mk
-                    vp = vs0[p]
-                    ax[p] = (ax[p] + w * (vj0 - vp)) + wk * (vk0 - vp)
-                    vp = vs1[p]
-                    ay[p] = (ay[p] + w * (vj1 - vp)) + wk * (vk1 - vp)
-                    vp = vs2[p]
-                    az[p] = (az[p] + w * (vj2 - vp)) + wk * (vk2 - vp)
-
-
-@njit(cache=True)
-def _separation_chunk(s0, s1, fncx, fncy, fncz, fcs, fstart, forder, fxs, r_s, w_s, sep):
-    """Separation sums (eq. 3 with f = 1, summed) of the agents at fine sorted positions ``s0 .. s1 -
-    1``: each agent's neighbours within R_s, found on the fine grid, are sorted by index and their
-    terms summed in that order. Cell by cell: the (at most 9) runs of neighbouring cells are found
-    once per cell."""
-    r_s2 = r_s * r_s
-    n = fxs.shape[1]
-    buf = np.empty(n, dtype=np.int64)  # fine positions of one agent's separation neighbours
-    lo = np.empty(9, dtype=np.int64)
-    hi = np.empty(9, dtype=np.int64)
-    if s0 >= s1:
-        return
-    for q in range(fcs[s0], fcs[s1 - 1] + 1):
-        a0 = max(fstart[q], s0)
-        a1 = min(fstart[q + 1], s1)
-        if a0 >= a1:
-            continue
-        qz = q % fncz
-        qy = (q // fncz) % fncy
-        qx = q // (fncz * fncy)
-        nr = 0
-        for bx in range(max(qx - 1, 0), min(qx + 2, fncx)):
-            for by in range(max(qy - 1, 0), min(qy + 2, fncy)):
-                c0 = (bx * fncy + by) * fncz
-                lo[nr] = fstart[c0 + max(qz - 1, 0)]
-                hi[nr] = fstart[c0 + min(qz + 1, fncz - 1) + 1]
-                nr += 1
-        for pa in range(a0, a1):
-            i = forder[pa]
-            xi0, xi1, xi2 = fxs[0, pa], fxs[1, pa], fxs[2, pa]
-            m = 0
-            for r in range(nr):
-                for pb in range(lo[r], hi[r]):
-                    ex = xi0 - fxs[0, pb]
-                    ey = xi1 - fxs[1, pb]
-                    ez = xi2 - fxs[2, pb]
-                    d2 = ex * ex + ey * ey + ez * ez
-                    if 0.0 < d2 < r_s2:
-                        # insertion into buf[0:m], kept in ascending agent index
-                        j = forder[pb]
-                        s = m
-                        while s > 0 and forder[buf[s - 1]] > j:
-                            buf[s] = buf[s - 1]
-                            s -= 1
-                        buf[s] = pb
-                        m += 1
-            sx = sy = sz = 0.0
-            for s in range(m):
-                pb = buf[s]
-                ex = xi0 - fxs[0, pb]
-                ey = xi1 - fxs[1, pb]
-                ez = xi2 - fxs[2, pb]
-                w = w_s / math.sqrt(ex * ex + ey * ey + ez * ez)
-                sx += w * ex
-                sy += w * ey
-                sz += w * ez
-            sep[0, i] = sx
-            sep[1, i] = sy
-            sep[2, i] = sz
-
-
-@njit(cache=True)
-def _combine(xs, order, acc, sep, c, planar, dv, sparse):
-    """dv = dt/m (F_s + F_a + F_c) (eq. 1-2): separation plus wall avoidance (a wall closer than
-    R_s adds w_s along its inward normal, after the neighbours' terms), then the alignment and
-    cohesion averages (eq. 6-9). In sorted order (``xs``: positions in sorted order, ``order[p]``: the
-    agent at sorted position p)."""
-    n = xs.shape[1]
-    r_s, w_s, box, dt_m = c[0], c[3], c[4], c[5]
     for p in range(n):
         i = order[p]
-        na = acc[7, p] - 1.0
-        nc = acc[6, p] - 1.0
+        ts[p] = types[i]
         for a in range(3):
-            f = acc[8 + a, p] if sparse else sep[a, i]
+            xs[a, p] = x[i, a]
+            qx[a, p] = np.int64(x[i, a] * s_x)
+            qv[a, p] = np.int64(v[i, a] * s_v)
+    fx, fy, fz, fstart, fpos = _grid(x, types, 1, lo, ext, c[0], planar, max(FINE_CELLS_MIN, 2 * n))
+    fmain = np.empty(n, dtype=np.int64)  # fine position -> sorted position
+    for i in range(n):
+        fmain[fpos[i]] = pos[i]
+    fxs = np.empty((3, n))
+    for f in range(n):
+        p = fmain[f]
+        for a in range(3):
+            fxs[a, f] = xs[a, p]
+    # chunks: cells (col, z), col = (x cell, y cell), of about n / nchunks agents each
+    ncells = ncx * ncy * nz
+    cells = np.full(nchunks + 1, ncells, dtype=np.int64)
+    cells[0] = 0
+    kk = 1
+    done = 0
+    for cc in range(ncells):
+        while kk < nchunks and done * nchunks >= kk * n:
+            cells[kk] = cc
+            kk += 1
+        col = cc // nz
+        z = cc - col * nz
+        for t in range(k):
+            q = (col * k + t) * nz + z
+            done += start[q + 1] - start[q]
+    return ncx, ncy, nz, start, order, xs, qx, qv, ts, fx, fy, fz, fstart, fmain, fxs, cells
+
+
+@njit(cache=True)
+def _sums_chunk(c0, c1, ncx, ncy, nz, k, start, xs, qx, qv, r_c2, r_a2, sums):
+    """Alignment and cohesion sums of the agents in R_c cells ``c0 .. c1 - 1`` (each chunk of cells
+    writes its own agents). ``sums[p, 8 t + r]`` for neighbour type t: r = 0-2 sum of Q(x_j), 3-5
+    sum of Q(v_j), 6 N_c, 7 N_a (the agent itself included, with equal and opposite terms). The
+    candidates of a cell are at most 9 k runs (a neighbouring column, one type, three z cells)."""
+    x0, x1, x2 = xs[0], xs[1], xs[2]
+    q0, q1, q2 = qx[0], qx[1], qx[2]
+    u0, u1, u2 = qv[0], qv[1], qv[2]
+    rlo = np.empty(9 * k, dtype=np.int64)
+    rhi = np.empty(9 * k, dtype=np.int64)
+    rend = np.empty(k, dtype=np.int64)  # the runs of type t are rlo/rhi[rend[t - 1] .. rend[t] - 1]
+    for cc in range(c0, c1):
+        col = cc // nz
+        z = cc - col * nz
+        here = 0  # agents in this cell
+        for t in range(k):
+            here += start[(col * k + t) * nz + z + 1] - start[(col * k + t) * nz + z]
+        if here == 0:
+            continue
+        cx, cy = col // ncy, col % ncy
+        za, zb = max(z - 1, 0), min(z + 1, nz - 1)
+        nr = 0
+        for t in range(k):
+            for bx in range(max(cx - 1, 0), min(cx + 2, ncx)):
+                for by in range(max(cy - 1, 0), min(cy + 2, ncy)):
+                    b = (bx * ncy + by) * k + t
+                    lo = start[b * nz + za]
+                    hi = start[b * nz + zb + 1]
+                    if hi > lo:
+                        rlo[nr] = lo
+                        rhi[nr] = hi
+                        nr += 1
+            rend[t] = nr
+        for tr in range(k):
+            q = (col * k + tr) * nz + z
+            for p in range(start[q], start[q + 1]):
+                xi0, xi1, xi2 = x0[p], x1[p], x2[p]
+                r = 0
+                for t in range(k):
+                    s0 = s1 = s2 = a0 = a1 = a2 = nc = na = np.int64(0)
+                    while r < rend[t]:
+                        # unsigned indices (no negative-index wraparound) let the loop vectorise
+                        for j in range(np.uint64(rlo[r]), np.uint64(rhi[r])):
+                            e0 = xi0 - x0[j]
+                            e1 = xi1 - x1[j]
+                            e2 = xi2 - x2[j]
+                            d2 = e0 * e0 + e1 * e1 + e2 * e2
+                            m = np.int64(-1) if d2 < r_c2 else np.int64(0)
+                            g = np.int64(-1) if d2 < r_a2 else np.int64(0)
+                            s0 += q0[j] & m
+                            s1 += q1[j] & m
+                            s2 += q2[j] & m
+                            nc -= m
+                            a0 += u0[j] & g
+                            a1 += u1[j] & g
+                            a2 += u2[j] & g
+                            na -= g
+                        r += 1
+                    o = 8 * t
+                    sums[p, o] = s0
+                    sums[p, o + 1] = s1
+                    sums[p, o + 2] = s2
+                    sums[p, o + 3] = a0
+                    sums[p, o + 4] = a1
+                    sums[p, o + 5] = a2
+                    sums[p, o + 6] = nc
+                    sums[p, o + 7] = na
+
+
+@njit(cache=True)
+def _separation_chunk(s0, s1, fncx, fncy, fncz, fstart, fmain, fxs, r_s, w_s, s_s, sep):
+    """Separation sums (eq. 3 with f = 1), fixed point, of the pairs whose first agent is at fine
+    sorted position ``s0 .. s1 - 1``: each pair once (its own cell after it, and 13 of the 26
+    neighbouring cells), the term Q(w_s xi / d) added to one agent's sum and subtracted from the
+    other's (Q(-y) = -Q(y)). ``sep[a, p]``: component a of the agent at (R_c grid) sorted position p;
+    ``fmain[f]``: the sorted position of the agent at fine position f."""
+    r_s2 = r_s * r_s
+    if s0 >= s1:
+        return
+    lo = np.empty(5, dtype=np.int64)
+    hi = np.empty(5, dtype=np.int64)
+    f = w_s * s_s
+    q = np.searchsorted(fstart, s0, side="right") - 1
+    nq = fncx * fncy * fncz
+    while q < nq and fstart[q] < s1:
+        a0 = max(fstart[q], s0)
+        a1 = min(fstart[q + 1], s1)
+        if a0 < a1:
+            qz = q % fncz
+            qy = (q // fncz) % fncy
+            qx = q // (fncz * fncy)
+            za, zb = max(qz - 1, 0), min(qz + 1, fncz - 1)
+            # run 0: this column from the agent on (this cell, then the cell above); runs 1-4: the
+            # columns (x, y + 1), (x + 1, y - 1), (x + 1, y), (x + 1, y + 1), three z cells each
+            hi[0] = fstart[(qx * fncy + qy) * fncz + zb + 1]
+            nr = 1
+            for d in range(4):
+                bx = qx + (0 if d == 0 else 1)
+                by = qy + (1 if d == 0 else d - 2)
+                if bx < fncx and 0 <= by < fncy:
+                    c0 = (bx * fncy + by) * fncz
+                    lo[nr] = fstart[c0 + za]
+                    hi[nr] = fstart[c0 + zb + 1]
+                    nr += 1
+            for pa in range(a0, a1):
+                xi0, xi1, xi2 = fxs[0, pa], fxs[1, pa], fxs[2, pa]
+                i = fmain[pa]
+                lo[0] = pa + 1
+                for r in range(nr):
+                    for pb in range(lo[r], hi[r]):
+                        ex = xi0 - fxs[0, pb]
+                        ey = xi1 - fxs[1, pb]
+                        ez = xi2 - fxs[2, pb]
+                        d2 = ex * ex + ey * ey + ez * ez
+                        if 0.0 < d2 < r_s2:
+                            w = f / math.sqrt(d2)
+                            j = fmain[pb]
+                            y = np.int64(w * ex)
+                            sep[0, i] += y
+                            sep[0, j] -= y
+                            y = np.int64(w * ey)
+                            sep[1, i] += y
+                            sep[1, j] -= y
+                            y = np.int64(w * ez)
+                            sep[2, i] += y
+                            sep[2, j] -= y
+        q += 1
+
+
+@njit(cache=True)
+def _combine(p0, p1, xs, qx, qv, ts, order, sums, sep, wa, wc, c, planar, s_x, s_v, s_s, dv):
+    """dv = dt/m (F_s + F_a + F_c) (eq. 1-9), as :func:`step_reference` computes it from the exact
+    sums: separation, plus wall avoidance (a wall closer than R_s adds w_s along its inward normal),
+    then the alignment and cohesion averages, each the sum over neighbour types t of
+    ``W[t_i, t] * (S_t - N_t Q(y_i)) / s`` divided by the number of neighbours. In sorted order
+    (``order[p]``: the agent at sorted position p), positions ``p0 .. p1 - 1``; ``sep[h]``: chunk h's
+    separation sums."""
+    k = wa.shape[0]
+    r_s, w_s, box, dt_m = c[0], c[3], c[4], c[5]
+    ix, iv, i_s = 1.0 / s_x, 1.0 / s_v, 1.0 / s_s
+    for p in range(p0, p1):
+        i = order[p]
+        ti = ts[p]
+        nc = -1
+        na = -1
+        for t in range(k):
+            nc += sums[p, 8 * t + 6]
+            na += sums[p, 8 * t + 7]
+        for a in range(3):
+            ss = np.int64(0)
+            for h in range(sep.shape[0]):
+                ss += sep[h, a, p]
+            f = float(ss) * i_s
             if a < 2 or not planar:
                 if xs[a, p] < r_s:
                     f += w_s
                 if box - xs[a, p] < r_s:
                     f += -w_s
-            if na > 0.0:
-                f += acc[3 + a, p] / na
-            if nc > 0.0:
-                f += acc[a, p] / nc
+            if na > 0:
+                g = 0.0
+                for t in range(k):
+                    g += wa[ti, t] * (float(sums[p, 8 * t + 3 + a] - sums[p, 8 * t + 7] * qv[a, p]) * iv)
+                f += g / na
+            if nc > 0:
+                g = 0.0
+                for t in range(k):
+                    g += wc[ti, t] * (float(sums[p, 8 * t + a] - sums[p, 8 * t + 6] * qx[a, p]) * ix)
+                f += g / nc
             dv[i, a] = dt_m * f
 
 
@@ -562,48 +484,53 @@ def _combine(xs, order, acc, sep, c, planar, dv, sparse):
 PARALLEL_FROM = 2000
 
 
-@njit(cache=True, parallel=True)
-def _chunks_parallel(bounds, nz, start, cs, zs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc, sparse,
-                     fncx, fncy, fncz, fcs, fstart, forder, fxs, r_s, w_s, sep):
-    """The pair and separation sums, chunk ``k`` of each on thread ``k``."""
-    nchunks = bounds.shape[0] - 1
-    n = fxs.shape[1]
-    for k in prange(nchunks):
-        _pairs_chunk(bounds[k], bounds[k + 1], nz, start, cs, zs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2,
-                     acc, sparse, r_s * r_s, w_s)
-        if not sparse:
-            _separation_chunk(k * n // nchunks, (k + 1) * n // nchunks, fncx, fncy, fncz, fcs, fstart, forder, fxs,
-                              r_s, w_s, sep)
-
-
 @njit(cache=True)
-def _forces(x, v, types, wa, wc, c, planar, dv, nchunks):
-    """dv = dt/m (F_s + F_a + F_c) of every agent (eq. 1-9), split into ``nchunks`` parts on parallel
-    threads if ``nchunks > 1`` (the result is the same: each sum's order is fixed by the agents'
-    indices)."""
+def _forces(x, v, types, wa, wc, c, planar, dv):
+    """dv = dt/m (F_s + F_a + F_c) of every agent (eq. 1-9), on one thread."""
     n = x.shape[0]
-    (sparse, nz, start, order, cs, zs, ts, xs, vs, wcs, was, hstart, halo, bounds,
-     fx, fy, fz, fcs, fstart, forder, fxs) = _prepare(x, v, types, wa, wc, c, planar, nchunks)
-    acc = np.zeros((11, n))
-    sep = np.empty((3, n))
+    k = wa.shape[0]
+    s_x, s_v, s_s = _scales(x, v, c[3])
+    (ncx, ncy, nz, start, order, xs, qx, qv, ts, fx, fy, fz, fstart, fmain, fxs,
+     cells) = _prepare(x, v, types, k, c, planar, 1, s_x, s_v)
+    sums = np.empty((n, 8 * k), dtype=np.int64)  # every entry written
+    sep = np.zeros((1, 3, n), dtype=np.int64)
+    _sums_chunk(0, ncx * ncy * nz, ncx, ncy, nz, k, start, xs, qx, qv, c[2] * c[2], c[1] * c[1], sums)
+    _separation_chunk(0, n, fx, fy, fz, fstart, fmain, fxs, c[0], c[3], s_s, sep[0])
+    _combine(0, n, xs, qx, qv, ts, order, sums, sep, wa, wc, c, planar, s_x, s_v, s_s, dv)
+
+
+# Called from Python only, never from another compiled function: a cached function that calls a
+# parallel one can crash when loaded from the cache (numba issue 8578).
+@njit(cache=True, parallel=True)
+def _forces_parallel(x, v, types, wa, wc, c, planar, dv, nchunks):
+    """:func:`_forces` split into ``nchunks`` parts on parallel threads (the result is the same: the
+    sums are exact integers). Each chunk of R_c cells writes its own agents' sums; each chunk of
+    the separation pairs writes its own ``sep[h]`` (a pair may cross chunks)."""
+    n = x.shape[0]
+    k = wa.shape[0]
+    s_x, s_v, s_s = _scales(x, v, c[3])
+    (ncx, ncy, nz, start, order, xs, qx, qv, ts, fx, fy, fz, fstart, fmain, fxs,
+     cells) = _prepare(x, v, types, k, c, planar, nchunks, s_x, s_v)
+    sums = np.empty((n, 8 * k), dtype=np.int64)
+    sep = np.zeros((nchunks, 3, n), dtype=np.int64)
     r_c2, r_a2 = c[2] * c[2], c[1] * c[1]
-    if nchunks > 1:
-        _chunks_parallel(bounds, nz, start, cs, zs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc, sparse,
-                         fx, fy, fz, fcs, fstart, forder, fxs, c[0], c[3], sep)
-    else:
-        _pairs_chunk(0, n, nz, start, cs, zs, ts, hstart, halo, xs, vs, wcs, was, r_c2, r_a2, acc, sparse,
-                     c[0] * c[0], c[3])
-        if not sparse:
-            _separation_chunk(0, n, fx, fy, fz, fcs, fstart, forder, fxs, c[0], c[3], sep)
-    _combine(xs, order, acc, sep, c, planar, dv, sparse)
+    for h in prange(nchunks):
+        _sums_chunk(cells[h], cells[h + 1], ncx, ncy, nz, k, start, xs, qx, qv, r_c2, r_a2, sums)
+        _separation_chunk(h * n // nchunks, (h + 1) * n // nchunks, fx, fy, fz, fstart, fmain, fxs, c[0], c[3], s_s,
+                          sep[h])
+    for h in prange(nchunks):
+        _combine(h * n // nchunks, (h + 1) * n // nchunks, xs, qx, qv, ts, order, sums, sep, wa, wc, c, planar, s_x,
+                 s_v, s_s, dv)
 
 
 @njit(cache=True)
-def _advance(x, v, dv, c):
+def _advance(x, v, dv, c, vmax):
     """Semi-implicit update (eq. 1-2) and reflecting walls; an agent is never left outside the box
-    (a reflection that would still land outside, possible only in a diverging run, is clamped)."""
+    (a reflection that would still land outside, possible only in a diverging run, is clamped).
+    Returns True if a speed exceeded ``vmax`` or became NaN."""
     n = x.shape[0]
     box, dt = c[4], c[6]
+    bad = False
     for i in range(n):
         for a in range(3):
             v[i, a] += dv[i, a]
@@ -616,27 +543,40 @@ def _advance(x, v, dv, c):
                 v[i, a] = -v[i, a]
             if not (0.0 <= x[i, a] <= box):
                 x[i, a] = min(max(x[i, a], 0.0), box) if x[i, a] == x[i, a] else 0.0
+        s = v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1] + v[i, 2] * v[i, 2]
+        if not (s <= vmax * vmax):
+            bad = True
+    return bad
 
 
 @njit(cache=True)
-def _run(x, v, types, wa, wc, c, planar, n_steps, vmax, nchunks):
-    """``n_steps`` steps; returns the first step (1-based) at which a speed exceeded ``vmax`` or
-    became NaN, else 0. The forces are split into ``nchunks`` parts on parallel threads."""
-    n = x.shape[0]
-    dv = np.empty((n, 3))
+def _run(x, v, types, wa, wc, c, planar, n_steps, vmax):
+    """``n_steps`` steps on one thread; returns the first step (1-based) at which a speed exceeded
+    ``vmax`` or became NaN, else 0."""
+    dv = np.empty(x.shape)
     for k in range(n_steps):
-        _forces(x, v, types, wa, wc, c, planar, dv, nchunks)
-        _advance(x, v, dv, c)
-        for i in range(n):
-            s = v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1] + v[i, 2] * v[i, 2]
-            if not (s <= vmax * vmax):
-                return k + 1
+        _forces(x, v, types, wa, wc, c, planar, dv)
+        if _advance(x, v, dv, c, vmax):
+            return k + 1
     return 0
 
 
-def _nchunks(n: int) -> int:
-    """One part below :data:`PARALLEL_FROM` agents, else one per numba thread."""
-    return 1 if n < PARALLEL_FROM else max(1, numba.get_num_threads())
+#: Below this many agents one thread is as fast (see docs/performance.md) and robust to a busy machine.
+PARALLEL_FROM = 2000
+
+
+def _steps(x, v, types, wa, wc, c, planar: bool, n_steps: int, vmax: float) -> int:
+    """:func:`_run`, or from :data:`PARALLEL_FROM` agents (and more than one numba thread) the same
+    steps with the forces on all threads, stepped from Python (a step then takes milliseconds)."""
+    nchunks = max(1, numba.get_num_threads())
+    if len(x) < PARALLEL_FROM or nchunks == 1:
+        return _run(x, v, types, wa, wc, c, planar, n_steps, vmax)
+    dv = np.empty(x.shape)
+    for k in range(n_steps):
+        _forces_parallel(x, v, types, wa, wc, c, planar, dv, nchunks)
+        if _advance(x, v, dv, c, vmax):
+            return k + 1
+    return 0
 
 
 def _as3(a: np.ndarray) -> np.ndarray:
@@ -649,8 +589,8 @@ def step_grid(x: np.ndarray, v: np.ndarray, types: np.ndarray, params: BoidParam
     engine. Raises :class:`UserError` when the run diverges."""
     x3, v3 = _as3(x), _as3(v)
     wa, wc, c = params.arrays()
-    bad = _run(x3, v3, np.asarray(types, dtype=np.int64), wa, wc, c, params.dims == 2, int(n_steps),
-               diverged_speed(params), _nchunks(len(x3)))
+    bad = _steps(x3, v3, np.asarray(types, dtype=np.int64), wa, wc, c, params.dims == 2, int(n_steps),
+                 diverged_speed(params))
     x[...] = x3[:, : x.shape[1]]
     v[...] = v3[:, : v.shape[1]]
     if bad:
@@ -673,15 +613,26 @@ def divergence_message(params: BoidParams, step: int) -> str:
 
 
 def step_reference(x: np.ndarray, v: np.ndarray, types: np.ndarray, params: BoidParams) -> None:
-    """One step over all pairs in plain Python: the definition the engine is tested against. Each
-    force component is the plain floating-point sum of its terms, neighbours in ascending index
-    order, then the wall terms (eq. 3-5, 7, 9)."""
+    """One step over all pairs in plain Python: the definition the engine is tested against (eq. 1-9,
+    walls). Each sum is exact, in Python integers, of the fixed-point values ``trunc(y * s)`` (scales
+    from :func:`_scales`): per neighbour type t, ``sum_j (Q(x_j) - Q(x_i))`` and ``sum_j (Q(v_j) -
+    Q(v_i))`` over the zone and the neighbour counts; separation, ``sum_j trunc(w_s s xi_ij / d)``.
+    The conversions back and the weighting by ``W[t_i, t]`` are the floating-point operations of the
+    engine, in its order."""
     n, D = x.shape
+    k = params.n_types
     wa, wc = np.array(params.wa), np.array(params.wc)
+    s_x, s_v, s_s = _scales(_as3(x), _as3(v), params.w_s)
+    qx = [[int(x[i, a] * s_x) for a in range(D)] for i in range(n)]
+    qv = [[int(v[i, a] * s_v) for a in range(D)] for i in range(n)]
+    r_s2, r_a2, r_c2 = params.r_s * params.r_s, params.r_a * params.r_a, params.r_c * params.r_c
     dv = np.zeros((n, D))
     for i in range(n):
-        fs, fa, fc = [0.0] * D, [0.0] * D, [0.0] * D
-        na = nc = 0
+        ti = int(types[i])
+        nc, na = [0] * k, [0] * k
+        sx = [[0] * D for _ in range(k)]  # per neighbour type: sum of Q(x_j) - Q(x_i) (cohesion)
+        sv = [[0] * D for _ in range(k)]  # sum of Q(v_j) - Q(v_i) (alignment)
+        ss = [0] * D  # separation
         for j in range(n):
             if j == i:
                 continue
@@ -689,31 +640,36 @@ def step_reference(x: np.ndarray, v: np.ndarray, types: np.ndarray, params: Boid
             d2 = 0.0
             for e in xi:
                 d2 += e * e
-            if d2 < params.r_c * params.r_c:
-                nc += 1
-                w = wc[types[i], types[j]]
+            t = int(types[j])
+            if d2 < r_c2:
+                nc[t] += 1
                 for a in range(D):
-                    fc[a] += -(w * xi[a])
-                if d2 < params.r_a * params.r_a:
-                    na += 1
-                    w = wa[types[i], types[j]]
+                    sx[t][a] += qx[j][a] - qx[i][a]
+                if d2 < r_a2:
+                    na[t] += 1
                     for a in range(D):
-                        fa[a] += w * (v[j, a] - v[i, a])
-                    if 0.0 < d2 < params.r_s * params.r_s:
-                        w = params.w_s / math.sqrt(d2)
+                        sv[t][a] += qv[j][a] - qv[i][a]
+                    if 0.0 < d2 < r_s2:
+                        w = params.w_s * s_s / math.sqrt(d2)
                         for a in range(D):
-                            fs[a] += w * xi[a]
+                            ss[a] += int(w * xi[a])
+        n_c, n_a = sum(nc), sum(na)
         for a in range(D):
+            f = float(ss[a]) * (1.0 / s_s)
             if x[i, a] < params.r_s:
-                fs[a] += params.w_s
+                f += params.w_s
             if params.box - x[i, a] < params.r_s:
-                fs[a] += -params.w_s
-        for a in range(D):
-            f = fs[a]
-            if na:
-                f += fa[a] / na
-            if nc:
-                f += fc[a] / nc
+                f += -params.w_s
+            if n_a:
+                g = 0.0
+                for t in range(k):
+                    g += wa[ti, t] * (float(sv[t][a]) * (1.0 / s_v))
+                f += g / n_a
+            if n_c:
+                g = 0.0
+                for t in range(k):
+                    g += wc[ti, t] * (float(sx[t][a]) * (1.0 / s_x))
+                f += g / n_c
             dv[i, a] = params.dt / params.mass * f
     v += dv
     x += params.dt * v
@@ -780,7 +736,7 @@ def simulate(params: BoidParams, n: int = N_AGENTS, n_steps: int = 3000, seed: i
         while done < n_steps:
             target = rec_steps[r] if r < len(rec_steps) else int(n_steps)
             k = target - done
-            bad = _run(x3, v3, types, wa, wc, c, planar, k, diverged_speed(params), _nchunks(n))
+            bad = _steps(x3, v3, types, wa, wc, c, planar, k, diverged_speed(params))
             if bad:
                 raise UserError(divergence_message(params, done + bad))
             done += k
