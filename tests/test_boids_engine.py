@@ -119,6 +119,14 @@ def test_divergence_is_a_clear_error(w_a, w_c):
         simulate(homogeneous(w_a, w_c), 300, 3000, seed=0, record_every=3000)
 
 
+def test_divergence_message_names_the_cause():
+    from lifelike_mj.boids.engine import divergence_message
+
+    assert "too large" in divergence_message(homogeneous(10.0, 0.01), 3)
+    assert "negative W_a" in divergence_message(load_preset("5b"), 625)
+    assert "too large" not in divergence_message(load_preset("5b"), 625)
+
+
 def test_homogeneous_grid_is_the_papers():
     g = load_grid()
     assert g["w_a"] == [1.0, 0.1, 0.01, 0.001] and g["w_c"] == [0.1, 0.01, 0.001, 0.0]

@@ -44,8 +44,8 @@ N_AGENTS = 300
 #: A run has diverged (section 2.2: w_a >= 10 or w_c >= 1) when an agent moves farther than the box
 #: side in one step (box units per step, as a multiple of the box side): the walls and zones no
 #: longer mean anything. With w_a >= 2 the speeds overflow within a few dozen steps; with w_c = 1
-#: the swarm stays finite but agents reach 22-40 box units per step (the fastest agent of the
-#: eight patterns, 5b, reaches 18.5 in the worst of 10 seeds).
+#: the swarm stays finite but agents pass 20 box units per step within 35-500 steps. Anti-alignment
+#: (a negative W_a entry, as in 5b) can throw a lone agent past it too (5b seed 2, at step 625).
 DIVERGED_BOX_PER_STEP = 1.0
 
 
@@ -604,9 +604,14 @@ def diverged_speed(params: BoidParams) -> float:
 
 def divergence_message(params: BoidParams, step: int) -> str:
     wa, wc = np.array(params.wa), np.array(params.wc)
-    return (f"the run diverged at step {step}: an agent moved farther than the box side ({params.box:g}) in one step; "
-            f"the weights are too large (largest W_a entry {np.max(np.abs(wa)):g}, largest W_c entry "
-            f"{np.max(np.abs(wc)):g}; the paper finds divergence from w_a >= 10 or w_c >= 1).")
+    head = (f"the run diverged at step {step}: an agent moved farther than the box side ({params.box:g}) in one step; "
+            f"largest W_a entry {np.max(np.abs(wa)):g}, largest W_c entry {np.max(np.abs(wc)):g}")
+    if np.max(np.abs(wa)) >= 10 or np.max(np.abs(wc)) >= 1:
+        return head + " (the paper finds divergence from w_a >= 10 or w_c >= 1: the weights are too large)."
+    if np.min(wa) < 0:
+        return (head + " (a negative W_a entry: an agent among neighbours it anti-aligns with is pushed along its "
+                "own velocity, which can run away; the paper's 5b does this now and then).")
+    return head + " (the paper finds divergence from w_a >= 10 or w_c >= 1)."
 
 
 # ---- the plain all-pairs reference -----------------------------------------------------------------
