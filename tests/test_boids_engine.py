@@ -123,8 +123,8 @@ def test_divergence_message_names_the_cause():
     from lifelike_mj.boids.engine import divergence_message
 
     assert "too large" in divergence_message(homogeneous(10.0, 0.01), 3)
-    assert "negative W_a" in divergence_message(load_preset("5b"), 625)
-    assert "too large" not in divergence_message(load_preset("5b"), 625)
+    assert "negative W_a" in divergence_message(load_preset("5b"), 626)
+    assert "too large" not in divergence_message(load_preset("5b"), 626)
 
 
 def test_homogeneous_grid_is_the_papers():

@@ -45,7 +45,7 @@ N_AGENTS = 300
 #: side in one step (box units per step, as a multiple of the box side): the walls and zones no
 #: longer mean anything. With w_a >= 2 the speeds overflow within a few dozen steps; with w_c = 1
 #: the swarm stays finite but agents pass 20 box units per step within 35-500 steps. Anti-alignment
-#: (a negative W_a entry, as in 5b) can throw a lone agent past it too (5b seed 2, at step 625).
+#: (a negative W_a entry, as in 5b) can throw a lone agent past it too (5b seed 2, at step 626).
 DIVERGED_BOX_PER_STEP = 1.0
 
 
