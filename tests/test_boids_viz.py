@@ -245,7 +245,9 @@ def test_view_boids_loop_with_a_stand_in_viewer(monkeypatch, stand_in_viewer):
     """The viewer loop (camera set-up, stepping by the clock, stop after ``duration_steps``) on a fake window."""
     import mujoco.viewer
 
-    monkeypatch.setattr(boids_video, "has_display", lambda: True)
+    from lifelike_mj.viz import viewer
+
+    monkeypatch.setattr(viewer, "has_display", lambda: True)
     boids_video.view_boids(load_preset("4a"), n=20, seed=0, steps_per_s=2000.0, duration_steps=20, warmup_steps=10)
     (v,) = stand_in_viewer
     assert v.syncs >= 1 and v.cam.type == mujoco.mjtCamera.mjCAMERA_FREE and v.cam.distance > 20.0

@@ -157,7 +157,7 @@ def test_view_fish_loop_with_a_stand_in_viewer(monkeypatch, params, stand_in_vie
     import mujoco
     import mujoco.viewer
 
-    monkeypatch.setattr(fish_video, "has_display", lambda: True)
+    monkeypatch.setattr(viewer, "has_display", lambda: True)
     fish_video.view_fish(params, n_fish=2, seed=0, duration_s=0.1, camera="follow")
     (v,) = stand_in_viewer
     assert v.syncs >= 1 and v.cam.type == mujoco.mjtCamera.mjCAMERA_TRACKING and v.cam.azimuth == 90.0

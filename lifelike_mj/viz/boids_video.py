@@ -36,7 +36,7 @@ import numpy as np
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import atomic_path
 from lifelike_mj.viz.video import _check_size, _Offscreen, _positive, _video_report, _video_target, _write_frames
-from lifelike_mj.viz.viewer import FRAME_S, MAX_CATCH_UP_S, has_display
+from lifelike_mj.viz.viewer import FRAME_S, MAX_CATCH_UP_S, launch_viewer, require_display
 
 if TYPE_CHECKING:  # pragma: no cover
     from lifelike_mj.boids.engine import BoidParams
@@ -227,9 +227,7 @@ def view_boids(params: BoidParams, n: int = 300, seed: int = 0, steps_per_s: flo
     cannot keep up. Raises :class:`UserError` when there is no display (use :func:`render_boids`
     instead); on macOS run it under ``mjpython``.
     """
-    if not has_display():
-        raise UserError("no display found (DISPLAY and WAYLAND_DISPLAY are unset), so the viewer cannot open a "
-                        "window; use `lifelike-mj render boids --out FILE.mp4` instead.")
+    require_display("boids")
     _count("the number of agents", n, 2)
     _count("seed", seed, 0)
     rate = _positive("steps per second", steps_per_s)
@@ -240,16 +238,11 @@ def view_boids(params: BoidParams, n: int = 300, seed: int = 0, steps_per_s: flo
         raise UserError(f"unknown viewer camera {camera!r}; choose overview or top.")
 
     import mujoco
-    import mujoco.viewer
 
     run = _Run(params, n, seed)
     run.advance(max(warmup, 1))  # compiles the engine (about 10 s the first time, then cached) before the window opens
     m, d = run.model, run.data
-    try:
-        handle = mujoco.viewer.launch_passive(m, d, show_left_ui=False, show_right_ui=False)
-    except RuntimeError as exc:  # macOS outside mjpython
-        raise UserError(f"the MuJoCo viewer cannot start here ({str(exc).strip()}).") from None
-    with handle as viewer:
+    with launch_viewer(m, d) as viewer:
         with viewer.lock():
             centre = run.layout.centre
             over = m.camera("overview")

@@ -42,7 +42,7 @@ import numpy as np
 
 from lifelike_mj.errors import UserError
 from lifelike_mj.viz.video import _check_size, _Offscreen, _positive, _video_report, _video_target, _write_frames
-from lifelike_mj.viz.viewer import FRAME_S, MAX_CATCH_UP_S, has_display
+from lifelike_mj.viz.viewer import FRAME_S, MAX_CATCH_UP_S, launch_viewer, require_display
 
 if TYPE_CHECKING:  # pragma: no cover
     from lifelike_mj.fish.params import FishParams
@@ -313,16 +313,13 @@ def view_fish(params: FishParams, n_fish: int = 10, seed: int = 0, size=None, du
     ``follow`` video camera). Raises :class:`UserError` when there is no display (use
     :func:`render_fish` instead); on macOS run it under ``mjpython``.
     """
-    if not has_display():
-        raise UserError("no display found (DISPLAY and WAYLAND_DISPLAY are unset), so the viewer cannot open a "
-                        "window; use `lifelike-mj render fish --out FILE.mp4` instead.")
+    require_display("fish")
     if duration_s is not None:
         duration_s = _positive("duration", duration_s)
     if camera not in ("side", "follow"):
         raise UserError(f"unknown viewer camera {camera!r}; choose side or follow.")
 
     import mujoco
-    import mujoco.viewer
 
     sw = _swimmer(params, n_fish, seed, size)
     m, d = sw.scene.model, sw.data
@@ -330,11 +327,7 @@ def view_fish(params: FishParams, n_fish: int = 10, seed: int = 0, size=None, du
     _refresh(m, d)
     follow = _Camera(sw, "follow", 640, 480, follow_fish) if camera == "follow" else None
     dt = params.control_dt_s
-    try:
-        handle = mujoco.viewer.launch_passive(m, d, show_left_ui=False, show_right_ui=False)
-    except RuntimeError as exc:  # macOS outside mjpython
-        raise UserError(f"the MuJoCo viewer cannot start here ({str(exc).strip()}).") from None
-    with handle as viewer:
+    with launch_viewer(m, d) as viewer:
         with viewer.lock():
             side = m.camera("side")
             L, D, H = sw.scene.size

@@ -37,6 +37,25 @@ def has_display() -> bool:
     return True
 
 
+def require_display(creature: str) -> None:
+    """Raise :class:`UserError` (pointing to ``lifelike-mj render CREATURE``) when :func:`has_display`
+    says no window can be opened: ``launch_passive`` would kill the whole process."""
+    if not has_display():
+        raise UserError("no display found (DISPLAY and WAYLAND_DISPLAY are unset), so the viewer cannot open a "
+                        f"window; use `lifelike-mj render {creature} --out FILE.mp4` instead.")
+
+
+def launch_viewer(m, d):
+    """``mujoco.viewer.launch_passive`` on model ``m`` and data ``d``, side panels hidden; a viewer
+    that cannot start (macOS outside ``mjpython``) is a :class:`UserError`."""
+    import mujoco.viewer
+
+    try:
+        return mujoco.viewer.launch_passive(m, d, show_left_ui=False, show_right_ui=False)
+    except RuntimeError as exc:
+        raise UserError(f"the MuJoCo viewer cannot start here ({str(exc).strip()}).") from None
+
+
 def view_butterfly(controller: ButterflyController, params: ButterflyParams | None = None,
                    condition: Condition | None = None, config: str = "paper", force_mode: str = "tip",
                    duration_s: float | None = None) -> None:
@@ -47,24 +66,17 @@ def view_butterfly(controller: ButterflyController, params: ButterflyParams | No
     Time step 1/1200 s. Raises :class:`UserError` when there is no display; on macOS run it under
     ``mjpython``.
     """
-    if not has_display():
-        raise UserError("no display found (DISPLAY and WAYLAND_DISPLAY are unset), so the viewer cannot open a "
-                        "window; use `lifelike-mj render butterfly --out FILE.mp4` instead.")
+    require_display("butterfly")
     if duration_s is not None and (isinstance(duration_s, bool) or not isinstance(duration_s, (int, float))
                                    or not (math.isfinite(duration_s) and duration_s > 0)):
         raise UserError(f"duration must be a positive number of seconds, got {duration_s!r}.")
 
     import mujoco
-    import mujoco.viewer
 
     from lifelike_mj.viz.video import FOLLOW_AZIMUTH_DEG, FOLLOW_DISTANCE_M, FOLLOW_ELEVATION_DEG, _Flight
 
     flight = _Flight(controller, params, condition, config, force_mode)  # compiles the loop (about 1 s)
-    try:
-        handle = mujoco.viewer.launch_passive(flight.m, flight.d, show_left_ui=False, show_right_ui=False)
-    except RuntimeError as exc:  # macOS outside mjpython
-        raise UserError(f"the MuJoCo viewer cannot start here ({str(exc).strip()}).") from None
-    with handle as viewer:
+    with launch_viewer(flight.m, flight.d) as viewer:
         with viewer.lock():
             viewer.cam.type = mujoco.mjtCamera.mjCAMERA_TRACKING
             viewer.cam.trackbodyid = flight.body
