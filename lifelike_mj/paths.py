@@ -1,14 +1,22 @@
-"""Where the model and controller files live, in a source checkout and in an installed wheel.
+"""Where the model and controller files live, and the one loader of "a shipped name or a path".
 
 In a checkout they are the top-level ``models/`` and ``controllers/`` folders; a wheel installs
 the same folders as ``lifelike_mj/models`` and ``lifelike_mj/controllers`` (see pyproject.toml).
+Both hold one folder per creature: ``models/butterfly/butterfly.xml``,
+``controllers/fish/B-D.json``.
 """
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
+from lifelike_mj.errors import UserError
+
 _PKG = Path(__file__).resolve().parent
+
+#: Largest file :func:`read_json` accepts (bytes): a controller or preset is a few hundred kB at most.
+MAX_JSON_BYTES = 20_000_000
 
 
 def _data_dir(name: str) -> Path:
@@ -19,10 +27,61 @@ def _data_dir(name: str) -> Path:
 
 
 def models_dir() -> Path:
-    """Folder with the MJCF models."""
+    """Folder with the MJCF models, one folder per creature."""
     return _data_dir("models")
 
 
 def controllers_dir() -> Path:
-    """Folder with the controller files."""
+    """Folder with the controller and preset files, one folder per creature."""
     return _data_dir("controllers")
+
+
+def model_path(creature: str, file: str) -> Path:
+    """Path of the shipped MJCF ``file`` of ``creature`` (``model_path("fish", "tank.xml")``)."""
+    return models_dir() / creature / file
+
+
+def shipped_names(creature: str) -> list[str]:
+    """Names of the JSON files shipped in ``controllers/<creature>/``, sorted."""
+    return sorted(p.stem for p in (controllers_dir() / creature).glob("*.json"))
+
+
+def resolve(creature: str, name_or_path: str | Path, what: str) -> Path:
+    """The file that ``name_or_path`` means: a path (anything ending in ``.json`` or that exists) or
+    the name of a file shipped in ``controllers/<creature>/``. ``what`` names the kind of file in
+    the :class:`UserError` raised when there is no such file ("boids preset")."""
+    text = str(name_or_path)
+    path = Path(text)
+    if text.endswith(".json") or path.exists():
+        if not path.is_file():
+            raise UserError(f"{what} file {text} does not exist.")
+        return path
+    path = controllers_dir() / creature / f"{text}.json"
+    if not path.is_file():
+        raise UserError(f"unknown {what} {text!r}; shipped: {', '.join(shipped_names(creature))} "
+                        "(or give the path of a JSON file).")
+    return path
+
+
+def read_json(path: str | Path, what: str) -> object:
+    """The content of the JSON file ``path``, as plain data. Reading never runs code; a file that is
+    not readable UTF-8 JSON, or larger than :data:`MAX_JSON_BYTES`, is a :class:`UserError`."""
+    p = Path(path)
+    try:
+        if p.stat().st_size > MAX_JSON_BYTES:
+            raise UserError(f"{what} file {p} is larger than {MAX_JSON_BYTES // 1_000_000} MB; it cannot be one.")
+        return json.loads(p.read_text(encoding="utf-8"), parse_constant=_no_constant)
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, ValueError) as exc:
+        if isinstance(exc, UserError):
+            raise
+        raise UserError(f"{what} file {p} is not readable JSON ({exc.__class__.__name__}).") from None
+
+
+def load_named_json(creature: str, name_or_path: str | Path, what: str) -> tuple[object, Path]:
+    """:func:`resolve` then :func:`read_json`: ``(data, path)``."""
+    path = resolve(creature, name_or_path, what)
+    return read_json(path, what), path
+
+
+def _no_constant(name: str) -> float:
+    raise ValueError(f"{name} is not a number in strict JSON")

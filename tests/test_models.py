@@ -12,10 +12,10 @@ import pytest
 
 from lifelike_mj.butterfly import controllers, mjbackend
 from lifelike_mj.butterfly.params import ButterflyParams
-from lifelike_mj.paths import models_dir
+from lifelike_mj.paths import model_path, models_dir
 from lifelike_mj.physics.callbacks import passive_callback
 
-MODELS = sorted(models_dir().glob("*.xml"))
+MODELS = sorted(models_dir().glob("*/*.xml"))
 P = ButterflyParams()
 
 
@@ -85,14 +85,14 @@ def test_everything_is_named(path):
 
 
 def test_paper_model_masses():
-    m = mujoco.MjModel.from_xml_path(str(models_dir() / "butterfly.xml"))
+    m = mujoco.MjModel.from_xml_path(str(model_path("butterfly", "butterfly.xml")))
     assert m.body_subtreemass[m.body("butterfly").id] == pytest.approx(0.319e-3, rel=0, abs=1e-12)
     for side in ("left", "right"):
         assert m.body_mass[m.body(f"wing_{side}").id] == pytest.approx(1e-8, rel=0, abs=1e-15)
 
 
 def test_rich_model_masses():
-    m = mujoco.MjModel.from_xml_path(str(models_dir() / "butterfly_rich.xml"))
+    m = mujoco.MjModel.from_xml_path(str(model_path("butterfly", "butterfly_rich.xml")))
     assert m.body_subtreemass[m.body("butterfly").id] == pytest.approx(0.319e-3, rel=0, abs=1e-12)
     assert m.body_mass[m.body("butterfly").id] == pytest.approx(0.287e-3, rel=0, abs=1e-12)
     for side in ("left", "right"):
@@ -101,7 +101,7 @@ def test_rich_model_masses():
 
 @pytest.mark.parametrize("name", ["butterfly.xml", "butterfly_rich.xml"])
 def test_wing_is_planform_2_with_centre_of_pressure_at_0_8_L(name):
-    m = mujoco.MjModel.from_xml_path(str(models_dir() / name))
+    m = mujoco.MjModel.from_xml_path(str(model_path("butterfly", name)))
     for side, sign in (("left", 1.0), ("right", -1.0)):
         corners = _wing_triangle(m, side)
         assert len(corners) == 3

@@ -12,12 +12,11 @@ The grid (``fig2_grid.json``) lists the homogeneous ``w_a`` and ``w_c`` values o
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from lifelike_mj.boids.engine import BoidParams
 from lifelike_mj.errors import UserError
-from lifelike_mj.paths import controllers_dir
+from lifelike_mj.paths import controllers_dir, load_named_json
 
 FORMAT = "lifelike-mj/boids-preset"
 GRID_FORMAT = "lifelike-mj/boids-grid"
@@ -30,18 +29,7 @@ def preset_path(name: str) -> Path:
 
 
 def _read(ref: str | Path) -> tuple[dict, Path]:
-    p = Path(ref)
-    if p.suffix != ".json" and not p.exists():
-        p = preset_path(str(ref))
-        if not p.is_file():
-            raise UserError(f"unknown boids preset {str(ref)!r}; known presets: {', '.join(PATTERNS)} "
-                            f"(or a path to a JSON file).")
-    elif not p.is_file():
-        raise UserError(f"no boids preset file {ref}.")
-    try:
-        return json.loads(p.read_text(encoding="utf-8")), p
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise UserError(f"cannot read boids preset {p}: {e}.") from None
+    return load_named_json("boids", ref, "boids preset")
 
 
 def load_preset(ref: str | Path, dims: int = 3) -> BoidParams:

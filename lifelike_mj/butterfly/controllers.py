@@ -22,7 +22,6 @@ Compiled code sees a controller as ``(kind, params)``: an integer code and a flo
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -32,7 +31,7 @@ import numpy as np
 from lifelike_mj.butterfly import ann
 from lifelike_mj.butterfly.params import FlapPattern
 from lifelike_mj.errors import UserError
-from lifelike_mj.paths import controllers_dir
+from lifelike_mj.paths import load_named_json, shipped_names
 
 FORMAT = "lifelike-mj/butterfly-controller"
 
@@ -199,21 +198,10 @@ def ann_controller(weights, flap: FlapPattern | None = None, inputs: str = "rela
 
 def builtin_names() -> list[str]:
     """Names of the controllers shipped in ``controllers/butterfly/``."""
-    return sorted(p.stem for p in (controllers_dir() / "butterfly").glob("*.json"))
+    return shipped_names("butterfly")
 
 
 def load(name_or_path: str | Path) -> ButterflyController:
     """Load a shipped controller by name (``simple_rule``) or any controller file by path."""
-    text = str(name_or_path)
-    path = Path(text)
-    if not (text.endswith(".json") or path.exists()):
-        path = controllers_dir() / "butterfly" / f"{text}.json"
-        if not path.exists():
-            raise UserError(f"unknown controller {text!r}; shipped controllers: {', '.join(builtin_names())}.")
-    if not path.is_file():
-        raise UserError(f"controller file {path} does not exist.")
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise UserError(f"controller file {path} is not readable JSON ({exc.__class__.__name__}).") from None
+    data, path = load_named_json("butterfly", name_or_path, "controller")
     return from_dict(data, path.stem)

@@ -40,13 +40,13 @@ import mujoco
 import numpy as np
 from numba import cfunc, njit, prange, types
 
+from lifelike_mj import paths
 from lifelike_mj.butterfly.aero import strip_nodes
 from lifelike_mj.butterfly.controllers import ButterflyController
 from lifelike_mj.butterfly.paper import Condition, check_timing, fitness_term, pitch_command
 from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.butterfly.trajectory import Trajectory
 from lifelike_mj.errors import UserError
-from lifelike_mj.paths import models_dir
 from lifelike_mj.physics import mjabi
 from lifelike_mj.physics.callbacks import passive_callback
 from lifelike_mj.physics.fluid import normal_drag_scalar
@@ -351,7 +351,7 @@ def check_config(config: str, force_mode: str) -> None:
 def model_path(config: str = "paper") -> Path:
     """Path of the MJCF file of a configuration ("paper" or "rich")."""
     check_config(config, "tip")
-    return models_dir() / CONFIGS[config]
+    return paths.model_path("butterfly", CONFIGS[config])
 
 
 def build_model(params: ButterflyParams | None = None, config: str = "paper") -> mujoco.MjModel:

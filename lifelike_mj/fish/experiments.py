@@ -41,7 +41,7 @@ from lifelike_mj.fish.sim import (
     swim,
 )
 from lifelike_mj.io import atomic_path, write_npz
-from lifelike_mj.paths import models_dir
+from lifelike_mj.paths import model_path
 from lifelike_mj.physics.callbacks import passive_callback
 
 PATTERNS = ("NB-ND", "NB-D", "B-ND", "B-D")
@@ -106,7 +106,7 @@ def drag_check(trials: int = 200, seed: int = 0) -> dict:
     per state) and the areas used."""
     rng = np.random.default_rng(seed)
     rho = FishParams().water_density_kg_m3
-    spec = mujoco.MjSpec.from_file(str(models_dir() / "fish.xml"))
+    spec = mujoco.MjSpec.from_file(str(model_path("fish", "fish.xml")))
     spec.nuserdata = U_FISH + FISH_BLOCK
     spec.body("fish").gravcomp = 0.0
     m = spec.compile()

@@ -45,7 +45,6 @@ Parameters (section numbers of the paper):
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
@@ -53,7 +52,7 @@ from pathlib import Path
 import numpy as np
 
 from lifelike_mj.errors import UserError
-from lifelike_mj.paths import controllers_dir
+from lifelike_mj.paths import controllers_dir, load_named_json
 
 FORMAT = "lifelike-mj/fish-preset"
 #: The paper's four patterns (section 5.1.1) and the calibrated default.
@@ -201,18 +200,7 @@ def preset_path(name: str) -> Path:
 def load_preset(name_or_path: str | Path | None = None, _seen: tuple[str, ...] = ()) -> FishParams:
     """A preset by name (``NB-ND``, ``NB-D``, ``B-ND``, ``B-D``, ``default``) or by path to a file."""
     ref = "default" if name_or_path is None else str(name_or_path)
-    p = Path(ref)
-    if p.suffix == ".json" or p.exists():
-        if not p.is_file():
-            raise UserError(f"no fish preset file {ref}.")
-    else:
-        p = preset_path(ref)
-        if not p.is_file():
-            raise UserError(f"unknown fish preset {ref!r}; known presets: {', '.join(PRESETS)} (or a path to a JSON file).")
-    try:
-        data = json.loads(p.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise UserError(f"cannot read fish preset {p}: {e}.") from None
+    data, p = load_named_json("fish", ref, "fish preset")
     if isinstance(data, dict) and "same_as" in data:
         target = str(data["same_as"])
         if target in _seen:

@@ -21,7 +21,7 @@ import mujoco
 import numpy as np
 
 from lifelike_mj.errors import UserError
-from lifelike_mj.paths import models_dir
+from lifelike_mj.paths import model_path
 
 #: The filmed tank (section 4): length (x, m), depth (y, m), height (z, m).
 FILMED_TANK_M = (5.0, 0.5, 1.0)
@@ -53,7 +53,7 @@ def base_spec(size=None) -> mujoco.MjSpec:
     """The tank of ``models/tank.xml`` with its walls resized to the water volume ``size`` (m)."""
     L, D, H = check_tank(size if size is not None else tank_size())
     t = WALL_THICKNESS_M
-    spec = mujoco.MjSpec.from_file(str(models_dir() / "tank.xml"))
+    spec = mujoco.MjSpec.from_file(str(model_path("fish", "tank.xml")))
     boxes = {
         "floor": ((L / 2 + 2 * t, D / 2 + 2 * t, t), (0.0, 0.0, -t)),
         "lid": ((L / 2 + 2 * t, D / 2 + 2 * t, t), (0.0, 0.0, H + t)),
@@ -113,7 +113,7 @@ def build_scene(n_fish: int, size=None, spec: mujoco.MjSpec | None = None, nuser
     else:
         size = check_tank(size if size is not None else tank_size())
     vision_model = spec.copy().compile()
-    fish = mujoco.MjSpec.from_file(str(models_dir() / "fish.xml"))
+    fish = mujoco.MjSpec.from_file(str(model_path("fish", "fish.xml")))
     src = fish.body("fish")
     spec.copy_during_attach = True
     for start in range(0, n_fish, _GROUP):
