@@ -43,7 +43,8 @@ def _run(problem, optimizer, executor, workers=None, **kw):
 def bare_step_us(n: int = 24000, repeats: int = 3) -> float:
     """Bare RK4 ``mj_step`` of models/butterfly.xml (no callback), us per step from a native loop
     (the measurement of ``lifelike-mj bench butterfly``), median of ``repeats``."""
-    from lifelike_mj.butterfly import bench, controllers, mjbackend
+    from lifelike_mj.butterfly import bench, controllers
+    from lifelike_mj.butterfly.backends import mj as mjbackend
 
     m = mjbackend.build_model()
     m.opt.timestep = 1.0 / 1200.0

@@ -77,8 +77,7 @@ def _add_backend(p: argparse.ArgumentParser) -> None:
 
 
 def _backend_options(args) -> dict:
-    from lifelike_mj.butterfly.backends import check_backend
-    from lifelike_mj.butterfly.compare import DEFAULT_FORCE_MODE
+    from lifelike_mj.butterfly.backends import DEFAULT_FORCE_MODE, check_backend
 
     check_backend(args.backend)
     if args.backend != "mujoco":
@@ -142,7 +141,7 @@ def cmd_timestep(args) -> None:
 
 def cmd_fly(args) -> None:
     from lifelike_mj.butterfly import backends
-    from lifelike_mj.butterfly.paper import Condition, check_timing
+    from lifelike_mj.butterfly.flight import Condition, check_timing
 
     ctrl = _controller(args)
     params = _params(args)
@@ -491,7 +490,7 @@ def cmd_view(args) -> None:
 
         view_fish(_fish_preset(args), _fish_count(args.fish), args.seed, _tank(args), duration_s=args.duration)
         return
-    from lifelike_mj.butterfly.paper import Condition
+    from lifelike_mj.butterfly.flight import Condition
     from lifelike_mj.viz.viewer import view_butterfly
 
     view_butterfly(_controller(args), _params(args), Condition(args.y0, args.wind), config=args.config,
@@ -519,7 +518,7 @@ def cmd_render(args) -> None:
                            width=args.width, height=args.height, camera=args.camera or "side")
         _emit(args, info, f"wrote {info['frames']} frames to {args.out}")
         return
-    from lifelike_mj.butterfly.paper import Condition
+    from lifelike_mj.butterfly.flight import Condition
     from lifelike_mj.viz.video import render_butterfly
 
     info = render_butterfly(args.out, _controller(args), _params(args), Condition(args.y0, args.wind),

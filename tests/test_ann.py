@@ -8,9 +8,10 @@ import math
 import numpy as np
 import pytest
 
-from lifelike_mj.butterfly import ann, controllers, mjbackend, paper
+from lifelike_mj.butterfly import ann, controllers
+from lifelike_mj.butterfly.backends import mj as mjbackend, paper
 from lifelike_mj.butterfly.evolution import PitchProblem, make_problem
-from lifelike_mj.butterfly.paper import Condition
+from lifelike_mj.butterfly.flight import Condition
 from lifelike_mj.cli import main
 from lifelike_mj.errors import UserError
 

@@ -18,7 +18,7 @@ from lifelike_mj.butterfly.ann_experiments import (
     WindsResult,
     flight_numbers,
 )
-from lifelike_mj.butterfly.trajectory import Trajectory
+from lifelike_mj.butterfly.flight import Trajectory
 from lifelike_mj.viz import ann_figures as af
 
 DT = 0.01  # s

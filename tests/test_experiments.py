@@ -9,7 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from lifelike_mj.butterfly import controllers, experiments, paper, report
+from lifelike_mj.butterfly import controllers, experiments, report
+from lifelike_mj.butterfly.backends import paper
 from lifelike_mj.errors import UserError
 from lifelike_mj.viz import figures
 

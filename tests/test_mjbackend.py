@@ -3,9 +3,10 @@
 import numpy as np
 import pytest
 
-from lifelike_mj.butterfly import controllers, mjbackend, paper
+from lifelike_mj.butterfly import controllers
+from lifelike_mj.butterfly.backends import mj as mjbackend, paper
 from lifelike_mj.butterfly.compare import compare
-from lifelike_mj.butterfly.paper import Condition
+from lifelike_mj.butterfly.flight import Condition
 from lifelike_mj.physics import mjabi
 
 

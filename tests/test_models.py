@@ -10,7 +10,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from lifelike_mj.butterfly import controllers, mjbackend
+from lifelike_mj.butterfly import controllers
+from lifelike_mj.butterfly.backends import mj as mjbackend
 from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.paths import model_path, models_dir
 from lifelike_mj.physics.callbacks import passive_callback

@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from lifelike_mj.butterfly import controllers, paper
+from lifelike_mj.butterfly import controllers
+from lifelike_mj.butterfly.backends import paper
 from lifelike_mj.butterfly.params import ButterflyParams, FlapPattern
 
 DT = 1.0 / 1200.0

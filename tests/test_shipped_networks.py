@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 from lifelike_mj.butterfly import ann_experiments as ax
-from lifelike_mj.butterfly import controllers, mjbackend, paper
+from lifelike_mj.butterfly import controllers
+from lifelike_mj.butterfly.backends import mj as mjbackend, paper
 from lifelike_mj.butterfly.evolution import make_problem
-from lifelike_mj.butterfly.paper import Condition
+from lifelike_mj.butterfly.flight import Condition
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,8 @@ import pytest
 from conftest import gif_frames
 from PIL import Image
 
-from lifelike_mj.butterfly import controllers, mjbackend
+from lifelike_mj.butterfly import controllers
+from lifelike_mj.butterfly.backends import mj as mjbackend
 from lifelike_mj.errors import UserError
 from lifelike_mj.viz import video, viewer
 

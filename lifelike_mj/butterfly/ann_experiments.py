@@ -21,10 +21,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from lifelike_mj.butterfly import backends, controllers
+from lifelike_mj.butterfly.backends.paper import compile_controllers, constants_row, run_batch
 from lifelike_mj.butterfly.controllers import ButterflyController
-from lifelike_mj.butterfly.paper import Condition, compile_controllers, constants_row, run_batch
+from lifelike_mj.butterfly.flight import Condition, Trajectory
 from lifelike_mj.butterfly.params import ButterflyParams
-from lifelike_mj.butterfly.trajectory import Trajectory
 from lifelike_mj.errors import UserError
 
 DT_S = 1.0 / 1200.0  # section 6.3

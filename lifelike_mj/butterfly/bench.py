@@ -21,8 +21,10 @@ import time
 import numpy as np
 from numba import njit
 
-from lifelike_mj.butterfly import controllers, mjbackend, paper
-from lifelike_mj.butterfly.paper import Condition
+from lifelike_mj.butterfly import controllers
+from lifelike_mj.butterfly.backends import mj as mjbackend
+from lifelike_mj.butterfly.backends import paper
+from lifelike_mj.butterfly.flight import Condition
 from lifelike_mj.machine import machine_info
 from lifelike_mj.physics.callbacks import passive_callback
 
@@ -47,8 +49,8 @@ def _time_mujoco(m, ctrl, mode: str | None, n: int) -> float:
     lay = mjbackend.layout(m).as_array()
     with passive_callback(mjbackend.COMPILED_PASSIVE):
         t0 = time.perf_counter()
-        mjbackend._run(m._address, d._address, d.qpos, d.qvel, d.userdata, n, 1, kind, cp, ctrl.flap.as_array(),
-                       0.0, lay, float(m.opt.timestep), out, div, np.zeros(1))
+        mjbackend.record_steps(m._address, d._address, d.qpos, d.qvel, d.userdata, 0, n, 1, kind, cp,
+                               ctrl.flap.as_array(), 0.0, lay, float(m.opt.timestep), 0.0, out, 1, div, np.zeros(1))
         return (time.perf_counter() - t0) / n
 
 

@@ -11,15 +11,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lifelike_mj.butterfly import mjbackend, paper
+from lifelike_mj.butterfly.backends import DEFAULT_FORCE_MODE, paper
+from lifelike_mj.butterfly.backends import mj as mjbackend
 from lifelike_mj.butterfly.controllers import ButterflyController
-from lifelike_mj.butterfly.paper import Condition
+from lifelike_mj.butterfly.flight import Condition, Trajectory
 from lifelike_mj.butterfly.params import ButterflyParams
-from lifelike_mj.butterfly.trajectory import Trajectory
 from lifelike_mj.errors import UserError
-
-#: Default wing-force mode of each MuJoCo configuration.
-DEFAULT_FORCE_MODE = {"paper": "tip", "rich": "strip"}
 
 
 @dataclass(frozen=True)

@@ -30,8 +30,9 @@ import numpy as np
 
 from lifelike_mj.butterfly import ann
 from lifelike_mj.butterfly.backends import check_backend
+from lifelike_mj.butterfly.backends.paper import constants_row, run_batch
 from lifelike_mj.butterfly.controllers import KIND_ANN, ButterflyController, ann_controller
-from lifelike_mj.butterfly.paper import Condition, check_timing, constants_row, run_batch
+from lifelike_mj.butterfly.flight import Condition, check_timing
 from lifelike_mj.butterfly.params import ButterflyParams, FlapPattern
 from lifelike_mj.errors import UserError
 
@@ -132,7 +133,7 @@ class PitchProblem:
             consts = np.repeat(constants_row(self.params)[None, :], n * nf, axis=0)
             _, _, fit = run_batch(kinds, cps, flaps, airs, y0s, consts, n_steps, self.dt_s, n_steps)
             return self.weights() @ fit.reshape(nf, n)
-        from lifelike_mj.butterfly.mjbackend import fitness_batch
+        from lifelike_mj.butterfly.backends.mj import fitness_batch
 
         fits = []
         for cond, rel in flights:

@@ -24,8 +24,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from lifelike_mj.butterfly import aero, backends, controllers
+from lifelike_mj.butterfly.flight import Trajectory
 from lifelike_mj.butterfly.params import ButterflyParams
-from lifelike_mj.butterfly.trajectory import Trajectory
 from lifelike_mj.errors import UserError
 
 #: The paper's numbers for the simple rule (Oe 2010 section 5.1, Fig. 4).

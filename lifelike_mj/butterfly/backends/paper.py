@@ -18,19 +18,27 @@ kept as the speed baseline and as an independent check of the compiled code.
 
 from __future__ import annotations
 
+import functools
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from numba import njit, prange
 
 from lifelike_mj.butterfly.ann import ann_pitch
 from lifelike_mj.butterfly.controllers import KIND_ANN, KIND_CONSTANT, KIND_SIMPLE_RULE, OMEGA_EPS, ButterflyController
+from lifelike_mj.butterfly.flight import (
+    Condition,
+    PitchObservation,
+    Trajectory,
+    builtin_law,
+    check_timing,
+    fitness_term,
+)
 from lifelike_mj.butterfly.params import ButterflyParams
-from lifelike_mj.butterfly.trajectory import Trajectory
 from lifelike_mj.errors import UserError
 from lifelike_mj.physics.fluid import normal_drag_scalar
+from lifelike_mj.physics.jit import njit_with
 
 # columns of the per-butterfly constants array
 _MASS, _K, _AB, _RHO, _CD, _L, _G = range(7)
@@ -39,28 +47,6 @@ _MASS, _K, _AB, _RHO, _CD, _L, _G = range(7)
 def constants_row(p: ButterflyParams) -> np.ndarray:
     """Constants of one butterfly for compiled code: m, K, A_b, rho, C_d, L, g (SI)."""
     return np.array([p.mass_kg, p.k_wings, p.body_area_m2, p.rho, p.cd, p.span_m, p.gravity])
-
-
-@njit(cache=True, inline="always")
-def pitch_command(kind, cparams, t, theta, omega, y, z, vy, vz, air_y, air_z, phi_prev):
-    """Pitch ``phi`` (rad) chosen once per step by the compiled controller ``kind``: flap angle
-    ``theta`` (rad) and rate ``omega`` (rad/s), altitude ``y`` (relative to the target altitude 0 m;
-    the start altitude of a :class:`Condition` only sets the initial state) and forward
-    position ``z`` (m), ground velocities ``vy``, ``vz`` and air velocity ``air_y``, ``air_z`` (m/s),
-    previous pitch ``phi_prev`` (rad)."""
-    if kind == KIND_SIMPLE_RULE:
-        return cparams[0] if omega > OMEGA_EPS else cparams[1]
-    if kind == KIND_ANN:
-        return ann_pitch(cparams, theta, omega, y, vy, vz, air_y, air_z, phi_prev)
-    return cparams[0]  # KIND_CONSTANT
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def fitness_term(y_rel, vz):
-    """One step's term of the fitness ``H`` of Oe 2010 eq. 13: ``(v_z/3) 0.1/(|y| + 0.1)``, with the
-    ground forward speed ``v_z`` (m/s) and the altitude ``y`` (m) measured from the target altitude 0 m
-    (the paper's start altitude; section 7.1 keeps the target at 0 m when the start changes)."""
-    return vz / 3.0 * 0.1 / (abs(y_rel) + 0.1)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -84,117 +70,144 @@ def _flap_from(flap, cw, sw):
     return -flap[1] * flap[2] * sw, math.cos(flap[0] + flap[1] * cw)
 
 
+# ---- one butterfly, resumable ------------------------------------------------------------------
+
+#: Columns of a butterfly's state array (for :func:`fly_steps`): altitude y (m), forward z (m),
+#: velocities v_y, v_z (m/s), the last pitch phi (rad), cos and sin of the flap phase 2 pi f t at the
+#: next step, and the fitness H summed so far (eq. 13).
+S_Y, S_Z, S_VY, S_VZ, S_PHI, S_CW, S_SW, S_FIT = range(8)
+N_STATE = 8
+
+
+def initial_state(y0_m: float) -> np.ndarray:
+    """The state array of a butterfly at rest at altitude ``y0_m`` (m), wings at the top, step 0."""
+    s = np.zeros(N_STATE)
+    s[S_Y] = y0_m
+    s[S_CW] = 1.0
+    return s
+
+
+def _fly_loop(kind, cp, flap, air_z, air_y, c, s, k0, n_steps, dt, every, out, r0):
+    """Steps ``k0 .. k0 + n_steps - 1`` of one butterfly (Oe 2010 eq. 7-11, RK4; module docstring),
+    from and back into its state array ``s`` (:data:`S_Y` ...). The pitch of step ``k`` is
+    ``_law(kind, cp, obs)`` with ``obs`` a :class:`~lifelike_mj.butterfly.flight.PitchObservation`
+    (the built-in laws in :func:`fly_steps`; a law of your own in :func:`fly_steps_with`).
+    Every ``every`` steps (counted from ``k0``) a row ``y, z, v_y, v_z, phi`` is written into ``out``
+    from row ``r0`` on. Returns ``(diverged, r)``: the step count at a runaway (rows from there on
+    are NaN) or -1, and the next row. Stepping in chunks gives the same numbers bit for bit as one
+    call: everything carried from step to step is in ``s`` or recomputed exactly from it."""
+    h = 0.5 * dt
+    # cos/sin of 2 pi f t advanced by exact rotations of 2 pi f h (two per step), re-synced with
+    # math.cos/sin every 256 steps: the same values to ~1e-15, at a third of the cost
+    cdh = math.cos(flap[2] * h)
+    sdh = math.sin(flap[2] * h)
+    y = s[S_Y]
+    z = s[S_Z]
+    vy = s[S_VY]
+    vz = s[S_VZ]
+    phi = s[S_PHI]
+    cw0 = s[S_CW]
+    sw0 = s[S_SW]
+    fit = s[S_FIT]
+    om0, ct0 = _flap_from(flap, cw0, sw0)
+    phi_prev = np.nan
+    sphi = 0.0
+    cphi = 1.0
+    r = r0
+    countdown = every
+    for k in range(k0, k0 + n_steps):
+        t = k * dt
+        theta0 = flap[0] + flap[1] * cw0
+        phi = _law(kind, cp, PitchObservation(t, phi, om0, theta0, vy, y, vz, air_y, air_z))
+        if phi != phi_prev:
+            sphi = math.sin(phi)
+            cphi = math.cos(phi)
+            phi_prev = phi
+        cwh = cw0 * cdh - sw0 * sdh
+        swh = sw0 * cdh + cw0 * sdh
+        omh, cth = _flap_from(flap, cwh, swh)
+        if (k + 1) & 255 == 0:  # re-sync the rotation with exact values
+            w1 = flap[2] * ((k + 1) * dt)
+            cw1 = math.cos(w1)
+            sw1 = math.sin(w1)
+        else:
+            cw1 = cwh * cdh - swh * sdh
+            sw1 = swh * cdh + cwh * sdh
+        om1, ct1 = _flap_from(flap, cw1, sw1)
+        a1y, a1z = _accel(vy, vz, sphi, cphi, om0, ct0, air_z, air_y, c)
+        v2y = vy + h * a1y
+        v2z = vz + h * a1z
+        a2y, a2z = _accel(v2y, v2z, sphi, cphi, omh, cth, air_z, air_y, c)
+        v3y = vy + h * a2y
+        v3z = vz + h * a2z
+        a3y, a3z = _accel(v3y, v3z, sphi, cphi, omh, cth, air_z, air_y, c)
+        v4y = vy + dt * a3y
+        v4z = vz + dt * a3z
+        a4y, a4z = _accel(v4y, v4z, sphi, cphi, om1, ct1, air_z, air_y, c)
+        y += dt / 6.0 * (vy + 2.0 * v2y + 2.0 * v3y + v4y)
+        z += dt / 6.0 * (vz + 2.0 * v2z + 2.0 * v3z + v4z)
+        vy += dt / 6.0 * (a1y + 2.0 * a2y + 2.0 * a3y + a4y)
+        vz += dt / 6.0 * (a1z + 2.0 * a2z + 2.0 * a3z + a4z)
+        cw0 = cw1
+        sw0 = sw1
+        om0 = om1
+        ct0 = ct1
+        if not (abs(vy) + abs(vz) < 1e4):  # also catches NaN
+            for rr in range(r, out.shape[0]):
+                for j in range(5):
+                    out[rr, j] = np.nan
+            _store(s, y, z, vy, vz, phi, cw0, sw0, fit)
+            return k + 1, r
+        fit += fitness_term(y, vz)
+        countdown -= 1
+        if countdown == 0:
+            countdown = every
+            out[r, 0] = y
+            out[r, 1] = z
+            out[r, 2] = vy
+            out[r, 3] = vz
+            out[r, 4] = phi
+            r += 1
+    _store(s, y, z, vy, vz, phi, cw0, sw0, fit)
+    return -1, r
+
+
+@njit(inline="always")
+def _store(s, y, z, vy, vz, phi, cw, sw, fit):
+    s[S_Y] = y
+    s[S_Z] = z
+    s[S_VY] = vy
+    s[S_VZ] = vz
+    s[S_PHI] = phi
+    s[S_CW] = cw
+    s[S_SW] = sw
+    s[S_FIT] = fit
+
+
+_law = builtin_law
+#: :func:`_fly_loop` with the built-in pitch laws (compiled once, cached).
+fly_steps = njit(cache=True, error_model="numpy")(_fly_loop)
+
+
+@functools.lru_cache(maxsize=64)
+def fly_steps_with(law) -> Callable:
+    """:func:`_fly_loop` compiled with the pitch law ``law(kind, cp, obs)`` (see
+    :func:`~lifelike_mj.butterfly.flight.kernel_law`), inlined as the built-in laws are."""
+    return njit_with(_fly_loop, "fly_steps_with", {"_law": law}, error_model="numpy")
+
+
 @njit(cache=True, parallel=True, error_model="numpy")
 def _simulate(kinds, cparams, flaps, airs, y0s, consts, n_steps, dt, record_every, out, diverged, fitness):
-    nb = kinds.shape[0]
-    for b in prange(nb):
-        flap = flaps[b]
-        c = consts[b]
-        cp = cparams[b]
-        kind = kinds[b]
-        air_z = airs[b, 0]
-        air_y = airs[b, 1]
-        y = y0s[b]
-        z = 0.0
-        vy = 0.0
-        vz = 0.0
-        phi = 0.0
-        out[b, 0, 0] = y
-        out[b, 0, 1] = z
-        out[b, 0, 2] = vy
-        out[b, 0, 3] = vz
-        out[b, 0, 4] = phi
-        r = 1
-        countdown = record_every
-        h = 0.5 * dt
-        # cos/sin of 2 pi f t advanced by exact rotations of 2 pi f h (two per step), re-synced with
-        # math.cos/sin every 256 steps: the same values to ~1e-15, at a third of the cost
-        cdh = math.cos(flap[2] * h)
-        sdh = math.sin(flap[2] * h)
-        cw0 = 1.0
-        sw0 = 0.0
-        om0, ct0 = _flap_from(flap, cw0, sw0)
-        phi_prev = np.nan
-        sphi = 0.0
-        cphi = 1.0
-        fit = 0.0
-        for k in range(n_steps):
-            t = k * dt
-            theta0 = flap[0] + flap[1] * cw0
-            phi = pitch_command(kind, cp, t, theta0, om0, y, z, vy, vz, air_y, air_z, phi)
-            if phi != phi_prev:
-                sphi = math.sin(phi)
-                cphi = math.cos(phi)
-                phi_prev = phi
-            cwh = cw0 * cdh - sw0 * sdh
-            swh = sw0 * cdh + cw0 * sdh
-            omh, cth = _flap_from(flap, cwh, swh)
-            if (k + 1) & 255 == 0:  # re-sync the rotation with exact values
-                w1 = flap[2] * ((k + 1) * dt)
-                cw1 = math.cos(w1)
-                sw1 = math.sin(w1)
-            else:
-                cw1 = cwh * cdh - swh * sdh
-                sw1 = swh * cdh + cwh * sdh
-            om1, ct1 = _flap_from(flap, cw1, sw1)
-            a1y, a1z = _accel(vy, vz, sphi, cphi, om0, ct0, air_z, air_y, c)
-            v2y = vy + h * a1y
-            v2z = vz + h * a1z
-            a2y, a2z = _accel(v2y, v2z, sphi, cphi, omh, cth, air_z, air_y, c)
-            v3y = vy + h * a2y
-            v3z = vz + h * a2z
-            a3y, a3z = _accel(v3y, v3z, sphi, cphi, omh, cth, air_z, air_y, c)
-            v4y = vy + dt * a3y
-            v4z = vz + dt * a3z
-            a4y, a4z = _accel(v4y, v4z, sphi, cphi, om1, ct1, air_z, air_y, c)
-            y += dt / 6.0 * (vy + 2.0 * v2y + 2.0 * v3y + v4y)
-            z += dt / 6.0 * (vz + 2.0 * v2z + 2.0 * v3z + v4z)
-            vy += dt / 6.0 * (a1y + 2.0 * a2y + 2.0 * a3y + a4y)
-            vz += dt / 6.0 * (a1z + 2.0 * a2z + 2.0 * a3z + a4z)
-            cw0 = cw1
-            sw0 = sw1
-            om0 = om1
-            ct0 = ct1
-            if not (abs(vy) + abs(vz) < 1e4):  # also catches NaN
-                diverged[b] = k + 1
-                for rr in range(r, out.shape[1]):
-                    for j in range(5):
-                        out[b, rr, j] = np.nan
-                break
-            fit += fitness_term(y, vz)
-            countdown -= 1
-            if countdown == 0:
-                countdown = record_every
-                out[b, r, 0] = y
-                out[b, r, 1] = z
-                out[b, r, 2] = vy
-                out[b, r, 3] = vz
-                out[b, r, 4] = phi
-                r += 1
-        fitness[b] = fit
-
-
-@dataclass(frozen=True)
-class Condition:
-    """Conditions of one flight: start altitude (m) and wind ``(a, b)`` (m/s, where it comes from)."""
-
-    y0_m: float = 0.0
-    wind_m_s: tuple[float, float] = (0.0, 0.0)
-
-    def air_velocity(self) -> tuple[float, float]:
-        """Air velocity (forward, up) in m/s: ``-(a, b)`` (spec section 3)."""
-        return (-float(self.wind_m_s[0]), -float(self.wind_m_s[1]))
-
-
-def check_timing(duration_s: float, dt_s: float, record_every: int = 1) -> int:
-    """Validate duration and step; return the number of steps."""
-    if not (math.isfinite(duration_s) and duration_s > 0):
-        raise UserError(f"duration must be a positive number of seconds, got {duration_s}.")
-    if not (math.isfinite(dt_s) and 0 < dt_s <= 0.1):
-        raise UserError(f"time step must be in (0, 0.1] s, got {dt_s}.")
-    if record_every < 1:
-        raise UserError("record_every must be at least 1.")
-    return int(round(duration_s / dt_s))
+    for b in prange(kinds.shape[0]):
+        s = np.zeros(N_STATE)
+        s[S_Y] = y0s[b]
+        s[S_CW] = 1.0
+        for j in range(5):
+            out[b, 0, j] = s[j]
+        dv, _ = fly_steps(kinds[b], cparams[b], flaps[b], airs[b, 0], airs[b, 1], consts[b], s, 0, n_steps, dt,
+                          record_every, out[b], 1)
+        diverged[b] = dv
+        fitness[b] = s[S_FIT]
 
 
 def simulate(

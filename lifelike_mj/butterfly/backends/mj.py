@@ -32,29 +32,32 @@ Python twin of the compiled callback, kept as the reference the compiled one is 
 
 from __future__ import annotations
 
+import functools
 import math
-from dataclasses import dataclass
-from pathlib import Path
+from collections.abc import Callable
 
 import mujoco
 import numpy as np
 from numba import cfunc, njit, prange, types
 
-from lifelike_mj import paths
 from lifelike_mj.butterfly.aero import strip_nodes
 from lifelike_mj.butterfly.controllers import ButterflyController
-from lifelike_mj.butterfly.paper import Condition, check_timing, fitness_term, pitch_command
+from lifelike_mj.butterfly.flight import (
+    Condition,
+    PitchObservation,
+    Trajectory,
+    builtin_law,
+    check_timing,
+    fitness_term,
+    pitch_command,
+)
+from lifelike_mj.butterfly.model import CP_FRACTION, FORCE_MODES, build_model, check_config, layout
 from lifelike_mj.butterfly.params import ButterflyParams
-from lifelike_mj.butterfly.trajectory import Trajectory
 from lifelike_mj.errors import UserError
 from lifelike_mj.physics import mjabi
 from lifelike_mj.physics.callbacks import passive_callback
 from lifelike_mj.physics.fluid import normal_drag_scalar
-
-CONFIGS = {"paper": "butterfly.xml", "rich": "butterfly_rich.xml"}
-FORCE_MODES = {"none": 0, "tip": 1, "strip": 2}
-#: Centre of pressure of planform 2 as a fraction of L: tau_2 / F_2 = (alpha L/10)/(alpha/8) (eq. 4, 6).
-CP_FRACTION = 0.8
+from lifelike_mj.physics.jit import njit_with
 
 # ---- userdata layout (float64 slots) -------------------------------------------------------
 U_MODE, U_RICH = 0, 1
@@ -323,71 +326,6 @@ def python_passive(m: mujoco.MjModel, d: mujoco.MjData) -> None:
 # ---- model set-up ----------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class Layout:
-    """Addresses the stepping loop needs (qpos/qvel indices), read by name from the model."""
-
-    rich: bool
-    q_forward: int
-    q_height: int
-    d_forward: int
-    d_height: int
-    q_pitch: int  # paper model: pitch hinge; rich: quaternion start
-    d_pitch: int
-    q_flap_left: int
-
-    def as_array(self) -> np.ndarray:
-        return np.array([int(self.rich), self.q_forward, self.q_height, self.d_forward, self.d_height,
-                         self.q_pitch, self.d_pitch, self.q_flap_left], dtype=np.int64)
-
-
-def check_config(config: str, force_mode: str) -> None:
-    if config not in CONFIGS:
-        raise UserError(f"unknown MuJoCo configuration {config!r}; choose one of: {', '.join(CONFIGS)}.")
-    if force_mode not in FORCE_MODES:
-        raise UserError(f"unknown wing-force mode {force_mode!r}; choose one of: {', '.join(FORCE_MODES)}.")
-
-
-def model_path(config: str = "paper") -> Path:
-    """Path of the MJCF file of a configuration ("paper" or "rich")."""
-    check_config(config, "tip")
-    return paths.model_path("butterfly", CONFIGS[config])
-
-
-def build_model(params: ButterflyParams | None = None, config: str = "paper") -> mujoco.MjModel:
-    """Compile the model with the physical constants of ``params`` (mass, L, W) applied via MjSpec.
-
-    The thorax takes the total mass ``m`` less the two wings; the wing meshes and their sites are
-    scaled to ``L`` and ``W``.
-    """
-    p = params or ButterflyParams()
-    spec = mujoco.MjSpec.from_file(str(model_path(config)))
-    wing_mass = spec.geom("wing_left").mass
-    if p.mass_kg <= 2.0 * wing_mass:
-        raise UserError(f"butterfly mass {p.mass_kg * 1e3:g} g is not more than its two wings ({2e3 * wing_mass:g} g).")
-    spec.geom("thorax").mass = p.mass_kg - 2.0 * wing_mass
-    for side, sign in (("left", 1.0), ("right", -1.0)):
-        spec.mesh(f"wing_{side}").scale = [p.width_m, p.span_m, 1.0]
-        spec.site(f"wing_{side}_cp").pos = [0.0, sign * CP_FRACTION * p.span_m, 0.0]
-        spec.site(f"wing_{side}_tip").pos = [0.0, sign * p.span_m, 0.0]
-    return spec.compile()
-
-
-def layout(m: mujoco.MjModel) -> Layout:
-    """Read joint addresses by name."""
-    def jq(name):
-        return int(m.jnt_qposadr[m.joint(name).id])
-
-    def jd(name):
-        return int(m.jnt_dofadr[m.joint(name).id])
-
-    if m.njnt and m.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE:
-        q0, d0 = jq("root"), jd("root")
-        return Layout(True, q0, q0 + 2, d0, d0 + 2, q0 + 3, d0 + 3, jq("flap_left"))
-    return Layout(False, jq("forward"), jq("height"), jd("forward"), jd("height"), jq("pitch"), jd("pitch"),
-                  jq("flap_left"))
-
-
 def setup_data(m: mujoco.MjModel, controller: ButterflyController, params: ButterflyParams | None = None,
                condition: Condition | None = None, force_mode: str = "tip", n_strips: int = 16) -> mujoco.MjData:
     """A fresh ``MjData`` at rest at the start altitude, its userdata filled for the callback."""
@@ -443,21 +381,21 @@ def setup_data(m: mujoco.MjModel, controller: ButterflyController, params: Butte
 # ---- the compiled stepping loop -------------------------------------------------------------
 
 
-@njit(cache=False)
-def advance(mptr, dptr, qpos, qvel, ud, k0, n_steps, kind, cp, flap, y_ref, lay, dt, phi, diverged, fit):
-    """Steps ``k0 .. k0 + n_steps - 1`` (time ``t = k dt``): the controller sets the pitch once per
-    step, then ``mj_step``. Returns the last pitch (rad); sets ``diverged[0]`` on a runaway and adds
-    each step's fitness term (eq. 13) to ``fit[0]``. Altitudes are measured from ``y_ref`` (m), the
-    target altitude (0 in every experiment; the start altitude is in the initial state)."""
+def _advance_loop(mptr, dptr, qpos, qvel, ud, k0, n_steps, kind, cp, flap, y_ref, lay, dt, phi, diverged, fit):
+    """Steps ``k0 .. k0 + n_steps - 1`` (time ``t = k dt``): the pitch law ``_law(kind, cp, obs)``
+    (``obs`` a :class:`~lifelike_mj.butterfly.flight.PitchObservation`) sets the pitch once per step,
+    then ``mj_step``. Returns the last pitch (rad); sets ``diverged[0]`` on a runaway and adds each
+    step's fitness term (eq. 13) to ``fit[0]``. Altitudes are measured from ``y_ref`` (m), the target
+    altitude (0 in every experiment; the start altitude is in the initial state)."""
     rich = lay[0] == 1
-    qf, qh, df, dh, qp, dp = lay[1], lay[2], lay[3], lay[4], lay[5], lay[6]
+    qh, df, dh, qp, dp = lay[2], lay[3], lay[4], lay[5], lay[6]
     air_z = ud[U_AIR]
     air_y = ud[U_AIR + 2]
     for k in range(k0, k0 + n_steps):
         t = k * dt
         theta = flap[0] + flap[1] * math.cos(flap[2] * t)
         omega = -flap[1] * flap[2] * math.sin(flap[2] * t)
-        phi = pitch_command(kind, cp, t, theta, omega, qpos[qh] - y_ref, qpos[qf], qvel[dh], qvel[df], air_y, air_z, phi)
+        phi = _law(kind, cp, PitchObservation(t, phi, omega, theta, qvel[dh], qpos[qh] - y_ref, qvel[df], air_y, air_z))
         if rich:
             ud[U_PHI_CMD] = phi
         else:
@@ -469,6 +407,11 @@ def advance(mptr, dptr, qpos, qvel, ud, k0, n_steps, kind, cp, flap, y_ref, lay,
             return phi
         fit[0] += fitness_term(qpos[qh] - y_ref, qvel[df])
     return phi
+
+
+_law = builtin_law
+#: :func:`_advance_loop` with the built-in pitch laws.
+advance = njit(cache=False)(_advance_loop)
 
 
 @njit(cache=False, parallel=True)
@@ -487,24 +430,25 @@ def _fitness_batch(mptr, dptrs, kinds, cparams, flap, lay, dt, n_steps, diverged
         fitness[b] = fit[0]
 
 
-@njit(cache=False)
-def _run(mptr, dptr, qpos, qvel, ud, n_steps, record_every, kind, cp, flap, y_ref, lay, dt, out, diverged, fit):
-    """:func:`advance` over the whole flight, recording a row every ``record_every`` steps."""
+def _record_loop(mptr, dptr, qpos, qvel, ud, k0, n_steps, every, kind, cp, flap, y_ref, lay, dt, phi, out, r0,
+                 diverged, fit):
+    """:func:`_advance` over ``n_steps`` steps from step ``k0``, writing a row ``y, z, v_y, v_z,
+    phi, theta_left`` (m, m/s, rad) into ``out`` every ``every`` steps from row ``r0`` on (rows after
+    a runaway are NaN). Returns the last pitch (rad)."""
     rich = lay[0] == 1
     qf, qh, df, dh, qp, ql = lay[1], lay[2], lay[3], lay[4], lay[5], lay[7]
-    phi = 0.0
-    r = 1
-    k = 0
-    while k < n_steps:
-        n = min(record_every, n_steps - k)
-        phi = advance(mptr, dptr, qpos, qvel, ud, k, n, kind, cp, flap, y_ref, lay, dt, phi, diverged, fit)
+    r = r0
+    k = k0
+    while k < k0 + n_steps:
+        n = min(every, k0 + n_steps - k)
+        phi = _advance(mptr, dptr, qpos, qvel, ud, k, n, kind, cp, flap, y_ref, lay, dt, phi, diverged, fit)
         k += n
         if diverged[0] >= 0:
             for rr in range(r, out.shape[0]):
                 for j in range(6):
                     out[rr, j] = np.nan
-            return
-        if n == record_every:
+            return phi
+        if n == every:
             out[r, 0] = qpos[qh]
             out[r, 1] = qpos[qf]
             out[r, 2] = qvel[dh]
@@ -516,6 +460,21 @@ def _run(mptr, dptr, qpos, qvel, ud, n_steps, record_every, kind, cp, flap, y_re
                 out[r, 4] = qpos[qp]
             out[r, 5] = qpos[ql]
             r += 1
+    return phi
+
+
+_advance = advance
+#: :func:`_record_loop` with the built-in pitch laws.
+record_steps = njit(cache=False)(_record_loop)
+
+
+@functools.lru_cache(maxsize=64)
+def steppers_with(law) -> tuple[Callable, Callable]:
+    """``(advance, record_steps)`` compiled with the pitch law ``law(kind, cp, obs)`` (see
+    :func:`~lifelike_mj.butterfly.flight.kernel_law`) instead of the built-in laws."""
+    adv = njit_with(_advance_loop, "advance_with", {"_law": law})
+    rec = njit_with(_record_loop, "record_steps_with", {"_advance": adv})
+    return adv, rec
 
 
 def fly_one(m: mujoco.MjModel, controller: ButterflyController, params: ButterflyParams | None = None,
@@ -535,9 +494,9 @@ def fly_one(m: mujoco.MjModel, controller: ButterflyController, params: Butterfl
     fit = np.zeros(1)
     if callback == "compiled":
         with passive_callback(COMPILED_PASSIVE):
-            _run(m._address, d._address, d.qpos, d.qvel, d.userdata, n_steps, record_every, kind,
-                 np.ascontiguousarray(cp, dtype=float), controller.flap.as_array(), 0.0, lay.as_array(), dt,
-                 out, diverged, fit)
+            record_steps(m._address, d._address, d.qpos, d.qvel, d.userdata, 0, n_steps, record_every, kind,
+                         np.ascontiguousarray(cp, dtype=float), controller.flap.as_array(), 0.0, lay.as_array(), dt,
+                         0.0, out, 1, diverged, fit)
     elif callback == "python":
         _run_python(m, d, n_steps, record_every, controller, cond, lay, dt, out, diverged, fit)
     else:
@@ -580,7 +539,7 @@ def fitness_batch(cparams: np.ndarray, flap, params: ButterflyParams | None, con
 
 
 def _run_python(m, d, n_steps, record_every, controller, cond, lay, dt, out, diverged, fit):
-    """The stepping loop of :func:`_run` with the Python callback and controller (reference)."""
+    """The stepping loop of :func:`record_loop` with the Python callback and controller (reference)."""
     kind, cp = controller.compiled()
     flap = controller.flap.as_array()
     qpos, qvel = d.qpos, d.qvel

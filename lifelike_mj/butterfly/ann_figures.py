@@ -26,6 +26,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
+from lifelike_mj.viz.figures import _new_figure, _save
 from matplotlib.axes import Axes
 from matplotlib.colors import ListedColormap
 from matplotlib.patches import Patch
@@ -42,8 +43,7 @@ from lifelike_mj.butterfly.ann_experiments import (
     WindMap,
     WindsResult,
 )
-from lifelike_mj.butterfly.trajectory import Trajectory
-from lifelike_mj.viz.figures import _new_figure, _save
+from lifelike_mj.butterfly.flight import Trajectory
 
 __all__ = [
     "fig7_fitness",

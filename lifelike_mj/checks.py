@@ -1,0 +1,65 @@
+"""Checks of numbers a user gives, each failing with one sentence (:class:`~lifelike_mj.errors.UserError`).
+
+``bool`` is never a number here (``True`` is an ``int`` to Python, not a count or a length to a
+user); NumPy scalars are.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+
+from lifelike_mj.errors import UserError
+
+
+def is_number(v: object) -> bool:
+    """Whether ``v`` is a real number (int, float or a NumPy scalar of either), not a bool."""
+    return isinstance(v, numbers.Real) and not isinstance(v, bool)
+
+
+def is_whole(v: object) -> bool:
+    """Whether ``v`` is a whole number (int or NumPy integer), not a bool."""
+    return isinstance(v, numbers.Integral) and not isinstance(v, bool)
+
+
+def number(name: str, v: object, lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
+           unit: str = "") -> float:
+    """``v`` as a float; a :class:`UserError` unless it is a finite number in ``[lo, hi]`` (``(lo, hi]``
+    with ``lo_open``). ``name`` and ``unit`` phrase the sentence."""
+    ok = is_number(v) and math.isfinite(float(v))
+    if ok and lo is not None:
+        ok = float(v) > lo if lo_open else float(v) >= lo
+    if ok and hi is not None:
+        ok = float(v) <= hi
+    if not ok:
+        u = f" {unit}" if unit else ""
+        if lo is not None and hi is not None:
+            rng = f"a number in {'(' if lo_open else '['}{lo:g}, {hi:g}]{u}"
+        elif lo is not None and lo_open and lo == 0:
+            rng = f"a positive number{u}"
+        elif lo is not None:
+            rng = f"a number {'>' if lo_open else '>='} {lo:g}{u}"
+        elif hi is not None:
+            rng = f"a number <= {hi:g}{u}"
+        else:
+            rng = f"a finite number{u}"
+        raise UserError(f"{name} must be {rng}, got {v!r}.")
+    return float(v)
+
+
+def positive(name: str, v: object, unit: str = "") -> float:
+    """``v`` as a float; a :class:`UserError` unless it is a finite number > 0."""
+    return number(name, v, 0.0, lo_open=True, unit=unit)
+
+
+def whole(name: str, v: object, lo: int | None = None, hi: int | None = None) -> int:
+    """``v`` as an int; a :class:`UserError` unless it is a whole number in ``[lo, hi]``."""
+    if not is_whole(v) or (lo is not None and v < lo) or (hi is not None and v > hi):
+        if lo is not None and hi is not None:
+            rng = f"a whole number from {lo} to {hi}"
+        elif lo is not None:
+            rng = f"a whole number of at least {lo}"
+        else:
+            rng = "a whole number"
+        raise UserError(f"{name} must be {rng}, got {v!r}.")
+    return int(v)
