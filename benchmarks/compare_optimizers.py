@@ -47,7 +47,7 @@ def main() -> None:
                       flush=True)
     write_json(args.out, {"task": "paper (section 6.3)", "evaluations": args.evaluations, "seeds": args.seeds,
                           "runs": runs})
-    from lifelike_mj.viz.ann_figures import fig_optimizer_convergence
+    from lifelike_mj.butterfly.ann_figures import fig_optimizer_convergence
 
     fig_optimizer_convergence({k: [r["history"] for r in v] for k, v in runs.items()}, args.figure)
     print("\n| optimiser | population | best H, median over seeds | min – max | evaluations/s |\n|---|---|---|---|---|")

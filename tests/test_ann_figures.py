@@ -19,7 +19,7 @@ from lifelike_mj.butterfly.ann_experiments import (
     flight_numbers,
 )
 from lifelike_mj.butterfly.flight import Trajectory
-from lifelike_mj.viz import ann_figures as af
+from lifelike_mj.butterfly import ann_figures as af
 
 DT = 0.01  # s
 DURATION = 4.0  # s

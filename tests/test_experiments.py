@@ -12,7 +12,7 @@ import pytest
 from lifelike_mj.butterfly import controllers, experiments, report
 from lifelike_mj.butterfly.backends import paper
 from lifelike_mj.errors import UserError
-from lifelike_mj.viz import figures
+from lifelike_mj.butterfly import figures
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

@@ -295,7 +295,7 @@ def test_cli_bad_preset_file_exit_2(capsys, tmp_path):
 
 
 def test_reproduce_fish_writes_report_results_and_figures(tmp_path):
-    from lifelike_mj.fish.reproduce import reproduce_fish
+    from lifelike_mj.fish.report import reproduce_fish
 
     res = reproduce_fish(tmp_path, seeds=(0, 1), pattern_s=10.0, swim_s=5.0, progress=False)
     text = (tmp_path / "report.md").read_text()

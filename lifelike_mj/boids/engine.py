@@ -709,49 +709,9 @@ class BoidRun:
 def simulate(params: BoidParams, n: int = N_AGENTS, n_steps: int = 3000, seed: int = 0, record_every: int = 1,
              record_from: int = 0, progress: bool = False, extra_steps=()) -> BoidRun:
     """Run ``n_steps`` steps from :func:`initial_state`; record the state every ``record_every``
-    steps from step ``record_from`` on (step 0 = the initial state), and at the ``extra_steps``.
-    Raises :class:`UserError` if the run diverges (section 2.2: w_a >= 10 or w_c >= 1)."""
-    import time
+    steps from step ``record_from`` on (step 0 = the initial state), and at the ``extra_steps``
+    (:meth:`~lifelike_mj.boids.sim.Flock.record` of a new flock). Raises
+    :class:`~lifelike_mj.errors.Diverged` if the run diverges (section 2.2: w_a >= 10 or w_c >= 1)."""
+    from lifelike_mj.boids.sim import Flock
 
-    if isinstance(n_steps, bool) or not isinstance(n_steps, (int, np.integer)) or n_steps < 1:
-        raise UserError(f"the number of steps must be a whole number of at least 1, got {n_steps!r}.")
-    if record_every < 1:
-        raise UserError(f"record_every must be at least 1, got {record_every}.")
-    t0 = time.perf_counter()
-    x, v, types = initial_state(params, n, seed)
-    x3, v3 = _as3(x), _as3(v)
-    wa, wc, c = params.arrays()
-    planar = params.dims == 2
-    D = params.dims
-    rec_steps = sorted({s for s in range(0, int(n_steps) + 1, record_every) if s >= record_from}
-                       | {int(s) for s in extra_steps if 0 <= s <= n_steps})
-    X = np.empty((len(rec_steps), n, 3))
-    V = np.empty((len(rec_steps), n, 3))
-    r = 0
-    if rec_steps and rec_steps[0] == 0:
-        X[0], V[0] = x3, v3
-        r = 1
-    done = 0
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=int(n_steps), unit="step", desc="boids", leave=False)
-    try:
-        while done < n_steps:
-            target = rec_steps[r] if r < len(rec_steps) else int(n_steps)
-            k = target - done
-            bad = _steps(x3, v3, types, wa, wc, c, planar, k, diverged_speed(params))
-            if bad:
-                raise UserError(divergence_message(params, done + bad))
-            done += k
-            if r < len(rec_steps) and done == rec_steps[r]:
-                X[r], V[r] = x3, v3
-                r += 1
-            if bar is not None:
-                bar.update(k)
-    finally:
-        if bar is not None:
-            bar.close()
-    return BoidRun(params, int(seed), types, np.array(rec_steps), X[:, :, :D].copy(), V[:, :, :D].copy(),
-                   time.perf_counter() - t0)
+    return Flock(params, n, seed).record(n_steps, record_every, record_from, extra_steps, progress)

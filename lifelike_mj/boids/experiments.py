@@ -180,3 +180,19 @@ def run_sweep(sweep: Sweep, values: list[list[float]], seeds, executor: str = "p
         cells[g] = max(set(labs), key=lambda lab: (labs.count(lab), -LABELS.index(lab)))
     return {"axes": list(sweep.axes), "values": [list(map(float, v)) for v in values], "seeds": list(seeds),
             "rows": table, "majority": {",".join(f"{x:g}" for x in g): lab for g, lab in cells.items()}}
+
+
+def write_sweep(result: dict, sweep: Sweep, values: list[list[float]], out_dir: str | Path) -> list[str]:
+    """A sweep's files, as ``boids sweep --out`` writes them: ``sweep.json`` (the result of
+    :func:`run_sweep`) and, for two axes, ``phase_diagram.png`` (majority label per cell). Atomic."""
+    from lifelike_mj.io import write_json
+
+    out = Path(out_dir)
+    files = [write_json(out / "sweep.json", result)]
+    if len(values) == 2:
+        from lifelike_mj.boids.figures import phase_diagram_figure
+
+        labels = np.array([[result["majority"][f"{a:g},{b:g}"] for a in values[0]] for b in values[1]])
+        phase_diagram_figure(labels, values[0], values[1], sweep.axes[0], sweep.axes[1], out / "phase_diagram.png")
+        files.append(out / "phase_diagram.png")
+    return [str(f) for f in files]

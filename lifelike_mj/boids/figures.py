@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -36,8 +35,8 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch, Rectangle
 
 from lifelike_mj.errors import UserError
-from lifelike_mj.viz.figures import _new_figure as _figure
-from lifelike_mj.viz.figures import _png_path, _save
+from lifelike_mj.render.plot import finish, png_path
+from lifelike_mj.render.plot import new_figure as _figure
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
@@ -149,15 +148,15 @@ def _label_title(label: str) -> str:
     return f"{label}: {name}" if name else str(label)
 
 
-def pattern_figure(run: BoidRun, out_path: str | os.PathLike, title: str | None = None, plane: str = "xy",
-                   trail_steps: int = TRAIL_STEPS) -> Path:
+def pattern_figure(run: BoidRun, out_path: str | os.PathLike | None = None, title: str | None = None, plane: str = "xy",
+                   trail_steps: int = TRAIL_STEPS) -> Figure:
     """One run as in Nakamura 2013 Fig. 4-5: each agent's last ``trail_steps`` (5) steps as a short
     trail, A red, B yellow-green, in the x-y projection (``plane``: module docstring) of the box.
 
     The run must hold the last ``trail_steps`` steps recorded every step:
     ``simulate(params, n_steps=N, record_every=1, record_from=N - 5)`` (:class:`UserError` otherwise).
     ``title``: default the preset's name and pattern. Writes a PNG atomically; returns its path."""
-    out = _png_path(out_path, "pattern figure")
+    out = None if out_path is None else png_path(out_path, "pattern figure")
     fig = _new_figure(4.8, 5.2)
     ax = fig.add_subplot()
     _draw_run(ax, run, plane, trail_steps)
@@ -167,15 +166,15 @@ def pattern_figure(run: BoidRun, out_path: str | os.PathLike, title: str | None 
     ax.set_xlabel(f"{x}  (step {int(run.steps[-1])}, n = {run.n}, trails of {trail_steps} steps)", fontsize=8)
     ax.set_ylabel(y, fontsize=8)
     _type_legend(fig, int(np.max(run.types)) + 1 if run.n else 1)
-    return _save(fig, out)
+    return finish(fig, out)
 
 
-def patterns_grid_figure(runs: Mapping[str, BoidRun], out_path: str | os.PathLike, plane: str = "xy",
-                         trail_steps: int = TRAIL_STEPS, title: str | None = None) -> Path:
+def patterns_grid_figure(runs: Mapping[str, BoidRun], out_path: str | os.PathLike | None = None, plane: str = "xy",
+                         trail_steps: int = TRAIL_STEPS, title: str | None = None) -> Figure:
     """Nakamura 2013 Fig. 4-5: the runs (``{label: run}``, e.g. the eight patterns ``4a`` ... ``5d``
     in that order) in a grid of 4 columns (2 x 4 for eight), each panel as :func:`pattern_figure`
     and titled with its label and pattern name. Writes a PNG atomically; returns its path."""
-    out = _png_path(out_path, "patterns figure")
+    out = None if out_path is None else png_path(out_path, "patterns figure")
     if not runs:
         raise UserError("the patterns figure needs at least one run.")
     items = list(runs.items())
@@ -195,17 +194,17 @@ def patterns_grid_figure(runs: Mapping[str, BoidRun], out_path: str | os.PathLik
                  f"Heterogeneous boids (cf. Nakamura 2013 Fig. 4-5): {x}-{y} projection, trails of the last "
                  f"{trail_steps} steps at step {', '.join(map(str, steps))}, n = {', '.join(map(str, ns))}", fontsize=10)
     _type_legend(fig, n_types)
-    return _save(fig, out)
+    return finish(fig, out)
 
 
-def homogeneous_grid_figure(runs: Mapping[tuple[float, float], BoidRun | None], out_path: str | os.PathLike,
-                            plane: str = "xy", trail_steps: int = TRAIL_STEPS, title: str | None = None) -> Path:
+def homogeneous_grid_figure(runs: Mapping[tuple[float, float], BoidRun | None], out_path: str | os.PathLike | None = None,
+                            plane: str = "xy", trail_steps: int = TRAIL_STEPS, title: str | None = None) -> Figure:
     """Nakamura 2013 Fig. 2: homogeneous runs keyed by ``(w_a, w_c)`` in a grid, ``w_a`` decreasing
     down the rows (1, 0.1, 0.01, 0.001 in the paper) and ``w_c`` decreasing along the columns (0.1,
     0.01, 0.001, 0), each cell as :func:`pattern_figure` (one type: one colour). A cell whose run
     diverged is passed as ``None`` and drawn as "diverged"; a combination missing from ``runs`` is
     left blank ("not run"). Writes a PNG atomically; returns its path."""
-    out = _png_path(out_path, "homogeneous grid figure")
+    out = None if out_path is None else png_path(out_path, "homogeneous grid figure")
     if not runs:
         raise UserError("the homogeneous grid figure needs at least one run.")
     try:
@@ -242,7 +241,7 @@ def homogeneous_grid_figure(runs: Mapping[tuple[float, float], BoidRun | None], 
     fig.suptitle(title if title is not None else
                  f"Homogeneous boids (cf. Nakamura 2013 Fig. 2): {x}-{y} projection, trails of the last {trail_steps} "
                  f"steps; alignment weight $w_a$ down, cohesion weight $w_c$ across", fontsize=10)
-    return _save(fig, out)
+    return finish(fig, out)
 
 
 def _label_colours(labels: Sequence[str]) -> dict[str, str]:
@@ -260,14 +259,15 @@ def _label_colours(labels: Sequence[str]) -> dict[str, str]:
 
 
 def phase_diagram_figure(labels, x_values: Sequence[float], y_values: Sequence[float], x_label: str, y_label: str,
-                         out_path: str | os.PathLike, title: str | None = None, annotate: bool | None = None) -> Path:
+                         out_path: str | os.PathLike | None = None, title: str | None = None,
+                         annotate: bool | None = None) -> Figure:
     """A categorical map of classified pattern labels over a sweep grid: ``labels`` (2-D, one row per
     ``y_values`` entry and one column per ``x_values`` entry; ``None`` is shown as "n/a") as
     coloured cells, row 0 at the bottom, the values as tick labels (cells equally spaced, whatever
     the spacing of the values), one colour per label (the eight patterns always in the same colours;
     "diverged" dark grey, "unclassified" grey, "n/a" and empty labels very light grey) and a legend. ``annotate``: write the
     label in each cell (default: when the grid has at most 12 columns). Writes a PNG atomically."""
-    out = _png_path(out_path, "phase diagram")
+    out = None if out_path is None else png_path(out_path, "phase diagram")
     lab = np.array([["n/a" if v is None else str(v) for v in row] for row in np.asarray(labels, dtype=object)],
                    dtype=object)
     xs, ys = list(x_values), list(y_values)
@@ -299,7 +299,7 @@ def phase_diagram_figure(labels, x_values: Sequence[float], y_values: Sequence[f
     handles = [Patch(color=colours[s], label=_label_title(s)) for s in seen]
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
     ax.set_title(title if title is not None else "Classified patterns", fontsize=10)
-    return _save(fig, out)
+    return finish(fig, out)
 
 
 def _hex(c: str) -> tuple[float, float, float]:

@@ -14,7 +14,7 @@ light floor at ``z = 0``. In 2D (``dims = 2``) the agents move in the plane ``z 
 
 Cameras (by name, :data:`CAMERAS`): ``overview`` (perspective, from above one corner: the whole
 box), ``top`` (orthographic, looking down -z, x to the right and y up: the x-y projection of the
-figures of :mod:`lifelike_mj.viz.boids_figures`) and, in 3D only, ``side`` (orthographic, looking
+figures of :mod:`lifelike_mj.boids.figures`) and, in 3D only, ``side`` (orthographic, looking
 along +y, x to the right and z up).
 
 Memory. MuJoCo's collision broadphase asks its arena for about ``2 n^2`` bytes (18 MB for 3,000

@@ -22,8 +22,13 @@ The paper gives neither input scaling nor biases. Our choice (kept fixed in the 
 Weight order (the genome): for hidden neuron ``h = 0..5``: its 6 input weights then its bias
 (indices ``7h .. 7h + 6``); then the 6 output weights (42..47) and the output bias (48).
 
-Compiled code sees the controller as a float array (see ``A_*`` below); :func:`ann_pitch` is the
-step function shared by the paper backend and the MuJoCo stepping loop.
+Networks of other shapes (``layers``, e.g. ``[6, 8, 8, 1]``: six inputs, two hidden layers of eight,
+one output) use the same inputs, transfer function, output scaling and weight order (per layer, per
+neuron: its input weights, then its bias), and run in :func:`mlp_pitch`; the paper's ``[6, 6, 1]``
+keeps its unrolled :func:`ann_pitch` (and :func:`mlp_pitch` computes the same numbers bit for bit).
+
+Compiled code sees the controller as a float array (see ``A_*`` below); :func:`ann_pitch` and
+:func:`mlp_pitch` are the step functions shared by the paper backend and the MuJoCo stepping loop.
 """
 
 from __future__ import annotations
@@ -36,6 +41,11 @@ from numba import njit
 N_INPUTS = 6
 N_HIDDEN = 6
 N_WEIGHTS = N_HIDDEN * (N_INPUTS + 1) + N_HIDDEN + 1  # 49
+#: The paper's network: 6 inputs, 6 hidden neurons, 1 output (section 6.1).
+PAPER_LAYERS = (N_INPUTS, N_HIDDEN, 1)
+#: Widest hidden layer and most hidden layers a network file may ask for.
+MAX_WIDTH = 64
+MAX_HIDDEN_LAYERS = 8
 INPUT_NAMES = ("phi", "omega", "theta", "climb_rate", "altitude", "forward_speed")
 INPUT_KINDS = ("relative", "ground")
 
@@ -44,6 +54,9 @@ A_RELATIVE, A_DMAX, A_LIMIT, A_THETA_C = 0, 1, 2, 3
 A_SCALE = 4  # 6 multipliers (1 / scale) in input order
 A_W = A_SCALE + N_INPUTS  # 10: the 49 weights
 N_COMPILED = A_W + N_WEIGHTS
+# a network of any shape (mlp_pitch): A_W holds the number of layers L (inputs and output counted),
+# then the L sizes, then the weights, then room for two layers of activations
+A_NLAYERS = A_W
 
 #: Default input scales (units in the key names); the theta and omega scales follow the flap.
 DEFAULT_SCALES = {"phi_deg": 30.0, "vy_m_s": 2.0, "y_m": 10.0, "vz_m_s": 3.0}
@@ -120,3 +133,95 @@ def compile_params(inputs: str, scales: dict, weights, max_dphi_deg: float = DEF
     )
     cp[A_W:] = np.asarray(weights, dtype=float)
     return cp
+
+
+def n_weights(layers) -> int:
+    """Number of weights (genes) of a network with these layer sizes (biases included)."""
+    return int(sum((a + 1) * b for a, b in zip(layers[:-1], layers[1:])))
+
+
+def check_layers(layers) -> tuple[int, ...]:
+    """``layers`` as a tuple if it is a valid network shape (6 inputs, 1 output, 1 to
+    :data:`MAX_HIDDEN_LAYERS` hidden layers of 1 to :data:`MAX_WIDTH` neurons), else a ``ValueError``."""
+    try:
+        t = tuple(int(x) for x in layers)
+        ok = all(float(x) == int(x) and not isinstance(x, bool) for x in layers)
+    except (TypeError, ValueError):
+        raise ValueError(f"layers must be a list of whole numbers, got {layers!r}") from None
+    if not ok or len(t) < 3 or t[0] != N_INPUTS or t[-1] != 1:
+        raise ValueError(f"layers must start with {N_INPUTS} (the inputs) and end with 1 (the output), "
+                         f"with at least one hidden layer, got {list(layers)}")
+    if len(t) - 2 > MAX_HIDDEN_LAYERS or not all(1 <= h <= MAX_WIDTH for h in t[1:-1]):
+        raise ValueError(f"at most {MAX_HIDDEN_LAYERS} hidden layers of 1 to {MAX_WIDTH} neurons, got {list(t)}")
+    return t
+
+
+def compile_mlp(inputs: str, scales: dict, weights, layers, max_dphi_deg: float = DEFAULT_MAX_DPHI_DEG,
+                phi_limit_deg: float = DEFAULT_PHI_LIMIT_DEG) -> np.ndarray:
+    """The compiled parameter array of a network of any shape (:func:`mlp_pitch`; rad inside)."""
+    layers = check_layers(layers)
+    head = compile_params(inputs, scales, np.zeros(N_WEIGHTS), max_dphi_deg, phi_limit_deg)[:A_W]
+    w = np.asarray(weights, dtype=float).ravel()
+    if len(w) != n_weights(layers):
+        raise ValueError(f"a {list(layers)} network has {n_weights(layers)} weights, got {len(w)}")
+    scratch = np.zeros(2 * max(layers))
+    return np.concatenate([head, [float(len(layers))], np.asarray(layers, dtype=float), w, scratch])
+
+
+def weights_offset(layers) -> int:
+    """Index of the first weight in the compiled array of a network with these layers."""
+    return A_W if tuple(layers) == PAPER_LAYERS else A_NLAYERS + 1 + len(layers)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def mlp_pitch(cp, theta, omega, y, vy, vz, air_y, air_z, phi_prev):
+    """:func:`ann_pitch` for a network of any shape (compiled array of :func:`compile_mlp`): the same
+    inputs and output scaling; hidden neurons ``G(sum_i w_i x_i + b)``, the output neuron
+    ``b + sum_i w_i x_i`` passed through ``G`` as the pitch change (the sums in the order of
+    :func:`ann_pitch`, so that a ``[6, 6, 1]`` network gives its numbers bit for bit). The
+    activations are kept in the array's last ``2 * max(layers)`` entries."""
+    if cp[A_RELATIVE] > 0.5:
+        vy = vy - air_y
+        vz = vz - air_z
+    nl = int(cp[A_NLAYERS])
+    w0 = A_NLAYERS + 1 + nl
+    width = 0
+    for k in range(nl):
+        width = max(width, int(cp[A_NLAYERS + 1 + k]))
+    nw = 0
+    for k in range(nl - 1):
+        nw += (int(cp[A_NLAYERS + 1 + k]) + 1) * int(cp[A_NLAYERS + 2 + k])
+    a = w0 + nw  # activations of the current layer's inputs
+    b = a + width  # ... and its outputs
+    cp[a] = phi_prev * cp[A_SCALE]
+    cp[a + 1] = omega * cp[A_SCALE + 1]
+    cp[a + 2] = (theta - cp[A_THETA_C]) * cp[A_SCALE + 2]
+    cp[a + 3] = vy * cp[A_SCALE + 3]
+    cp[a + 4] = y * cp[A_SCALE + 4]
+    cp[a + 5] = vz * cp[A_SCALE + 5]
+    w = w0
+    out = 0.0
+    for k in range(nl - 1):
+        n_in = int(cp[A_NLAYERS + 1 + k])
+        n_out = int(cp[A_NLAYERS + 2 + k])
+        last = k == nl - 2
+        for j in range(n_out):
+            if last:
+                s = cp[w + n_in]
+                for i in range(n_in):
+                    s += cp[w + i] * cp[a + i]
+                out = s
+            else:
+                s = cp[w] * cp[a]
+                for i in range(1, n_in):
+                    s += cp[w + i] * cp[a + i]
+                cp[b + j] = transfer(s + cp[w + n_in])
+            w += n_in + 1
+        a, b = b, a
+    phi = phi_prev + cp[A_DMAX] * transfer(out)
+    lim = cp[A_LIMIT]
+    if phi > lim:
+        phi = lim
+    elif phi < -lim:
+        phi = -lim
+    return phi

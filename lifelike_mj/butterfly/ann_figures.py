@@ -2,9 +2,9 @@
 
 Each ``fig*`` function draws one result of :mod:`lifelike_mj.butterfly.ann_experiments` (or an
 optimiser's fitness history) with the quantities and units of the paper's figure, names that
-figure in its title ("cf. Oe 2010 Fig. 8") and writes a PNG through
-:func:`lifelike_mj.viz.figures._save` (atomically: a temporary file in the same folder, then
-``os.replace``). Figures are built with :func:`lifelike_mj.viz.figures._new_figure` on the Agg
+figure in its title ("cf. Oe 2010 Fig. 8") and returns the figure; given a path it also writes a
+PNG through :func:`lifelike_mj.render.plot.save` (atomically: a temporary file in the same folder,
+then ``os.replace``). Figures are built with :func:`lifelike_mj.render.plot.new_figure` on the Agg
 canvas, without pyplot, so drawing them never changes the process's matplotlib backend.
 
 Units: altitude ``y`` and forward distance ``z`` in m (``y`` measured from the target altitude
@@ -23,12 +23,11 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Mapping, Sequence
-from pathlib import Path
 
 import numpy as np
-from lifelike_mj.viz.figures import _new_figure, _save
 from matplotlib.axes import Axes
 from matplotlib.colors import ListedColormap
+from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
 from lifelike_mj.butterfly.ann_experiments import (
@@ -44,6 +43,8 @@ from lifelike_mj.butterfly.ann_experiments import (
     WindsResult,
 )
 from lifelike_mj.butterfly.flight import Trajectory
+from lifelike_mj.render.plot import finish
+from lifelike_mj.render.plot import new_figure as _new_figure
 
 __all__ = [
     "fig7_fitness",
@@ -120,7 +121,7 @@ def _target_line(ax: Axes) -> None:
 # E6: Fig. 7, 8, 9
 
 
-def fig7_fitness(history: Sequence[Mapping], path: str | os.PathLike, label: str = "") -> Path:
+def fig7_fitness(history: Sequence[Mapping], path: str | os.PathLike | None = None, label: str = "") -> Figure:
     """Oe 2010 Fig. 7: the best (best so far) and the mean fitness ``H`` (eq. 13, dimensionless)
     of each generation against the generation.
 
@@ -155,7 +156,7 @@ def fig7_fitness(history: Sequence[Mapping], path: str | os.PathLike, label: str
     ax.set_ylim(ylo, yhi + 0.15 * (yhi - ylo))
     what = f" — {label}" if label else ""
     ax.set_title(f"cf. Oe 2010 Fig. 7 — fitness per generation{what}", fontsize=11)
-    return _save(fig, path)
+    return finish(fig, path)
 
 
 def _require(tr: Trajectory | None, what: str) -> Trajectory:
@@ -164,7 +165,7 @@ def _require(tr: Trajectory | None, what: str) -> Trajectory:
     return tr
 
 
-def fig8_flight(level: LevelResult, path: str | os.PathLike) -> Path:
+def fig8_flight(level: LevelResult, path: str | os.PathLike | None = None) -> Figure:
     """Oe 2010 Fig. 8: the evolved controller's flight from 0 m in still air, altitude ``y`` (m)
     against forward distance ``z`` (m) over the whole flight (20 s), with the level band
     (±``LEVEL_BAND_M`` m), the point where ``z`` = 20 m is reached and the paper's numbers
@@ -194,10 +195,10 @@ def fig8_flight(level: LevelResult, path: str | os.PathLike) -> Path:
             f"ripple {n['ripple_cm']:.1f} cm; holds level: {'yes' if n.get('holds_level') else 'no'}")
     ax.text(0.01, 0.97, note, transform=ax.transAxes, va="top", fontsize=8, bbox=_BOX)
     ax.set_title(f"cf. Oe 2010 Fig. 8 — optimized flight from 0 m in still air ({tr.t[-1] - tr.t[0]:g} s)", fontsize=11)
-    return _save(fig, path)
+    return finish(fig, path)
 
 
-def fig9_phi(level: LevelResult, path: str | os.PathLike, window_s: float = 3.0) -> Path:
+def fig9_phi(level: LevelResult, path: str | os.PathLike | None = None, window_s: float = 3.0) -> Figure:
     """Oe 2010 Fig. 9: the pitch ``phi`` (deg) chosen by the network over the first ``window_s``
     seconds (3 s as in the paper), with the flap angle ``theta`` (deg) for reference and the
     ±30° pitch limits marked. A lower panel shows the altitude ``y`` (cm) and each flap cycle's
@@ -245,14 +246,14 @@ def fig9_phi(level: LevelResult, path: str | os.PathLike, window_s: float = 3.0)
                   fontsize=9)
     ax.set_xlim(tr.t[0], tr.t[0] + window_s)
     fig.suptitle(f"cf. Oe 2010 Fig. 9 — pitch φ of the evolved controller, first {window_s:g} s", fontsize=11)
-    return _save(fig, path)
+    return finish(fig, path)
 
 
 # ----------------------------------------------------------------------------------------------
 # E7, E9: Fig. 11, 13
 
 
-def _starts_figure(starts: StartsResult, path: str | os.PathLike, title: str, band_m: float, paper: str) -> Path:
+def _starts_figure(starts: StartsResult, path: str | os.PathLike | None, title: str, band_m: float, paper: str) -> Figure:
     """Every start of ``starts``: (a) altitude ``y`` (m) against forward distance ``z`` (m), the
     paper's axes; (b) altitude against time ``t`` (s), where a flight that drops without moving
     forward (a vertical line in (a)) can be seen."""
@@ -292,17 +293,17 @@ def _starts_figure(starts: StartsResult, path: str | os.PathLike, title: str, ba
     fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", fontsize=8)
     axt.text(0.98, 0.97, paper, transform=axt.transAxes, ha="right", va="top", fontsize=8, bbox=_BOX)
     fig.suptitle(title, fontsize=11)
-    return _save(fig, path)
+    return finish(fig, path)
 
 
-def fig11_from_above(starts: StartsResult, path: str | os.PathLike) -> Path:
+def fig11_from_above(starts: StartsResult, path: str | os.PathLike | None = None) -> Figure:
     """Oe 2010 Fig. 11: the flight from +10 m, altitude ``y`` (m) against forward distance
     ``z`` (m); the paper's controller descends to about 0 m and holds it."""
     return _starts_figure(starts, path, "cf. Oe 2010 Fig. 11 — flight from above the target (+10 m)", 0.5,
                           "paper: descends to ≈ 0 m and holds it")
 
 
-def fig13_from_below(starts: StartsResult, path: str | os.PathLike) -> Path:
+def fig13_from_below(starts: StartsResult, path: str | os.PathLike | None = None) -> Figure:
     """Oe 2010 Fig. 13: flights from -10, -2 and -1 m, altitude ``y`` (m) against forward
     distance ``z`` (m); the paper's controller never climbs back to 0 m."""
     return _starts_figure(starts, path, "cf. Oe 2010 Fig. 13 — flights from below the target", 0.5,
@@ -313,7 +314,7 @@ def fig13_from_below(starts: StartsResult, path: str | os.PathLike) -> Path:
 # E8: Fig. 12
 
 
-def fig12_sink(glide: GlideResult, path: str | os.PathLike) -> Path:
+def fig12_sink(glide: GlideResult, path: str | os.PathLike | None = None) -> Figure:
     """Oe 2010 Fig. 12: climb rate ``v_y`` (m/s) against time ``t`` (s) of the controller's
     flapping descent from +10 m ("Flapping") and of the glide from the same height (phi = 0,
     wings fixed at 75°, "Gliding"). The window over which the maximum sink speeds are compared
@@ -351,7 +352,7 @@ def fig12_sink(glide: GlideResult, path: str | os.PathLike) -> Path:
             "(dashed lines: −max sink speed in the shaded window)")
     ax.text(0.99, 0.97, note, transform=ax.transAxes, ha="right", va="top", fontsize=8, bbox=_BOX)
     ax.set_title("cf. Oe 2010 Fig. 12 — climb rate of the flapping descent and of the glide from +10 m", fontsize=11)
-    return _save(fig, path)
+    return finish(fig, path)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -365,7 +366,7 @@ def _wind_passes(num: Mapping) -> bool:
                 and num.get("settled_forward_speed_cm_s", -np.inf) >= 0.0)
 
 
-def fig14_15_winds(winds: WindsResult, path: str | os.PathLike) -> Path:
+def fig14_15_winds(winds: WindsResult, path: str | os.PathLike | None = None) -> Figure:
     """Oe 2010 Fig. 14 and 15: flights from 0 m in the four uniform 2 m/s winds, altitude ``y``
     (m) against forward distance ``z`` (m), one panel per input kind (network fed air-relative
     velocities, Fig. 14; ground velocities, Fig. 15), with the pass band ±1 m shaded. Each
@@ -398,7 +399,7 @@ def fig14_15_winds(winds: WindsResult, path: str | os.PathLike) -> Path:
         ax.set_title(f"({chr(ord('a') + j)}) {names.get(kind, kind + ' inputs')}", fontsize=10)
     fig.suptitle("cf. Oe 2010 Fig. 14, 15 — flights in uniform 2 m/s winds (a, b) [m/s], named by where the wind "
                  "comes from", fontsize=11)
-    return _save(fig, path)
+    return finish(fig, path)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -419,7 +420,8 @@ def _map_codes(m: WindMap) -> np.ndarray:
     return codes
 
 
-def fig_windmap(maps: Sequence[WindMap] | WindMap, path: str | os.PathLike, titles: Sequence[str] | None = None) -> Path:
+def fig_windmap(maps: Sequence[WindMap] | WindMap, path: str | os.PathLike | None = None,
+                titles: Sequence[str] | None = None) -> Figure:
     """Oe 2010 Fig. 15 "boundary": pass/fail of the settled flight over a grid of uniform winds,
     one panel per map (e.g. relative and ground inputs side by side, or two controllers).
 
@@ -474,14 +476,14 @@ def fig_windmap(maps: Sequence[WindMap] | WindMap, path: str | os.PathLike, titl
     step = float(a0[1] - a0[0]) if len(a0) > 1 else 0.0
     fig.suptitle(f'cf. Oe 2010 Fig. 15 "boundary" — wind map, grid step {step:g} m/s\n'
                  f"(pass: settled y within ±{MAP_BAND_M:g} m over the last 10 s and forward speed ≥ 0)", fontsize=11)
-    return _save(fig, path)
+    return finish(fig, path)
 
 
 # ----------------------------------------------------------------------------------------------
 # comparisons beyond the paper
 
 
-def fig_compare_starts(trajs: Mapping[str, Trajectory], path: str | os.PathLike, title: str) -> Path:
+def fig_compare_starts(trajs: Mapping[str, Trajectory], path: str | os.PathLike | None, title: str) -> Figure:
     """Several labelled flights side by side: altitude ``y`` (m) against time ``t`` (s), e.g. two
     controllers started from -10 m. ``title`` should name the paper figure compared with (for
     example ``"cf. Oe 2010 Fig. 13 — ann_paper vs ann_robust from -10 m"``)."""
@@ -506,7 +508,7 @@ def fig_compare_starts(trajs: Mapping[str, Trajectory], path: str | os.PathLike,
     ax.grid(alpha=0.3)
     fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", fontsize=8)
     ax.set_title(title, fontsize=11)
-    return _save(fig, path)
+    return finish(fig, path)
 
 
 def _best_on_grid(run: Sequence[Mapping], grid: np.ndarray) -> np.ndarray:
@@ -525,8 +527,8 @@ def _best_on_grid(run: Sequence[Mapping], grid: np.ndarray) -> np.ndarray:
     return out
 
 
-def fig_optimizer_convergence(runs: Mapping[str, Sequence[Sequence[Mapping]]], path: str | os.PathLike,
-                              log_x: bool | None = None) -> Path:
+def fig_optimizer_convergence(runs: Mapping[str, Sequence[Sequence[Mapping]]], path: str | os.PathLike | None = None,
+                              log_x: bool | None = None) -> Figure:
     """Best fitness so far (``H`` of eq. 13, dimensionless) against the number of fitness
     evaluations for several optimisers, cf. Oe 2010 Fig. 7.
 
@@ -566,4 +568,4 @@ def fig_optimizer_convergence(runs: Mapping[str, Sequence[Sequence[Mapping]]], p
     ax.grid(alpha=0.3, which="both")
     ax.legend(loc="best", fontsize=8.5, title="thick: median over seeds; thin: each seed", title_fontsize=8)
     ax.set_title("cf. Oe 2010 Fig. 7 — convergence of the optimisers (best so far per evaluation)", fontsize=11)
-    return _save(fig, path)
+    return finish(fig, path)

@@ -39,6 +39,8 @@ FORMAT = "lifelike-mj/butterfly-controller"
 KIND_CONSTANT = 0
 KIND_SIMPLE_RULE = 1
 KIND_ANN = 2
+#: A network of another shape than the paper's 6-6-1 (``layers`` in the file).
+KIND_MLP = 3
 #: The simple rule's upstroke test is ``omega > OMEGA_EPS`` (rad/s): at a stroke reversal omega is
 #: zero up to rounding (+-1e-14), and a bare ``omega > 0`` would let rounding pick the pitch.
 OMEGA_EPS = 1e-9
@@ -81,8 +83,11 @@ class ButterflyController:
         kind, names = PITCH_LAWS[self.type]
         if self.type == "ann":
             p = self.parameters
-            return kind, ann.compile_params(p["inputs"], self.input_scale(), p["weights"], float(p["max_dphi_deg"]),
-                                            float(p["phi_limit_deg"]))
+            if self.layers == ann.PAPER_LAYERS:
+                return kind, ann.compile_params(p["inputs"], self.input_scale(), p["weights"], float(p["max_dphi_deg"]),
+                                                float(p["phi_limit_deg"]))
+            return KIND_MLP, ann.compile_mlp(p["inputs"], self.input_scale(), p["weights"], self.layers,
+                                             float(p["max_dphi_deg"]), float(p["phi_limit_deg"]))
         return kind, np.radians([float(self.parameters[k]) for k in names])
 
     def input_scale(self) -> dict:
@@ -111,8 +116,13 @@ class ButterflyController:
         return replace(self, parameters=params)
 
     @property
+    def layers(self) -> tuple[int, ...]:
+        """Layer sizes of an ann controller's network (``[6, 6, 1]``, the paper's, unless the file says)."""
+        return tuple(int(x) for x in self.parameters.get("layers", ann.PAPER_LAYERS))
+
+    @property
     def weights(self) -> np.ndarray:
-        """The genome of an ann controller (49 floats)."""
+        """The genome of an ann controller (49 floats for the paper's network)."""
         return np.asarray(self.parameters["weights"], dtype=float)
 
     def to_dict(self) -> dict:
@@ -159,8 +169,13 @@ def _check_ann(p: dict, where: str) -> None:
     w = p.get("weights")
     if not isinstance(w, list) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in w):
         raise UserError(f"{where} needs 'weights' as a list of numbers.")
-    if len(w) != ann.N_WEIGHTS:
-        raise UserError(f"{where} has {len(w)} weights; the network of section 6 needs {ann.N_WEIGHTS}.")
+    try:
+        layers = ann.check_layers(p.get("layers", ann.PAPER_LAYERS))
+    except ValueError as exc:
+        raise UserError(f"{where}: {exc}.") from None
+    if len(w) != ann.n_weights(layers):
+        what = "the network of section 6" if layers == ann.PAPER_LAYERS else f"a {list(layers)} network"
+        raise UserError(f"{where} has {len(w)} weights; {what} needs {ann.n_weights(layers)}.")
     if not all(math.isfinite(x) for x in w):
         raise UserError(f"{where} has weights that are not finite numbers.")
     if p.get("inputs") not in ann.INPUT_KINDS:
@@ -181,12 +196,14 @@ def _check_ann(p: dict, where: str) -> None:
 
 
 def ann_controller(weights, flap: FlapPattern | None = None, inputs: str = "relative",
-                   provenance: dict | None = None, name: str = "") -> ButterflyController:
-    """An ann controller (section 6) with the documented input scales of ``butterfly/ann.py``.
+                   provenance: dict | None = None, name: str = "", layers=ann.PAPER_LAYERS) -> ButterflyController:
+    """An ann controller (section 6) with the documented input scales of ``butterfly/ann.py``;
+    ``layers``: the network's shape (default the paper's ``[6, 6, 1]``).
 
     The default flap is section 6.3's: 10 Hz over [-60, 75] degrees."""
     flap = flap or FlapPattern(10.0, -60.0, 75.0)
     params = {
+        "layers": list(ann.check_layers(layers)),
         "inputs": inputs,
         "max_dphi_deg": ann.DEFAULT_MAX_DPHI_DEG,
         "phi_limit_deg": ann.DEFAULT_PHI_LIMIT_DEG,

@@ -31,7 +31,7 @@ import numpy as np
 from lifelike_mj.butterfly import ann
 from lifelike_mj.butterfly.backends import check_backend
 from lifelike_mj.butterfly.backends.paper import constants_row, run_batch
-from lifelike_mj.butterfly.controllers import KIND_ANN, ButterflyController, ann_controller
+from lifelike_mj.butterfly.controllers import ButterflyController, ann_controller
 from lifelike_mj.butterfly.flight import Condition, check_timing
 from lifelike_mj.butterfly.params import ButterflyParams, FlapPattern
 from lifelike_mj.errors import UserError
@@ -59,9 +59,14 @@ class PitchProblem:
     params: ButterflyParams = field(default_factory=ButterflyParams)
     gene_bound: float = GENE_BOUND
     weighting: str = "none"
+    layers: tuple[int, ...] = ann.PAPER_LAYERS
 
     def __post_init__(self) -> None:
         check_backend(self.backend)
+        try:
+            object.__setattr__(self, "layers", ann.check_layers(self.layers))
+        except ValueError as exc:
+            raise UserError(f"{exc}.") from None
         if self.weighting not in WEIGHTINGS:
             raise UserError(f"weighting must be one of {', '.join(WEIGHTINGS)}, got {self.weighting!r}.")
         if self.inputs not in (*ann.INPUT_KINDS, "both"):
@@ -73,15 +78,15 @@ class PitchProblem:
     # ---- the evolve.Problem protocol ----
     @property
     def dim(self) -> int:
-        return ann.N_WEIGHTS
+        return ann.n_weights(self.layers)
 
     @property
     def lower(self) -> np.ndarray:
-        return np.full(ann.N_WEIGHTS, -self.gene_bound)
+        return np.full(self.dim, -self.gene_bound)
 
     @property
     def upper(self) -> np.ndarray:
-        return np.full(ann.N_WEIGHTS, self.gene_bound)
+        return np.full(self.dim, self.gene_bound)
 
     @property
     def maximize(self) -> bool:
@@ -89,7 +94,8 @@ class PitchProblem:
 
     def describe(self) -> dict:
         """Plain-data description (what the fingerprint hashes; ``weighting`` only when not
-        ``none``, so that fingerprints of unweighted problems are unchanged)."""
+        ``none`` and ``layers`` only when not the paper's, so that fingerprints made before either
+        existed are unchanged)."""
         d = {
             "problem": "butterfly-pitch-ann",
             "backend": self.backend,
@@ -100,10 +106,12 @@ class PitchProblem:
             "flap": asdict(self.flap),
             "params": asdict(self.params),
             "gene_bound": self.gene_bound,
-            "n_weights": ann.N_WEIGHTS,
+            "n_weights": self.dim,
         }
         if self.weighting != "none":
             d["weighting"] = self.weighting
+        if self.layers != ann.PAPER_LAYERS:
+            d["layers"] = list(self.layers)
         return d
 
     def fingerprint(self) -> str:
@@ -111,22 +119,23 @@ class PitchProblem:
         return "butterfly-pitch-ann:" + hashlib.sha256(text.encode()).hexdigest()[:16]
 
     def evaluate(self, X: np.ndarray) -> np.ndarray:
-        """Mean eq. 13 fitness of each row of ``X`` (n, 49) over the flights (weighted by
+        """Mean eq. 13 fitness of each row of ``X`` (n, :attr:`dim`) over the flights (weighted by
         :meth:`weights`). A flight that diverges keeps the fitness it had gathered up to then."""
         X = np.atleast_2d(np.asarray(X, dtype=float))
-        if X.shape[1] != ann.N_WEIGHTS:
-            raise UserError(f"a genome has {ann.N_WEIGHTS} weights, got {X.shape[1]}.")
+        if X.shape[1] != self.dim:
+            raise UserError(f"a genome has {self.dim} weights, got {X.shape[1]}.")
         n = X.shape[0]
-        template = self.controller(np.zeros(ann.N_WEIGHTS)).compiled()[1]
+        kind, template = self.controller(np.zeros(self.dim)).compiled()
         cp = np.repeat(template[None, :], n, axis=0)
-        cp[:, ann.A_W :] = X
+        w0 = ann.weights_offset(self.layers)
+        cp[:, w0 : w0 + self.dim] = X
         n_steps = check_timing(self.duration_s, self.dt_s)
         flights = self.flights()
         nf = len(flights)
         if self.backend == "paper":
             cps = np.tile(cp, (nf, 1))
             cps[:, ann.A_RELATIVE] = np.repeat([1.0 if rel else 0.0 for _, rel in flights], n)
-            kinds = np.full(n * nf, KIND_ANN, dtype=np.int64)
+            kinds = np.full(n * nf, kind, dtype=np.int64)
             flaps = np.repeat(self.flap.as_array()[None, :], n * nf, axis=0)
             airs = np.repeat(np.array([c.air_velocity() for c, _ in flights]), n, axis=0)
             y0s = np.repeat(np.array([c.y0_m for c, _ in flights], dtype=float), n)
@@ -139,7 +148,7 @@ class PitchProblem:
         for cond, rel in flights:
             c = cp.copy()
             c[:, ann.A_RELATIVE] = 1.0 if rel else 0.0
-            fits.append(fitness_batch(c, self.flap, self.params, cond, n_steps, self.dt_s))
+            fits.append(fitness_batch(c, self.flap, self.params, cond, n_steps, self.dt_s, kind=kind))
         return self.weights() @ np.asarray(fits)
 
     def weights(self) -> np.ndarray:
@@ -163,7 +172,8 @@ class PitchProblem:
     # ---- helpers ----
     def controller(self, weights, provenance: dict | None = None, name: str = "") -> ButterflyController:
         """The controller file content of a genome."""
-        return ann_controller(weights, self.flap, "ground" if self.inputs == "ground" else "relative", provenance, name)
+        return ann_controller(weights, self.flap, "ground" if self.inputs == "ground" else "relative", provenance, name,
+                              self.layers)
 
 
 def flight_weight(head_wind_m_s: float) -> float:
@@ -203,8 +213,9 @@ TASKS = ("paper", "robust", "robust_wide", "robust_map")
 
 
 def make_problem(task: str = "paper", backend: str = "paper", inputs: str | None = None,
-                 params: ButterflyParams | None = None) -> PitchProblem:
-    """``paper``: section 6.3's task (still air, from 0 m; inputs default ``relative``);
+                 params: ButterflyParams | None = None, hidden=None) -> PitchProblem:
+    """The network's shape is the paper's 6-6-1, or 6 inputs, the ``hidden`` layer sizes (a list, or
+    text like ``"8,8"``) and one output. ``paper``: section 6.3's task (still air, from 0 m; inputs default ``relative``);
     ``robust`` / ``robust_wide``: :func:`robust_conditions` / :func:`robust_wide_conditions`
     (inputs default ``both``); ``robust_map``: :func:`robust_map_conditions`, inputs ``both``, flights
     weighted by ground speed (:func:`flight_weight`)."""
@@ -216,7 +227,21 @@ def make_problem(task: str = "paper", backend: str = "paper", inputs: str | None
         inputs = "relative" if task == "paper" else "both"
     weighting = "ground_speed" if task == "robust_map" else "none"
     return PitchProblem(backend=backend, conditions=conds, inputs=inputs, params=params or ButterflyParams(),
-                        weighting=weighting)
+                        weighting=weighting, layers=_layers(hidden))
+
+
+def _layers(hidden) -> tuple[int, ...]:
+    if hidden is None:
+        return ann.PAPER_LAYERS
+    if isinstance(hidden, str):
+        try:
+            hidden = [int(x) for x in hidden.split(",")]
+        except ValueError:
+            raise UserError(f"--hidden must be layer sizes like 8,8, got {hidden!r}.") from None
+    try:
+        return ann.check_layers((ann.N_INPUTS, *hidden, 1))
+    except ValueError as exc:
+        raise UserError(f"hidden layers {list(hidden)}: {exc}.") from None
 
 
 def evolve_controller(problem: PitchProblem, optimizer: str, seed: int, out: str | Path,

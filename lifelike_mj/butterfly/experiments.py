@@ -450,3 +450,49 @@ def e5_timestep(
         diverged_step={k: int(tr.diverged_step) for k, tr in trs.items()},
         trajectories=trs,
     )
+
+
+# ---- one flight, as `butterfly fly` flies it ------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class FlyResult:
+    """One flight (:func:`fly`): its trajectory and the summary numbers ``butterfly fly`` prints."""
+
+    trajectory: Trajectory
+    summary: dict
+
+    def write(self, out_dir: str, title: str = "") -> list[str]:
+        """``trajectory.npz``, ``trajectory.csv``, ``flight.png`` and ``summary.json`` into ``out_dir``
+        (atomically); returns the paths written."""
+        from pathlib import Path
+
+        from lifelike_mj.butterfly.figures import fig_flight
+        from lifelike_mj.io import write_json, write_npz, write_text
+
+        out = Path(out_dir)
+        files = [write_npz(out / "trajectory.npz", **self.trajectory.to_npz_dict()),
+                 write_text(out / "trajectory.csv", self.trajectory.to_csv())]
+        fig_flight(self.trajectory, out / "flight.png", title)
+        files += [out / "flight.png", write_json(out / "summary.json", self.summary)]
+        return [str(f) for f in files]
+
+
+def fly(controller: controllers.ButterflyController, params: ButterflyParams | None = None, condition=None,
+        duration_s: float = 20.0, dt_s: float = 1.0 / 1200.0, backend: str = "paper", config: str = "paper",
+        force_mode: str | None = None, name: str = "") -> FlyResult:
+    """Fly ``controller`` for ``duration_s`` seconds at time step ``dt_s`` (s) on ``backend`` (the MuJoCo
+    backend in ``config`` with ``force_mode``); every step recorded. A runaway is a
+    :class:`~lifelike_mj.errors.Diverged` error naming the step."""
+    from lifelike_mj.butterfly.flight import Condition, check_timing
+    from lifelike_mj.errors import Diverged
+
+    backends.check_backend(backend)
+    opts = backends.mujoco_options(config, force_mode) if backend == "mujoco" else {}
+    check_timing(duration_s, dt_s)
+    traj = backends.simulate(backend, controller, params or ButterflyParams(), condition or Condition(), duration_s,
+                             dt_s, 1, **opts)[0]
+    summary = {"controller": controller.name or name, **traj.summary(), **({"config": opts} if opts else {})}
+    if traj.diverged_step >= 0:
+        raise Diverged(f"the flight diverged (runaway speed) at step {traj.diverged_step}.", traj.diverged_step)
+    return FlyResult(traj, summary)

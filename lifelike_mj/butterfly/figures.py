@@ -2,8 +2,8 @@
 
 Each ``fig_*`` function draws one result of :mod:`lifelike_mj.butterfly.experiments` with the
 same axes, quantities and units as the paper's figure, names the figure in its title and
-annotates the paper's numbers where the paper states them. The PNG is written atomically (a
-temporary file in the same folder, then ``os.replace``). The figures are built on
+annotates the paper's numbers where the paper states them, and returns the figure; given a path
+it also writes the PNG atomically (a temporary file in the same folder, then ``os.replace``). The figures are built on
 :class:`matplotlib.figure.Figure` with the Agg canvas, without pyplot, so drawing them never
 changes the process's matplotlib backend.
 """
@@ -11,44 +11,19 @@ changes the process's matplotlib backend.
 from __future__ import annotations
 
 import os
-from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from lifelike_mj.butterfly.params import ButterflyParams
-from lifelike_mj.errors import UserError
-from lifelike_mj.io import atomic_path
+from lifelike_mj.render.plot import finish
+from lifelike_mj.render.plot import new_figure as _new_figure
 
-DPI = 120
 _DT_COLOURS = {"1/12000": "black", "1/1200": "tab:blue", "1/360": "tab:orange", "1/120": "tab:red"}
 _SPEED_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple")
 
 
-def _new_figure(width_in: float, height_in: float) -> Figure:
-    fig = Figure(figsize=(width_in, height_in), layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
-
-
-def _png_path(path: str | os.PathLike, what: str) -> Path:
-    """``path`` as a Path; a :class:`UserError` unless it names a ``.png`` file."""
-    p = Path(path)
-    if p.suffix.lower() != ".png":
-        raise UserError(f"cannot write {p.name}: the {what} is a .png file.")
-    return p
-
-
-def _save(fig: Figure, path: str | os.PathLike) -> Path:
-    """Write ``fig`` as a PNG to ``path`` atomically; return the path."""
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=DPI)
-    return path
-
-
-def fig3_forces(curves, path: str | os.PathLike) -> Path:
+def fig3_forces(curves, path: str | os.PathLike | None = None) -> Figure:
     """Oe 2010 Fig. 3: ``F_y`` and ``F_z`` (mN, both wings, eq. 8-9 at ``theta = 0``) against the
     pitch ``phi`` (deg) for ``v_z`` = 0, 2, 4 m/s, upstroke (solid) and downstroke (dashed).
 
@@ -84,10 +59,10 @@ def fig3_forces(curves, path: str | os.PathLike) -> Path:
     ax_z.text(0.02, 0.02, "paper: as v_z grows both ranges widen,\nwhile the maximum of F_z decreases",
               transform=ax_z.transAxes, fontsize=8, va="bottom")
     fig.suptitle("Oe 2010 Fig. 3 — forces for the forward velocity (eq. 8–9, θ = 0, ω = ±62.8 rad/s)")
-    return _save(fig, path)
+    return finish(fig, path)
 
 
-def fig_speed_limit(sweep, path: str | os.PathLike) -> Path:
+def fig_speed_limit(sweep, path: str | os.PathLike | None = None) -> Figure:
     """Speed limit of Oe 2010 section 4.3 (cm/s, 1 cm/s steps) against the body area ``A_b``
     (cm^2) of eq. 10, with the paper's 380 cm/s and the points at 1.0 and 1.53 cm^2 marked.
 
@@ -109,10 +84,10 @@ def fig_speed_limit(sweep, path: str | os.PathLike) -> Path:
     ax.grid(alpha=0.3)
     ax.legend(fontsize=9)
     ax.set_title("Oe 2010 section 4.3 — forward-speed limit against the body area (ω = 62.8 rad/s)", fontsize=10)
-    return _save(fig, path)
+    return finish(fig, path)
 
 
-def fig4_trim(trim, path: str | os.PathLike) -> Path:
+def fig4_trim(trim, path: str | os.PathLike | None = None) -> Figure:
     """Oe 2010 Fig. 4: flight by the simple rule. Left: altitude ``y`` (m) against forward
     distance ``z`` (m) over the whole flight at the level angle and at level -/+ 0.5 deg.
     Right: a few flap cycles of the settled level flight, ``y`` in cm against ``z`` in m,
@@ -163,10 +138,10 @@ def fig4_trim(trim, path: str | os.PathLike) -> Path:
     ylo, yhi = axz.get_ylim()
     axz.set_ylim(ylo, yhi + 0.45 * (yhi - ylo))
     fig.suptitle("Oe 2010 Fig. 4 — flight by a simple rule (φ = φ_up on the upstroke, 0 on the downstroke)")
-    return _save(fig, path)
+    return finish(fig, path)
 
 
-def fig5_timestep(ts, path: str | os.PathLike) -> Path:
+def fig5_timestep(ts, path: str | os.PathLike | None = None) -> Figure:
     """Oe 2010 Fig. 5: variation of flights by the time step (``phi_up`` = 14 deg).
     (a) altitude ``y`` (m) against forward distance ``z`` (m), one point every 1 s, for
     dt = 1/12000, 1/1200, 1/360, 1/120 s; (b) altitude difference from the 1/12000 s run,
@@ -209,4 +184,42 @@ def fig5_timestep(ts, path: str | os.PathLike) -> Path:
     ax_b.set_title(f"(b) difference from dt = 1/12000 s; error ×{ts.error_ratio_per_3x_dt:.3g} for dt ×3 "
                    "(paper ≈ ×10)", fontsize=10)
     fig.suptitle(f"Oe 2010 Fig. 5 — variation of flights by the time step (φ_up = {ts.phi_up_deg:g}°, RK4)")
-    return _save(fig, path)
+    return finish(fig, path)
+
+
+def fig_flight(traj, path: str | os.PathLike | None = None, title: str = "") -> Figure:
+    """One flight: altitude y (m) against forward distance z (m), and the pitch phi and flap theta
+    (deg) over the first 0.5 s."""
+    fig = _new_figure(11.0, 4.0)
+    a, b = fig.subplots(1, 2, width_ratios=[2, 1])
+    a.plot(traj.z, traj.y, lw=0.8)
+    a.set_xlabel("forward distance z [m]")
+    a.set_ylabel("altitude y [m] (target 0 m)")
+    a.grid(alpha=0.3)
+    a.set_title(title or f"flight ({traj.backend} backend)")
+    mask = traj.t <= min(traj.t[-1], 0.5)
+    b.plot(traj.t[mask], np.degrees(traj.theta[mask]), label="flap theta")
+    b.plot(traj.t[mask], np.degrees(traj.phi[mask]), label="pitch phi")
+    b.set_xlabel("time [s]")
+    b.set_ylabel("angle [deg]")
+    b.legend(loc="upper right", fontsize=8)
+    b.grid(alpha=0.3)
+    return finish(fig, path)
+
+
+def fig_compare(results, path: str | os.PathLike | None = None) -> Figure:
+    """Altitude (m) against time (s) on both backends, one panel per MuJoCo configuration
+    (:class:`~lifelike_mj.butterfly.compare.CompareResult` with its trajectories)."""
+    fig = _new_figure(6.0 * len(results), 4.0)
+    axes = fig.subplots(1, len(results), squeeze=False)
+    for ax, r in zip(axes[0], results):
+        ref, mj = r.trajectories
+        ax.plot(ref.t, ref.y - ref.y0, lw=1.2, label="paper backend (eq. 7-11)")
+        ax.plot(mj.t, mj.y - mj.y0, lw=0.8, ls="--", label=f"MuJoCo, {r.config} config, {r.force_mode} force")
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("altitude y [m]")
+        ax.set_title(f"{r.config}: max |dy| = {100 * r.max_altitude_diff_m:.2f} cm, "
+                     f"max |dz| = {100 * r.max_forward_diff_m:.1f} cm", fontsize=9)
+        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
+    return finish(fig, path)

@@ -25,8 +25,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from lifelike_mj.butterfly.ann import ann_pitch
-from lifelike_mj.butterfly.controllers import KIND_ANN, KIND_SIMPLE_RULE, OMEGA_EPS
+from lifelike_mj.butterfly.ann import ann_pitch, mlp_pitch
+from lifelike_mj.butterfly.controllers import KIND_ANN, KIND_MLP, KIND_SIMPLE_RULE, OMEGA_EPS
 from lifelike_mj.errors import UserError
 
 
@@ -64,6 +64,8 @@ def pitch_command(kind, cparams, t, theta, omega, y, z, vy, vz, air_y, air_z, ph
         return cparams[0] if omega > OMEGA_EPS else cparams[1]
     if kind == KIND_ANN:
         return ann_pitch(cparams, theta, omega, y, vy, vz, air_y, air_z, phi_prev)
+    if kind == KIND_MLP:
+        return mlp_pitch(cparams, theta, omega, y, vy, vz, air_y, air_z, phi_prev)
     return cparams[0]  # KIND_CONSTANT
 
 

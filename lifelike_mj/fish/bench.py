@@ -51,7 +51,7 @@ def run(repeats: int = 5, max_fish: int = 1000, long_minutes: float = 10.0, rend
         out["long_run"] = long_run(long_minutes)
     if render:
         try:
-            from lifelike_mj.viz.fish_video import render_benchmark
+            from lifelike_mj.fish.render import render_benchmark
 
             out["render"] = render_benchmark()
         except Exception as exc:  # no GL on this machine: say so in the JSON

@@ -200,3 +200,18 @@ def pattern_table(seeds=(0, 1, 2, 3, 4), duration_s: float = 60.0, n_fish: int =
         ok = all(math.isfinite(x) and x > 0 for x in margins)
         table.checks[f"{hi} > {lo} on {k}"] = {"holds": ok, "margins": [float(x) for x in margins]}
     return table
+
+
+def write_swim(result: SwimResult, out_dir: str | Path, summary: dict | None = None) -> list[str]:
+    """A swim's files, as ``fish swim --out`` writes them: the tracks (npz, CSV), the Fig. 7/8-style
+    tracks and acceleration histogram (PNG) and the measures (``measures.json``: ``summary``, or
+    :func:`swim_summary` of the swim). Atomic writes; returns the paths written."""
+    from lifelike_mj.fish.figures import accel_histogram_figure, tracks_figure
+    from lifelike_mj.io import write_json
+
+    out = Path(out_dir)
+    files = write_tracks(result, out)
+    tracks_figure(result, out / "tracks.png")
+    accel_histogram_figure(result, out / "accel_histogram.png")
+    write_json(out / "measures.json", summary if summary is not None else swim_summary(result))
+    return [str(f) for f in (*files.values(), out / "tracks.png", out / "accel_histogram.png", out / "measures.json")]

@@ -7,7 +7,7 @@
 * :func:`patterns_figure`: the four motion patterns NB-ND, NB-D, B-ND, B-D on the objective measures
   (burstiness, kurtosis of the acceleration, turning entropy) that stand in for the paper's
   questionnaire (Satoi 2015 Fig. 10-12);
-* :func:`tank_snapshot`: one rendered frame of the tank (:mod:`lifelike_mj.viz.fish_video`).
+* :func:`tank_snapshot`: one rendered frame of the tank (:mod:`lifelike_mj.fish.render`).
 
 The figures are built on :class:`matplotlib.figure.Figure` with the Agg canvas, without pyplot (the
 process's matplotlib backend is never changed); every PNG is written atomically (a temporary file
@@ -21,10 +21,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+from matplotlib.figure import Figure
 
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import atomic_path
-from lifelike_mj.viz.figures import _new_figure, _png_path, _save
+from lifelike_mj.render.plot import finish, png_path
+from lifelike_mj.render.plot import new_figure as _new_figure
 
 if TYPE_CHECKING:  # pragma: no cover
     from lifelike_mj.fish.params import FishParams
@@ -59,7 +61,8 @@ def _shade(ax, t: np.ndarray, mask: np.ndarray, dt: float, colour: str, label: s
                    label=label if n == 0 else None, transform=trans)
 
 
-def tracks_figure(result: SwimResult, out_path: str | os.PathLike, fish: int = 0, duration_s: float = 30.0) -> Path:
+def tracks_figure(result: SwimResult, out_path: str | os.PathLike | None = None, fish: int = 0,
+                  duration_s: float = 30.0) -> Figure:
     """Satoi 2015 Fig. 7/8 style: the tracks of fish ``fish`` over the first ``duration_s`` s (or
     the whole swim if shorter), written as a PNG.
 
@@ -69,7 +72,7 @@ def tracks_figure(result: SwimResult, out_path: str | os.PathLike, fish: int = 0
     side view (x against z, true aspect, the tank's walls dashed), from a circle (start) to a
     square (end). ``result``: a :class:`~lifelike_mj.fish.sim.SwimResult`. Returns the path written.
     """
-    out = _png_path(out_path, "tracks figure")
+    out = None if out_path is None else png_path(out_path, "tracks figure")
     n = result.n_fish
     if isinstance(fish, bool) or not isinstance(fish, (int, np.integer)) or not 0 <= fish < n:
         raise UserError(f"fish must be a whole number from 0 to {n - 1}, got {fish!r}.")
@@ -123,7 +126,7 @@ def tracks_figure(result: SwimResult, out_path: str | os.PathLike, fish: int = 0
     ax_p.set_ylabel("z (m)")
     ax_p.set_title(f"Path in the side view (tank {L:g} m x {H:g} m, dashed)", fontsize=10)
     ax_p.legend(loc="upper left", fontsize=8, ncols=3)
-    return _save(fig, out)
+    return finish(fig, out)
 
 
 def side_accelerations_bl(result: SwimResult, body_length_m: float = 0.07, fps: float | None = None) -> np.ndarray:
@@ -138,7 +141,7 @@ def side_accelerations_bl(result: SwimResult, body_length_m: float = 0.07, fps: 
     return accel / body_length_m
 
 
-def accel_histogram_figure(result: SwimResult, out_path: str | os.PathLike, body_length_m: float = 0.07) -> Path:
+def accel_histogram_figure(result: SwimResult, out_path: str | os.PathLike | None = None, body_length_m: float = 0.07) -> Figure:
     """Satoi 2015 Fig. 2/7/8 style: histogram of the tangential acceleration in the side view, pooled
     over the fish, in body lengths/s^2, written as a PNG.
 
@@ -150,7 +153,7 @@ def accel_histogram_figure(result: SwimResult, out_path: str | os.PathLike, body
     """
     from lifelike_mj.fish.metrics import VIDEO_FPS, accel_histogram, histogram_summary, kurtosis
 
-    out = _png_path(out_path, "acceleration histogram")
+    out = None if out_path is None else png_path(out_path, "acceleration histogram")
     if isinstance(body_length_m, bool) or not isinstance(body_length_m, (int, float)) or not body_length_m > 0:
         raise UserError(f"the body length must be a positive number of m, got {body_length_m!r}.")
     a = side_accelerations_bl(result, body_length_m)
@@ -182,10 +185,10 @@ def accel_histogram_figure(result: SwimResult, out_path: str | os.PathLike, body
             bbox={"boxstyle": "round,pad=0.3", "fc": "white", "ec": "0.7", "alpha": 0.9})
     ax.set_title(f"Side-view acceleration at {VIDEO_FPS:g} fps, preset {name}, {span:.0f} s "
                  "(cf. Satoi 2015 Fig. 2 real fish, Fig. 7/8 simulated)", fontsize=10)
-    return _save(fig, out)
+    return finish(fig, out)
 
 
-def patterns_figure(rows: list[dict], out_path: str | os.PathLike) -> Path:
+def patterns_figure(rows: list[dict], out_path: str | os.PathLike | None = None) -> Figure:
     """Satoi 2015 Fig. 10-12 stand-in: the four motion patterns NB-ND, NB-D, B-ND, B-D (not bursty /
     bursty, not diverse / diverse) compared on the objective measures that replace the paper's
     questionnaire ratings, written as a PNG.
@@ -198,7 +201,7 @@ def patterns_figure(rows: list[dict], out_path: str | os.PathLike) -> Path:
     and value); the paper's four patterns first, any other preset after them. Non-finite values
     are left out. Returns the path written.
     """
-    out = _png_path(out_path, "patterns figure")
+    out = None if out_path is None else png_path(out_path, "patterns figure")
     if not isinstance(rows, (list, tuple)) or not rows:
         raise UserError("the patterns figure needs at least one row of measures.")
     for i, r in enumerate(rows):
@@ -233,7 +236,7 @@ def patterns_figure(rows: list[dict], out_path: str | os.PathLike) -> Path:
     seed_text = f"{len(seeds)} seed{'s' if len(seeds) != 1 else ''}"
     fig.suptitle(f"The four motion patterns (Satoi 2015 Fig. 10-12) on objective measures in place of the "
                  f"questionnaire: one point per seed ({seed_text}), bar = median", fontsize=10)
-    return _save(fig, out)
+    return finish(fig, out)
 
 
 def tank_snapshot(out_path: str | os.PathLike, params: FishParams, n_fish: int = 10, seed: int = 0, t_s: float = 5.0,
@@ -241,14 +244,14 @@ def tank_snapshot(out_path: str | os.PathLike, params: FishParams, n_fish: int =
     """One rendered frame of the swim at time ``t_s`` (s), as a PNG of ``width`` x ``height`` pixels.
 
     ``camera``: ``side`` (the whole tank, Satoi 2015's view), ``oblique`` or ``follow`` (1 m of tank
-    around fish 0); ``size``: the water volume (m). See :func:`lifelike_mj.viz.fish_video.render_frame`.
+    around fish 0); ``size``: the water volume (m). See :func:`lifelike_mj.fish.render.render_frame`.
     Written atomically; returns the path.
     """
     from PIL import Image
 
-    from lifelike_mj.viz.fish_video import render_frame
+    from lifelike_mj.fish.render import render_frame
 
-    out = _png_path(out_path, "snapshot")
+    out = None if out_path is None else png_path(out_path, "snapshot")
     img = render_frame(params, t_s=t_s, n_fish=n_fish, seed=seed, size=size, camera=camera, width=width, height=height)
     with atomic_path(out) as tmp:
         Image.fromarray(img).save(tmp, format="PNG")

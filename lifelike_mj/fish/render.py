@@ -1,9 +1,9 @@
 """Offscreen video, single frames, a render benchmark and the viewer of the fish tank (Satoi 2015).
 
-The fish are the real simulation of :mod:`lifelike_mj.fish.sim`: a :class:`~lifelike_mj.fish.sim.Swimmer`
+The fish are the real simulation of :mod:`lifelike_mj.fish.sim`: a :class:`~lifelike_mj.fish.sim.Tank`
 advanced by whole control steps (``params.control_hz``, 60 per second, as in Satoi, Nakadai,
 Hoshino 2015), so a rendered swim is the swim that :func:`~lifelike_mj.fish.sim.swim` computes with
-the same preset, fish count, seed and tank (the swimmer draws its random numbers per control step,
+the same preset, fish count, seed and tank (the tank draws its random numbers per control step,
 in any chunking). Frame ``j`` of a video shows the state at the control step nearest to its time
 ``j / fps`` (s), rounding halves up: at 30 frames per second every 2nd control step, at 24 the
 steps 0, 3, 5, 8, 10, ... (the frame times 0, 0.042, 0.083, ... s fall between control steps).
@@ -22,16 +22,15 @@ Cameras (``camera=``):
   fish turn in view). The fish of this model do not school (each swims on its own, spread over the
   whole tank), so the centroid of the tank's fish is usually empty water: one fish is followed.
 
-Rendering reuses the butterfly's offscreen machinery of :mod:`lifelike_mj.viz.video` (OpenGL
-backend choice, context, frame writers for ``.mp4`` and ``.gif``, size checks, atomic writes); the
-tank keeps its own lighting (``models/tank.xml``; shadows and multisampling are off for speed).
-As there, ``mujoco`` is imported only inside functions, so that :func:`~lifelike_mj.viz.video.ensure_gl_backend`
-can run first.
+A swim you already recorded (:class:`~lifelike_mj.fish.sim.SwimResult`) is drawn the same way
+through :func:`playback`. Rendering uses the generic :mod:`lifelike_mj.render` package (OpenGL
+backend choice, the recorder and its MP4/GIF writers, atomic writes); the tank keeps its own
+lighting (``models/fish/tank.xml``; shadows and multisampling are off for speed). ``mujoco`` is
+imported only inside functions, so that :func:`~lifelike_mj.render.gl.ensure_gl_backend` can run first.
 """
 
 from __future__ import annotations
 
-import contextlib
 import math
 import statistics
 import time
@@ -40,13 +39,16 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from lifelike_mj import checks
 from lifelike_mj.errors import UserError
-from lifelike_mj.viz.video import _check_size, _Offscreen, _positive, _video_report, _video_target, _write_frames
-from lifelike_mj.viz.viewer import FRAME_S, MAX_CATCH_UP_S, launch_viewer, require_display
+from lifelike_mj.render.offscreen import Offscreen, gl_renderer_name
+from lifelike_mj.render.video import advance_to, check_size, film, video_target, write_png
+from lifelike_mj.render.viewer import require_display, view
+from lifelike_mj.stepper import Playback
 
 if TYPE_CHECKING:  # pragma: no cover
     from lifelike_mj.fish.params import FishParams
-    from lifelike_mj.fish.sim import Swimmer
+    from lifelike_mj.fish.sim import SwimResult, Tank
 
 #: The cameras of :func:`render_fish`: two of the tank model, and the closer following view.
 CAMERAS = ("side", "oblique", "follow")
@@ -65,34 +67,12 @@ def _check_camera(camera: str) -> None:
         raise UserError(f"unknown camera {camera!r}; choose one of {', '.join(CAMERAS)}.")
 
 
-def _refresh(m, d) -> None:
-    """Recompute the drawing quantities (body poses, cameras, lights) of the current state.
+def _tank(params: FishParams, n_fish: int, seed: int, size) -> Tank:
+    from lifelike_mj.fish.sim import Tank
 
-    ``mj_step`` leaves them at the start of its last step; they are derived quantities that the
-    next step recomputes, so this does not change the swim."""
-    import mujoco
-
-    mujoco.mj_kinematics(m, d)
-    mujoco.mj_comPos(m, d)
-    mujoco.mj_camlight(m, d)
-
-
-def _swimmer(params: FishParams, n_fish: int, seed: int, size) -> Swimmer:
-    from lifelike_mj.fish.sim import Swimmer
-
-    sw = Swimmer(params, n_fish, seed, size)
-    _refresh(sw.scene.model, sw.data)
-    return sw
-
-
-def _advance(sw: Swimmer, step: int) -> None:
-    """Run the swimmer to control step ``step`` (no-op if there) and refresh its drawing state."""
-    n = int(step) - sw.step
-    if n < 0:
-        raise ValueError("a swim cannot be stepped backwards")
-    if n:
-        sw.run(n, record=False)
-        _refresh(sw.scene.model, sw.data)
+    tank = Tank(params, n_fish, seed, size)
+    tank.sync()
+    return tank
 
 
 def frame_steps(n_frames: int, fps: float, control_hz: float) -> np.ndarray:
@@ -105,7 +85,7 @@ def frame_steps(n_frames: int, fps: float, control_hz: float) -> np.ndarray:
 class _Camera:
     """An ``MjvCamera`` for one of :data:`CAMERAS`; :meth:`aim` moves the ``follow`` camera."""
 
-    def __init__(self, sw: Swimmer, camera: str, width: int, height: int, follow_fish: int = 0) -> None:
+    def __init__(self, sw: Tank | Playback, camera: str, width: int, height: int, follow_fish: int = 0) -> None:
         import mujoco
 
         _check_camera(camera)
@@ -118,8 +98,7 @@ class _Camera:
             self.cam.fixedcamid = m.camera(camera).id
             return
         n = sw.scene.n
-        if isinstance(follow_fish, bool) or not isinstance(follow_fish, (int, np.integer)) or not 0 <= follow_fish < n:
-            raise UserError(f"the fish to follow must be a whole number from 0 to {n - 1}, got {follow_fish!r}.")
+        checks.whole("the fish to follow", follow_fish, 0, n - 1)
         self.qadr = int(sw.scene.qadr[follow_fish])
         L, D, H = sw.scene.size
         half_v = math.radians(float(m.vis.global_.fovy)) / 2.0  # a free camera's vertical field of view
@@ -149,102 +128,122 @@ class _Camera:
         self.cam.lookat[:] = (x, 0.0, z)
 
 
-def _renderer(sw: Swimmer, width: int, height: int) -> _Offscreen:
+def _renderer(sw: Tank | Playback, width: int, height: int) -> Offscreen:
     # five visible geoms per fish, plus the tank
-    return _Offscreen(sw.scene.model, width, height, maxgeom=100 + 8 * sw.scene.n, dress=False)
+    return Offscreen(sw.scene.model, width, height, maxgeom=100 + 8 * sw.scene.n)
+
+
+def playback(result: SwimResult) -> Playback:
+    """A recorded swim (:class:`~lifelike_mj.fish.sim.SwimResult`) in the stepper shape: step ``k`` poses
+    the fish of a tank like the swim's at its control step ``k`` (positions and orientations)."""
+    import mujoco
+
+    from lifelike_mj.fish.scene import build_scene
+
+    scene = build_scene(result.n_fish, result.tank_m)
+    d = mujoco.MjData(scene.model)
+    pos, quat = result.positions, result.quats
+
+    def pose(k: int) -> None:
+        for i, a in enumerate(scene.qadr):
+            d.qpos[a : a + 3] = pos[k, i]
+            d.qpos[a + 3 : a + 7] = quat[k, i]
+        mujoco.mj_kinematics(scene.model, d)
+        mujoco.mj_comPos(scene.model, d)
+        mujoco.mj_camlight(scene.model, d)
+
+    def state(k: int) -> dict:
+        return {"position_m": pos[k], "quat": quat[k], "mu": result.mu[k] % 4, "avoiding": result.mu[k] >= 4}
+
+    dt = float(result.times_s[1] - result.times_s[0]) if len(result.times_s) > 1 else result.params.control_dt_s
+    pb = Playback(scene.model, d, len(result.times_s), pose, dt, state)
+    pb.scene = scene  # the cameras need the tank's size and the fish's addresses
+    pb.params = result.params
+    return pb
+
+
+def film_tank(out_path: str | Path, tank: Tank | Playback, duration_s: float = 10.0, fps: float = 30.0,
+              width: int = 640, height: int = 480, camera: str = "side", follow_fish: int = 0,
+              progress: bool = False) -> dict:
+    """Film a tank you made (a :class:`~lifelike_mj.fish.sim.Tank`, from its current state on, or a
+    :func:`playback` of a swim) into an ``.mp4`` or ``.gif`` file: ``round(duration_s * fps)`` frames
+    at ``fps`` frames/s (real speed; at most the control rate), frame ``j`` showing the control step
+    nearest to ``j / fps`` s after the start (module docstring). Returns the keys of
+    :func:`~lifelike_mj.render.video.video_report`."""
+    video_target(out_path, width, height)
+    _check_camera(camera)
+    duration_s = checks.positive("duration", duration_s, "s")
+    fps = checks.positive("fps", fps)
+    control_hz = 1.0 / tank.dt
+    if fps > control_hz * (1.0 + 1e-9):
+        raise UserError(f"{fps:g} frames per second is more than the {control_hz:g} control steps per second "
+                        "of the swim (frames would repeat); choose fps <= the control rate.")
+    n_frames = max(1, int(round(duration_s * fps)))
+    steps = int(tank.steps) + frame_steps(n_frames, fps, control_hz)
+    cam = _Camera(tank, camera, width, height, follow_fish)
+
+    def aimed(j: int):
+        cam.aim(tank.data, None if j == 0 else int(steps[j] - steps[j - 1]) * tank.dt)
+        return cam.cam
+
+    tank.sync()
+    with _renderer(tank, width, height) as renderer:
+        return film(out_path, tank, [int(k) for k in steps], renderer, aimed, fps, camera, progress, "render fish")
 
 
 def render_fish(out_path: str | Path, params: FishParams, n_fish: int = 10, duration_s: float = 10.0, seed: int = 0,
                 size=None, fps: float = 30.0, width: int = 640, height: int = 480, camera: str = "side",
                 follow_fish: int = 0, progress: bool = False, start_s: float = 0.0) -> dict:
-    """Render a swim of ``n_fish`` fish offscreen to an ``.mp4`` or ``.gif`` file (Satoi 2015 model).
+    """Render a new swim of ``n_fish`` fish offscreen to an ``.mp4`` or ``.gif`` file (Satoi 2015 model).
 
     ``params``: a preset (:func:`~lifelike_mj.fish.params.load_preset`); ``seed``: the swim's seed;
     ``size``: the water volume ``(L, D, H)`` in m (default the filmed tank, 5 x 0.5 x 1 m).
-    ``round(duration_s * fps)`` frames (``duration_s`` in s) are played at ``fps`` frames/s, at real
-    speed; frame ``j`` shows control step ``round(start_s * control_hz) + round(j * control_hz / fps)``
-    (module docstring), so ``fps`` may be at most the control rate (60). ``start_s`` (s, default 0): the swim runs that
-    long unrendered first (the fish start at rest and wait for their first *accelerate* MU, about
-    0.5 s on average with the B-D preset). ``camera``: ``side`` (the whole tank, the paper's view),
-    ``oblique``, or ``follow`` (a 1 m wide side view following fish ``follow_fish``; module
-    docstring). ``width``/``height`` in pixels (8-4096; even for MP4). ``progress``: a tqdm bar.
-    The file is written atomically (nothing is left behind on an error, e.g. a runaway swim).
+    ``start_s`` (s, default 0): the swim runs that long unrendered first (the fish start at rest and
+    wait for their first *accelerate* MU, about 0.5 s on average with the B-D preset); then
+    :func:`film_tank`. ``camera``: ``side`` (the whole tank, the paper's view), ``oblique``, or
+    ``follow`` (a 1 m wide side view following fish ``follow_fish``; module docstring).
+    ``width``/``height`` in pixels (8-4096; even for MP4). The file is written atomically (nothing is
+    left behind on an error, e.g. a runaway swim).
 
-    Returns ``{"path", "frames", "fps", "width", "height", "camera", "seconds" (video length, s =
-    simulated time shown), "n_fish", "seed", "preset", "gl_backend", "sim_s", "render_s", "encode_s",
-    "wall_s" (wall-clock s of the swim, of drawing and reading the frames, of encoding, and in all),
-    "render_fps" (frames drawn per wall second of drawing alone, swim and encoding excluded),
-    "start_s"}``.
+    Returns the keys of :func:`~lifelike_mj.render.video.video_report` and ``"n_fish", "seed",
+    "preset", "start_s"``.
     """
-    out, suffix = _video_target(out_path, width, height)
+    video_target(out_path, width, height)
     _check_camera(camera)
-    duration_s = _positive("duration", duration_s)
-    fps = _positive("fps", fps)
-    if fps > params.control_hz * (1.0 + 1e-9):
-        raise UserError(f"{fps:g} frames per second is more than the {params.control_hz:g} control steps per second "
-                        "of the swim (frames would repeat); choose fps <= the control rate.")
-    if isinstance(start_s, bool) or not isinstance(start_s, (int, float)) or not (math.isfinite(start_s) and start_s >= 0):
-        raise UserError(f"the start time must be a number of seconds >= 0, got {start_s!r}.")
-    n_frames = max(1, int(round(duration_s * fps)))
+    start_s = checks.number("the start time", start_s, 0.0, unit="s")
+    tank = _tank(params, n_fish, seed, size)
     first = int(math.floor(start_s * params.control_hz + 0.5))
-    steps = first + frame_steps(n_frames, fps, params.control_hz)
+    advance_to(tank, first)
+    info = film_tank(out_path, tank, duration_s, fps, width, height, camera, follow_fish, progress)
+    return {**info, "n_fish": int(tank.scene.n), "seed": int(tank.seed), "preset": params.name,
+            "start_s": first * params.control_dt_s}
 
-    t_start = time.perf_counter()
-    sw = _swimmer(params, n_fish, seed, size)
-    cam = _Camera(sw, camera, width, height, follow_fish)
-    renderer = _renderer(sw, width, height)
-    m, d = sw.scene.model, sw.data
 
-    def advance(j: int) -> None:
-        _advance(sw, int(steps[j]))
-
-    def draw(j: int) -> np.ndarray:
-        cam.aim(d, None if j == 0 else int(steps[j] - steps[j - 1]) * params.control_dt_s)
-        renderer.update(m, d, cam.cam)
-        return renderer.draw()
-
-    try:
-        t = _write_frames(out, suffix, fps, n_frames, advance, draw, "render fish", progress)
-    finally:
-        renderer.close()
-    return {
-        **_video_report(out, n_frames, fps, width, height, camera, renderer.backend, t, t_start),
-        "n_fish": int(sw.scene.n),
-        "seed": int(sw.seed),
-        "preset": params.name,
-        "start_s": first * params.control_dt_s,
-    }
-
-def render_frame(params: FishParams, t_s: float = 5.0, n_fish: int = 10, seed: int = 0, size=None,
+def render_frame(params: FishParams | Tank | Playback, t_s: float = 5.0, n_fish: int = 10, seed: int = 0, size=None,
                  camera: str = "side", width: int = 640, height: int = 480, follow_fish: int = 0) -> np.ndarray:
-    """One rendered frame of the swim at time ``t_s`` (s; the nearest control step): an
-    ``(height, width, 3)`` uint8 RGB image, top row first. Arguments as :func:`render_fish`; the
-    ``follow`` camera aims straight at its fish (no filter history)."""
-    _check_size(width, height, "image")
+    """One rendered frame: of a new swim with preset ``params`` at time ``t_s`` (s; the nearest control
+    step), or of a tank or playback you pass (its current state; ``t_s``, ``n_fish``, ``seed`` and
+    ``size`` unused). An ``(height, width, 3)`` uint8 RGB image, top row first. The ``follow`` camera
+    aims straight at its fish (no filter history)."""
+    check_size(width, height, "image")
     _check_camera(camera)
-    if isinstance(t_s, bool) or not isinstance(t_s, (int, float)) or not (math.isfinite(t_s) and t_s >= 0):
-        raise UserError(f"the snapshot time must be a number of seconds >= 0, got {t_s!r}.")
-    sw = _swimmer(params, n_fish, seed, size)
-    cam = _Camera(sw, camera, width, height, follow_fish)
-    _advance(sw, int(math.floor(t_s * params.control_hz + 0.5)))
-    cam.aim(sw.data)
-    renderer = _renderer(sw, width, height)
-    try:
-        renderer.update(sw.scene.model, sw.data, cam.cam)
+    if hasattr(params, "step"):
+        tank = params
+    else:
+        t_s = checks.number("the snapshot time", t_s, 0.0, unit="s")
+        tank = _tank(params, n_fish, seed, size)
+        advance_to(tank, int(math.floor(t_s * params.control_hz + 0.5)))
+    tank.sync()
+    cam = _Camera(tank, camera, width, height, follow_fish)
+    cam.aim(tank.data)
+    with _renderer(tank, width, height) as renderer:
+        renderer.update(tank.scene.model, tank.data, cam.cam)
         return renderer.draw()
-    finally:
-        renderer.close()
 
 
-def _gl_renderer_name() -> str:
-    """The OpenGL renderer's name (e.g. ``llvmpipe`` = software, or the GPU's) of the current context."""
-    with contextlib.suppress(Exception):
-        from OpenGL import GL
-
-        name = GL.glGetString(GL.GL_RENDERER)
-        if name:
-            return name.decode(errors="replace") if isinstance(name, bytes) else str(name)
-    return "unknown"
+def frame_png(out_path: str | Path, params: FishParams | Tank | Playback, **kw) -> Path:
+    """:func:`render_frame` written as a PNG, atomically; returns the path."""
+    return write_png(out_path, render_frame(params, **kw))
 
 
 def render_benchmark(n_frames: int = 120, width: int = 640, height: int = 480, n_fish: int = 10,
@@ -260,32 +259,28 @@ def render_benchmark(n_frames: int = 120, width: int = 640, height: int = 480, n
     """
     from lifelike_mj.fish.params import load_preset
 
-    _check_size(width, height, "benchmark")
+    check_size(width, height, "benchmark")
     _check_camera(camera)
-    for name, v in (("frame count", n_frames), ("repeats", repeats)):
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
-            raise UserError(f"{name} must be a whole number of at least 1, got {v!r}.")
+    checks.whole("frame count", n_frames, 1)
+    checks.whole("repeats", repeats, 1)
     params = load_preset("B-D")
-    sw = _swimmer(params, n_fish, seed, None)
-    _advance(sw, int(round(2.0 * params.control_hz)))
-    cam = _Camera(sw, camera, width, height)
-    cam.aim(sw.data)
-    m, d = sw.scene.model, sw.data
-    renderer = _renderer(sw, width, height)
+    tank = _tank(params, n_fish, seed, None)
+    advance_to(tank, int(round(2.0 * params.control_hz)))
+    cam = _Camera(tank, camera, width, height)
+    cam.aim(tank.data)
+    m, d = tank.scene.model, tank.data
     runs = []
-    try:
+    with _renderer(tank, width, height) as renderer:
         for _ in range(5):
             renderer.update(m, d, cam.cam)
             renderer.draw()
-        gl_name = _gl_renderer_name()
+        gl_name = gl_renderer_name()
         for _ in range(repeats):
             t0 = time.perf_counter()
             for _ in range(n_frames):
                 renderer.update(m, d, cam.cam)
                 renderer.draw()
             runs.append(n_frames / (time.perf_counter() - t0))
-    finally:
-        renderer.close()
     fps = statistics.median(runs)
     return {
         "fps": fps,
@@ -303,63 +298,48 @@ def render_benchmark(n_frames: int = 120, width: int = 640, height: int = 480, n
 
 
 def view_fish(params: FishParams, n_fish: int = 10, seed: int = 0, size=None, duration_s: float | None = None,
-              camera: str = "side", follow_fish: int = 0) -> None:
+              camera: str = "side", follow_fish: int = 0, tank: Tank | None = None) -> None:
     """Swim the fish in the MuJoCo viewer in about real time, until the window is closed or
     ``duration_s`` seconds of simulated swim have passed (``None``: until closed).
 
-    Control steps at ``params.control_hz`` (60 per second). ``camera``: ``side`` (a free camera
-    placed as the tank's side camera: the whole tank; drag to orbit, scroll to zoom) or ``follow``
-    (MuJoCo's tracking camera on fish ``follow_fish``, from the side at the distance of the
-    ``follow`` video camera). Raises :class:`UserError` when there is no display (use
-    :func:`render_fish` instead); on macOS run it under ``mjpython``.
+    A new tank, or the ``tank`` you give. ``camera``: ``side`` (a free camera placed as the tank's side
+    camera: the whole tank; drag to orbit, scroll to zoom) or ``follow`` (MuJoCo's tracking camera on
+    fish ``follow_fish``, from the side at the distance of the ``follow`` video camera). Raises
+    :class:`UserError` when there is no display (use :func:`render_fish` instead); on macOS run it
+    under ``mjpython``.
     """
     require_display("fish")
     if duration_s is not None:
-        duration_s = _positive("duration", duration_s)
+        duration_s = checks.positive("duration", duration_s, "s")
     if camera not in ("side", "follow"):
         raise UserError(f"unknown viewer camera {camera!r}; choose side or follow.")
+    if tank is None:
+        tank = _tank(params, n_fish, seed, size)
+    tank.step(1)  # compiles the swim loop (a few s, once per process) before the window opens
+    tank.sync()
+    m = tank.scene.model
+    follow = _Camera(tank, "follow", 640, 480, follow_fish) if camera == "follow" else None
+    end = None if duration_s is None else int(round(duration_s / tank.dt))
 
-    import mujoco
+    def setup(viewer) -> None:
+        import mujoco
 
-    sw = _swimmer(params, n_fish, seed, size)
-    m, d = sw.scene.model, sw.data
-    sw.run(1, record=False)  # compiles the swim loop (a few s, once per process) before the window opens
-    _refresh(m, d)
-    follow = _Camera(sw, "follow", 640, 480, follow_fish) if camera == "follow" else None
-    dt = params.control_dt_s
-    with launch_viewer(m, d) as viewer:
-        with viewer.lock():
-            side = m.camera("side")
-            L, D, H = sw.scene.size
-            if follow is None:
-                viewer.cam.type = mujoco.mjtCamera.mjCAMERA_FREE
-                viewer.cam.lookat[:] = (0.0, 0.0, H / 2)
-                viewer.cam.distance = float(np.linalg.norm(side.pos - np.array([0.0, 0.0, H / 2])))
-                viewer.cam.elevation = 0.0
-            else:
-                viewer.cam.type = mujoco.mjtCamera.mjCAMERA_TRACKING
-                viewer.cam.trackbodyid = int(sw.scene.body[follow_fish])
-                viewer.cam.distance = follow.cam.distance
-                viewer.cam.elevation = FOLLOW_ELEVATION_DEG
-            viewer.cam.azimuth = 90.0
-            viewer.opt.sitegroup[:] = 0
-        end_step = None if duration_s is None else int(round(duration_s / dt))
-        max_chunk = max(1, int(round(MAX_CATCH_UP_S / dt)))
-        start = time.perf_counter()
-        sim_at_start = sw.step
-        while viewer.is_running():
-            target = sim_at_start + int((time.perf_counter() - start) / dt)
-            if target - sw.step > max_chunk:  # fell behind: re-anchor the clock, run slower than real time
-                target = sw.step + max_chunk
-                sim_at_start, start = target, time.perf_counter()
-            if end_step is not None:
-                target = min(target, end_step)
-            with viewer.lock():
-                _advance(sw, max(target, sw.step))
-            viewer.sync()
-            if end_step is not None and sw.step >= end_step:
-                break
-            time.sleep(FRAME_S)
+        side = m.camera("side")
+        _L, _D, H = tank.scene.size
+        if follow is None:
+            viewer.cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+            viewer.cam.lookat[:] = (0.0, 0.0, H / 2)
+            viewer.cam.distance = float(np.linalg.norm(side.pos - np.array([0.0, 0.0, H / 2])))
+            viewer.cam.elevation = 0.0
+        else:
+            viewer.cam.type = mujoco.mjtCamera.mjCAMERA_TRACKING
+            viewer.cam.trackbodyid = int(tank.scene.body[follow_fish])
+            viewer.cam.distance = follow.cam.distance
+            viewer.cam.elevation = FOLLOW_ELEVATION_DEG
+        viewer.cam.azimuth = 90.0
+
+    view(tank, 1.0 / tank.dt, end, setup)
 
 
-__all__ = ["CAMERAS", "FOLLOW_VIEW_M", "frame_steps", "render_benchmark", "render_fish", "render_frame", "view_fish"]
+__all__ = ["CAMERAS", "FOLLOW_VIEW_M", "film_tank", "frame_png", "frame_steps", "playback", "render_benchmark",
+           "render_fish", "render_frame", "view_fish"]

@@ -42,7 +42,8 @@ import mujoco
 import numpy as np
 from numba import cfunc, njit, types
 
-from lifelike_mj.errors import UserError
+from lifelike_mj import checks
+from lifelike_mj.errors import Diverged, UserError
 from lifelike_mj.fish.params import ACCELERATE, BRAKE, CRUISE, MU_NAMES, FishParams
 from lifelike_mj.fish.scene import BODY_LENGTH_M, FishScene, box_areas, build_scene
 from lifelike_mj.physics import mjabi
@@ -385,26 +386,76 @@ class SwimResult:
         return out.any(axis=0)
 
 
-class Swimmer:
-    """A tank of fish with their state; :meth:`run` advances it. One per thread (mjData)."""
+#: Names of :meth:`Tank.state` and their units.
+STATE_UNITS = {
+    "position_m": "m: each fish's centre of mass (x along the tank, y across, z up from the floor)",
+    "quat": "unit quaternion (w, x, y, z) of each fish's body frame (x forward, y left, z up)",
+    "velocity_m_s": "m/s: each fish's velocity (world frame)",
+    "mu": "motion unit of each fish: 0 accelerate, 1 coast, 2 cruise, 3 brake (MU_NAMES)",
+    "avoiding": "whether each fish is avoiding a wall it saw",
+}
 
-    def __init__(self, params: FishParams, n_fish: int = 10, seed: int = 0, size=None,
+
+class Tank:
+    """A tank of fish (Satoi 2015), in the stepper shape every creature shares (:mod:`lifelike_mj.stepper`).
+
+    ``params``: a preset (:class:`~lifelike_mj.fish.params.FishParams`; default ``B-D``); ``n_fish``
+    fish in a tank of ``size`` (L, D, H) m (default the filmed 5 x 0.5 x 1 m); ``seed`` fixes the
+    start and every random draw. One step is one control step (``params.control_hz``, 60 per second:
+    look, choose the motion unit, push), then ``params.substeps`` MuJoCo steps. One tank per thread
+    (it owns its ``MjData``).
+    """
+
+    def __init__(self, params: FishParams | None = None, n_fish: int = 10, seed: int = 0, size=None,
                  scene: FishScene | None = None):
-        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-            raise UserError(f"seed must be a non-negative whole number, got {seed!r}.")
-        self.params = params
-        self.seed = int(seed)
+        from lifelike_mj.fish.params import load_preset
+
+        self.params = params if params is not None else load_preset("B-D")
+        self._seed = _check_seed(seed)
         self.scene = scene if scene is not None else build_scene(n_fish, size, nuserdata=U_FISH + FISH_BLOCK * n_fish)
-        sc = self.scene
-        m = sc.model
-        m.opt.timestep = params.timestep_s
-        n = sc.n
-        need = U_FISH + FISH_BLOCK * n
-        if m.nuserdata < need:
+        self.scene.model.opt.timestep = self.params.timestep_s
+        if self.scene.model.nuserdata < U_FISH + FISH_BLOCK * self.scene.n:
             raise RuntimeError("internal: the scene was compiled without room for the fish userdata")
+        self.vision_data = mujoco.MjData(self.scene.vision_model)
+        mujoco.mj_kinematics(self.scene.vision_model, self.vision_data)
+        self.reset()
+
+    @property
+    def seed(self) -> int:
+        return self._seed
+
+    @property
+    def dt(self) -> float:
+        """Seconds per step (one control step)."""
+        return self.params.control_dt_s
+
+    @property
+    def steps(self) -> int:
+        """Control steps taken since the start."""
+        return self._k
+
+    @property
+    def time(self) -> float:
+        """Simulated time, s."""
+        return self._k * self.params.control_dt_s
+
+    @property
+    def model(self) -> mujoco.MjModel:
+        return self.scene.model
+
+    @property
+    def n_fish(self) -> int:
+        return self.scene.n
+
+    def reset(self, seed: int | None = None) -> None:
+        """Back to the start: fish placed at random (from the seed) at rest, every fish coasting.
+        ``seed``: a new seed, or ``None`` for the tank's own."""
+        if seed is not None:
+            self._seed = _check_seed(seed)
+        params, sc = self.params, self.scene
+        m = sc.model
+        n = sc.n
         self.data = mujoco.MjData(m)
-        self.vision_data = mujoco.MjData(sc.vision_model)
-        mujoco.mj_kinematics(sc.vision_model, self.vision_data)
         mjabi.verify_offsets(self.data)
         ud = self.data.userdata
         sv, sw = box_areas(sc.mass_kg, sc.inertia)
@@ -423,12 +474,12 @@ class Swimmer:
             ud[b] = sc.qadr[i]
             ud[b + 1] = sc.dadr[i]
             ud[b + 2] = 1  # coast
-        ss = np.random.SeedSequence(self.seed)
+        ss = np.random.SeedSequence(self._seed)
         children = ss.spawn(n + 1)
         self.rngs = [np.random.Generator(np.random.PCG64(ch)) for ch in children[1:]]
         self._place(np.random.Generator(np.random.PCG64(children[0])))
-        self.state = np.zeros((n, N_STATE))
-        self.state[:, S_MU] = 1
+        self.state_array = np.zeros((n, N_STATE))
+        self.state_array[:, S_MU] = 1
         self.cum = np.cumsum(params.transition_matrix(False), axis=1)
         self.cum_avoid = np.cumsum(params.transition_matrix(True), axis=1)
         self.cum[:, -1] = self.cum_avoid[:, -1] = 1.0
@@ -444,7 +495,7 @@ class Swimmer:
         c[C_DT] = params.control_dt_s
         c[C_VMAX] = params.runaway_speed_bl_s * BODY_LENGTH_M
         self.c = c
-        self.step = 0  # control steps done
+        self._k = 0
         mujoco.mj_forward(m, self.data)
 
     def _place(self, rng: np.random.Generator) -> None:
@@ -466,9 +517,13 @@ class Swimmer:
             U[:, i, :] = g.random((k, 4))
         return U
 
+    def step(self, n: int = 1) -> None:
+        """Advance ``n`` control steps; a runaway speed raises :class:`~lifelike_mj.errors.Diverged`."""
+        self.run(checks.whole("the number of steps", n, 0), record=False)
+
     def run(self, n_control_steps: int, record: bool = True):
         """Advance ``n_control_steps`` control steps. Returns ``(pos, quat, mu)`` for them (empty
-        arrays when not recording). Raises :class:`UserError` on a runaway speed."""
+        arrays when not recording). Raises :class:`~lifelike_mj.errors.Diverged` on a runaway speed."""
         sc = self.scene
         n = sc.n
         k = int(n_control_steps)
@@ -480,14 +535,67 @@ class Swimmer:
         err = np.zeros(4)
         with passive_callback(COMPILED_PASSIVE):
             _run_chunk(sc.model._address, self.data._address, sc.vision_model._address, self.vision_data._address,
-                       self.data.qpos, self.data.qvel, self.data.userdata, self.state, self.cum, self.cum_avoid,
+                       self.data.qpos, self.data.qvel, self.data.userdata, self.state_array, self.cum, self.cum_avoid,
                        U, self.c, n, int(self.params.substeps), pos, quat, mu, record, err)
         if err[0] != 0:
-            t = (self.step + err[1] + 1) * self.params.control_dt_s
-            self.step += int(err[1]) + 1
-            raise UserError(self._runaway_message(int(err[0]), int(err[2]), err[3], t))
-        self.step += k
+            t = (self._k + err[1] + 1) * self.params.control_dt_s
+            self._k += int(err[1]) + 1
+            raise Diverged(self._runaway_message(int(err[0]), int(err[2]), err[3], t), self._k)
+        self._k += k
         return pos, quat, mu
+
+    def record(self, n_steps: int | None = None, *, duration_s: float | None = None, chunk_steps: int = 60,
+               progress: bool = False) -> SwimResult:
+        """Swim on ``n_steps`` control steps (or ``duration_s`` s) and return the tracks at every control
+        step, the current state first (:class:`SwimResult`). ``progress``: a tqdm bar."""
+        import time
+
+        if (n_steps is None) == (duration_s is None):
+            raise UserError("give either n_steps or duration_s.")
+        total = (checks.whole("the number of steps", n_steps, 1) if n_steps is not None
+                 else int(round(checks.positive("duration", duration_s, "s") * self.params.control_hz)))
+        t0 = time.perf_counter()
+        k0 = self._k
+        p0, q0 = self.snapshot()
+        m0 = (self.state_array[:, S_MU] + 4 * (self.state_array[:, S_AVOID_T] > 0.0)).astype(np.int8)
+        P, Q, M = [p0[None]], [q0[None]], [m0[None]]
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=total, unit="step", desc="swim", leave=False)
+        try:
+            done = 0
+            while done < total:
+                k = min(chunk_steps, total - done)
+                p, q, m = self.run(k)
+                P.append(p)
+                Q.append(q)
+                M.append(m)
+                done += k
+                if bar is not None:
+                    bar.update(k)
+        finally:
+            if bar is not None:
+                bar.close()
+        times = (k0 + np.arange(total + 1)) * self.params.control_dt_s
+        return SwimResult(self.params, self.seed, self.scene.size, times, np.concatenate(P), np.concatenate(Q),
+                          np.concatenate(M), time.perf_counter() - t0)
+
+    def state(self) -> dict[str, np.ndarray]:
+        """The current state as named arrays (:data:`STATE_UNITS`)."""
+        pos, quat = self.snapshot()
+        vel = np.array([self.data.qvel[a : a + 3] for a in self.scene.dadr])
+        return {"position_m": pos, "quat": quat, "velocity_m_s": vel,
+                "mu": self.state_array[:, S_MU].astype(np.int64), "avoiding": self.state_array[:, S_AVOID_T] > 0.0}
+
+    def sync(self) -> None:
+        """Bring the drawing quantities (body poses, cameras, lights) up to the current state; ``mj_step``
+        leaves them at the start of its last step. They are derived quantities that the next step
+        recomputes, so this does not change the swim."""
+        mujoco.mj_kinematics(self.scene.model, self.data)
+        mujoco.mj_comPos(self.scene.model, self.data)
+        mujoco.mj_camlight(self.scene.model, self.data)
 
     def _runaway_message(self, kind: int, fish: int, speed: float, t: float) -> str:
         p = self.params
@@ -499,47 +607,25 @@ class Swimmer:
                 f"(the chance to accelerate again is {prob:.2f} per step): lower {name}.")
 
     def snapshot(self) -> tuple[np.ndarray, np.ndarray]:
+        """Positions (m) and orientations (quaternions) of every fish now."""
         sc = self.scene
         pos = np.array([self.data.qpos[a : a + 3] for a in sc.qadr])
         quat = np.array([self.data.qpos[a + 3 : a + 7] for a in sc.qadr])
         return pos, quat
 
 
+def _check_seed(seed) -> int:
+    return checks.whole("seed", seed, 0)
+
+
 def swim(params: FishParams, n_fish: int = 10, duration_s: float = 30.0, seed: int = 0, size=None,
          progress: bool = False, chunk_s: float = 1.0) -> SwimResult:
-    """Simulate ``n_fish`` fish for ``duration_s`` seconds; the tracks at every control step."""
-    import time
-
-    if not (isinstance(duration_s, (int, float)) and math.isfinite(duration_s) and duration_s > 0):
-        raise UserError(f"duration must be a positive number of seconds, got {duration_s!r}.")
-    t0 = time.perf_counter()
-    sw = Swimmer(params, n_fish, seed, size)
-    total = int(round(duration_s * params.control_hz))
-    chunk = max(1, int(round(chunk_s * params.control_hz)))
-    p0, q0 = sw.snapshot()
-    P, Q, M = [p0[None]], [q0[None]], [np.full((1, sw.scene.n), 1, dtype=np.int8)]
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=total, unit="step", desc="swim", leave=False)
-    try:
-        done = 0
-        while done < total:
-            k = min(chunk, total - done)
-            p, q, m = sw.run(k)
-            P.append(p)
-            Q.append(q)
-            M.append(m)
-            done += k
-            if bar is not None:
-                bar.update(k)
-    finally:
-        if bar is not None:
-            bar.close()
-    times = np.arange(total + 1) * params.control_dt_s
-    return SwimResult(params, sw.seed, sw.scene.size, times, np.concatenate(P), np.concatenate(Q), np.concatenate(M),
-                      time.perf_counter() - t0)
+    """Simulate ``n_fish`` fish for ``duration_s`` seconds; the tracks at every control step
+    (:meth:`Tank.record` of a new :class:`Tank`)."""
+    checks.positive("duration", duration_s, "s")
+    tank = Tank(params, n_fish, seed, size)
+    return tank.record(duration_s=duration_s, chunk_steps=max(1, int(round(chunk_s * params.control_hz))),
+                       progress=progress)
 
 
-__all__ = ["MU_NAMES", "SwimResult", "Swimmer", "swim", "COMPILED_PASSIVE", "python_passive", "fish_forces"]
+__all__ = ["MU_NAMES", "STATE_UNITS", "SwimResult", "Tank", "swim", "COMPILED_PASSIVE", "python_passive", "fish_forces"]

@@ -511,7 +511,7 @@ _MODEL_CACHE: dict = {}
 
 
 def fitness_batch(cparams: np.ndarray, flap, params: ButterflyParams | None, condition: Condition, n_steps: int,
-                  dt_s: float, config: str = "paper", force_mode: str = "tip") -> np.ndarray:
+                  dt_s: float, config: str = "paper", force_mode: str = "tip", kind: int | None = None) -> np.ndarray:
     """Eq. 13 fitness of a batch of compiled ann controllers (rows of ``cparams``) flown on MuJoCo
     under one condition: one ``mjData`` per individual, stepped on parallel native threads with the
     compiled callback and the compiled controller (weights per simulation)."""
@@ -532,7 +532,8 @@ def fitness_batch(cparams: np.ndarray, flap, params: ButterflyParams | None, con
     diverged = np.full(n, -1, dtype=np.int64)
     fitness = np.zeros(n)
     with passive_callback(COMPILED_PASSIVE):
-        _fitness_batch(m._address, dptrs, np.full(n, KIND_ANN, dtype=np.int64), np.ascontiguousarray(cparams),
+        kinds = np.full(n, KIND_ANN if kind is None else kind, dtype=np.int64)
+        _fitness_batch(m._address, dptrs, kinds, np.ascontiguousarray(cparams),
                        flap.as_array(), layout(m).as_array(), float(dt_s), int(n_steps), diverged, fitness)
     del datas
     return fitness

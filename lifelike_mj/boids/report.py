@@ -39,7 +39,7 @@ def _runs(params_list, seeds, executor, workers):
 
 def reproduce_boids(out: str | Path, seeds=SEEDS, executor: str = "process", workers: int | None = None,
                     phase_steps: int = 7) -> dict:
-    from lifelike_mj.viz.boids_figures import homogeneous_grid_figure, patterns_grid_figure, phase_diagram_figure
+    from lifelike_mj.boids.figures import homogeneous_grid_figure, patterns_grid_figure, phase_diagram_figure
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

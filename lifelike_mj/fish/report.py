@@ -32,7 +32,7 @@ def _f(x: float, d: int = 2) -> str:
 def reproduce_fish(out: str | Path, seeds=PATTERN_SEEDS, pattern_s: float = PATTERN_S, swim_s: float = SWIM_S,
                    progress: bool = True) -> dict:
     """Run everything; returns the results dictionary (also written as ``results.json``)."""
-    from lifelike_mj.viz.fish_figures import accel_histogram_figure, patterns_figure, tank_snapshot, tracks_figure
+    from lifelike_mj.fish.figures import accel_histogram_figure, patterns_figure, tank_snapshot, tracks_figure
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -1,0 +1,129 @@
+"""The ``lifelike-mj`` command: one module per creature, and a registry for the shared verbs.
+
+``lifelike-mj CREATURE ...`` runs a creature's own commands (:mod:`lifelike_mj.cli.butterfly`,
+:mod:`~lifelike_mj.cli.fish`, :mod:`~lifelike_mj.cli.boids`); the shared verbs ``view``,
+``render``, ``reproduce`` and ``bench`` take the creature as their first word and then only that
+creature's options. Each creature module provides ``add_commands``, ``add_view_args``/``view``,
+``add_render_args``/``render``, ``add_reproduce_args``/``reproduce`` and ``add_bench_args``/``bench``;
+the commands call the creatures' library functions, so the command line and Python do the same thing.
+
+Every error a user can cause ends in one sentence on stderr and exit status 2; imports are lazy so
+that ``--help`` is instant and the GL backend can be chosen before MuJoCo is imported.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from pathlib import Path
+from types import ModuleType
+
+from lifelike_mj.cli.common import Parser, add_json, emit
+from lifelike_mj.errors import UserError
+
+#: The creatures, in the order of ``reproduce all``.
+CREATURES = ("butterfly", "fish", "boids")
+
+
+def creature(name: str) -> ModuleType:
+    """The command-line module of creature ``name``."""
+    return importlib.import_module(f"lifelike_mj.cli.{name}")
+
+
+def _verb(sub, name: str, helptext: str, add: str, extra=None) -> None:
+    p = sub.add_parser(name, help=helptext)
+    per = p.add_subparsers(dest="what", required=True, parser_class=Parser, metavar="CREATURE")
+    for c in CREATURES:
+        mod = creature(c)
+        q = per.add_parser(c, help=mod.HELP)
+        getattr(mod, add)(q)
+        if extra is not None:
+            extra(q)
+        q.set_defaults(func=globals()[f"cmd_{name}"])
+
+
+def _render_options(p) -> None:
+    p.add_argument("--out", required=True, help="FILE.mp4 or FILE.gif")
+    p.add_argument("--fps", type=int, default=30)
+    p.add_argument("--width", type=int, default=640)
+    p.add_argument("--height", type=int, default=480)
+    add_json(p)
+
+
+def _reproduce_options(p) -> None:
+    p.add_argument("--out", default=None, help="output folder (default reports/CREATURE; with all: OUT/CREATURE)")
+
+
+def _bench_options(p) -> None:
+    p.add_argument("--out", help="also write the JSON here")
+    add_json(p)
+
+
+def build_parser() -> Parser:
+    from lifelike_mj import __version__
+
+    top = Parser(prog="lifelike-mj", description="Creatures that move like living things, by physics on MuJoCo.")
+    top.add_argument("--version", action="version", version=f"lifelike-mj {__version__}")
+    sub = top.add_subparsers(dest="command", required=True, parser_class=Parser)
+    for c in CREATURES:
+        creature(c).add_commands(sub)
+    _verb(sub, "view", "open the MuJoCo viewer on a live simulation", "add_view_args")
+    _verb(sub, "render", "render a video offscreen", "add_render_args", _render_options)
+    _verb(sub, "bench", "speed benchmark", "add_bench_args", _bench_options)
+    p = sub.add_parser("reproduce", help="run a paper's experiments and write a report")
+    per = p.add_subparsers(dest="what", required=True, parser_class=Parser, metavar="CREATURE")
+    for c in (*CREATURES, "all"):
+        q = per.add_parser(c, help=creature(c).HELP if c != "all" else "all three, one after another")
+        if c == "all":
+            creature("butterfly").add_reproduce_args(q)
+        else:
+            creature(c).add_reproduce_args(q)
+        _reproduce_options(q)
+        q.set_defaults(func=cmd_reproduce)
+    return top
+
+
+def cmd_view(args) -> None:
+    creature(args.what).view(args)
+
+
+def cmd_render(args) -> None:
+    if Path(args.out).suffix.lower() not in (".mp4", ".gif"):
+        raise UserError(f"--out must end in .mp4 or .gif, got {args.out!r}.")
+    info = creature(args.what).render(args)
+    emit(args, info, f"wrote {info['frames']} frames to {args.out}")
+
+
+def cmd_bench(args) -> None:
+    r, human = creature(args.what).bench(args)
+    if args.out:
+        from lifelike_mj.io import write_json
+
+        write_json(args.out, r)
+    emit(args, r, human)
+
+
+def cmd_reproduce(args) -> None:
+    whats = CREATURES if args.what == "all" else (args.what,)
+    for what in whats:
+        out = Path(args.out or "reports") / what if (args.what == "all" or not args.out) else Path(args.out)
+        creature(what).reproduce(out, args)
+        print(f"report written to {out / 'report.md'}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] in (["render"], ["reproduce"]) or (argv[:1] == ["fish"] and any(a.startswith("--video") for a in argv)):
+        from lifelike_mj.render.gl import ensure_gl_backend
+
+        ensure_gl_backend()  # before anything imports mujoco
+    try:
+        args = build_parser().parse_args(argv)
+        args.func(args)
+    except UserError as exc:
+        print(f"lifelike-mj: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("lifelike-mj: interrupted.", file=sys.stderr)
+        return 130
+    return 0

@@ -1,0 +1,179 @@
+"""``lifelike-mj boids ...`` and the boids' part of ``view``, ``render``, ``reproduce``, ``bench``."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from lifelike_mj.cli.common import add_json, emit, seeds
+from lifelike_mj.errors import UserError
+
+NAME = "boids"
+HELP = "the heterogeneous boids of Nakamura 2013"
+
+
+def _add_boids(p) -> None:
+    p.add_argument("--preset", default=None, help="pattern preset 4a ... 5d (default 5a), or a JSON file")
+    p.add_argument("--wa", help="alignment matrix 'a,b;c,d' (rows: own type), with --wc instead of a preset")
+    p.add_argument("--wc", help="cohesion matrix 'a,b;c,d'")
+    p.add_argument("--n", type=int, default=300, help="number of agents")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--dims", type=int, default=3, help="3 or 2 (section 4.3)")
+
+
+def _params(args):
+    from lifelike_mj.boids.engine import parse_matrix
+    from lifelike_mj.boids.presets import load_preset
+
+    if args.dims not in (2, 3):
+        raise UserError(f"--dims must be 3 or 2, got {args.dims}.")
+    if (args.wa is None) != (args.wc is None):
+        raise UserError("give both --wa and --wc (or neither, and a --preset).")
+    if args.wa is not None:
+        from lifelike_mj.boids.engine import BoidParams
+
+        return BoidParams(wa=parse_matrix(args.wa, "--wa"), wc=parse_matrix(args.wc, "--wc"), dims=args.dims,
+                          name="custom")
+    return load_preset("5a" if args.preset in (None, "default") else args.preset, dims=args.dims)
+
+
+def _axis(spec: str) -> tuple[str, list[float]]:
+    import numpy as np
+
+    try:
+        name, rng = spec.split("=")
+        a, b, k = rng.split(":")
+        values = [float(x) for x in np.linspace(float(a), float(b), int(k))]
+    except ValueError:
+        raise UserError(f"a sweep axis looks like wa_cross=-0.3:0.5:9 (name=start:stop:count), got {spec!r}.") from None
+    if len(values) < 1:
+        raise UserError(f"a sweep axis needs at least one value, got {spec!r}.")
+    return name, values
+
+
+def cmd_run(args) -> None:
+    from lifelike_mj.boids.experiments import classified_run, write_trajectories
+
+    params = _params(args)
+    if args.n < 2:
+        raise UserError(f"--n must be at least 2, got {args.n}.")
+    if args.steps is not None and args.steps < 10:
+        raise UserError(f"--steps must be at least 10, got {args.steps}.")
+    run, m, label, reasons = classified_run(params, args.n, args.seed, args.steps, progress=not args.json)
+    out = {"label": label, "reasons": reasons, **m, "preset": params.name, "n": args.n, "seed": args.seed,
+           "steps": int(run.steps[-1]), "dims": params.dims, "wall_time_s": run.wall_time_s}
+    if args.plot:
+        from lifelike_mj.boids.figures import pattern_figure
+
+        pattern_figure(run, args.plot, title=f"{params.name}: classified {label}")
+    if args.out:
+        from lifelike_mj.io import write_json
+
+        files = write_trajectories(run, args.out)
+        write_json(Path(args.out) / "measures.json", out)
+        out["files"] = [str(f) for f in files.values()]
+    emit(args, out, f"{params.name}, n = {args.n}, seed {args.seed}, {out['steps']} steps: classified {label} "
+         f"(segregation index {m.get('segregation_index', float('nan')):.2f}, groups {m.get('n_groups')})")
+
+
+def cmd_sweep(args) -> None:
+    from lifelike_mj.boids.experiments import Sweep, run_sweep, write_sweep
+    from lifelike_mj.boids.presets import homogeneous, load_grid
+
+    seed_list = seeds(args.seeds)
+    if args.grid:
+        g = load_grid(args.grid)
+        sweep = Sweep(homogeneous(1.0, 0.0, dims=args.dims), ("wa", "wc"), args.n, args.steps)
+        values = [g["w_a"], g["w_c"]]
+    else:
+        if not args.x:
+            raise UserError("give --grid fig2_grid, or at least --x AXIS=START:STOP:COUNT.")
+        axes, values = [], []
+        for spec in [args.x] + ([args.y] if args.y else []):
+            name, rng = _axis(spec)
+            axes.append(name)
+            values.append(rng)
+        sweep = Sweep(_params(args), tuple(axes), args.n, args.steps)
+    res = run_sweep(sweep, values, seed_list, executor=args.executor, workers=args.workers,
+                    ray_address=args.ray_address)
+    if args.out:
+        write_sweep(res, sweep, values, args.out)
+    counts: dict[str, int] = {}
+    for v in res["majority"].values():
+        counts[v] = counts.get(v, 0) + 1
+    emit(args, res, f"{len(res['rows'])} runs over {len(res['majority'])} cells: "
+         + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
+
+
+def add_commands(sub) -> None:
+    from lifelike_mj.cli.common import Parser
+
+    boids = sub.add_parser(NAME, help=HELP).add_subparsers(dest="sub", required=True, parser_class=Parser)
+    p = boids.add_parser("run", help="one run: classified pattern and its measures")
+    _add_boids(p)
+    p.add_argument("--steps", type=int, default=None, help="steps (default: the classifier's run length)")
+    add_json(p)
+    p.add_argument("--plot", help="PNG of the last 5 steps in the paper's style")
+    p.add_argument("--out", help="folder for trajectories (npz, CSV) and measures")
+    p.set_defaults(func=cmd_run)
+    p = boids.add_parser("sweep", help="a grid of runs, classified: the phase diagram")
+    _add_boids(p)
+    p.add_argument("--grid", help="a homogeneous grid preset (fig2_grid: the paper's Fig. 2)")
+    p.add_argument("--x", help="axis NAME=START:STOP:COUNT: wa_cross, wc_cross, wa_IJ, wc_IJ, wa, wc")
+    p.add_argument("--y", help="second axis, same form")
+    p.add_argument("--seeds", default="0-2", help="seeds, e.g. 0-4 or 0,3,7")
+    p.add_argument("--steps", type=int, default=None)
+    p.add_argument("--executor", default="process", help="serial, process (default) or ray")
+    p.add_argument("--workers", type=int, default=None)
+    p.add_argument("--ray-address", default=None)
+    p.add_argument("--out", help="folder for sweep.json and phase_diagram.png")
+    add_json(p)
+    p.set_defaults(func=cmd_sweep)
+
+
+def add_view_args(p: argparse.ArgumentParser) -> None:
+    _add_boids(p)
+    p.add_argument("--camera", default="overview", help="overview (default) or top")
+
+
+def view(args) -> None:
+    from lifelike_mj.boids.render import view_boids
+
+    view_boids(_params(args), n=args.n, seed=args.seed, camera=args.camera)
+
+
+def add_render_args(p: argparse.ArgumentParser) -> None:
+    _add_boids(p)
+    p.add_argument("--steps", type=int, default=None, help="steps to render (default 3000)")
+    p.add_argument("--camera", default="overview", help="overview (default), top or side")
+
+
+def render(args) -> dict:
+    from lifelike_mj.boids.render import render_boids
+
+    return render_boids(args.out, _params(args), n=args.n, n_steps=args.steps or 3000, seed=args.seed, fps=args.fps,
+                        width=args.width, height=args.height, camera=args.camera)
+
+
+def add_reproduce_args(p: argparse.ArgumentParser) -> None:
+    pass
+
+
+def reproduce(out: Path, args) -> None:
+    from lifelike_mj.boids.report import reproduce_boids
+
+    reproduce_boids(out)
+
+
+def add_bench_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--max-n", type=int, default=1_000_000, help="largest n of the scaling run")
+    p.add_argument("--mesa-python", default=None, help="a Python interpreter that has Mesa (for the peer)")
+
+
+def bench(args) -> tuple[dict, str]:
+    from lifelike_mj.boids import bench as b
+
+    r = b.run(repeats=min(args.repeats, 3), max_n=args.max_n, mesa_python=args.mesa_python)
+    return r, (f"n = 300: {r['agent_steps_per_s_n300']:.3g} agent-steps/s; scaling exponent "
+               f"{r.get('scaling_exponent', float('nan')):.2f}; x{r.get('mesa_ratio', float('nan')):.0f} Mesa")

@@ -1,1 +1,0 @@
-"""Figures of the papers' experiments, side by side with the papers' numbers (matplotlib)."""
