@@ -14,14 +14,16 @@ def gl_backend():
     """The offscreen backend this machine offers; skip the rendering tests only if there is none."""
     import mujoco
 
-    from lifelike_mj.viz import video
+    from lifelike_mj.render import gl as video
 
     backend = video.ensure_gl_backend()
     if backend is None:
         pytest.skip("no offscreen OpenGL backend can be created here (tried MUJOCO_GL=egl and osmesa; install "
                     "libegl1 or libosmesa6)")
     try:
-        video._Offscreen(mujoco.MjModel.from_xml_string("<mujoco/>"), 16, 16, dress=False).close()
+        from lifelike_mj.render.offscreen import Offscreen
+
+        Offscreen(mujoco.MjModel.from_xml_string("<mujoco/>"), 16, 16).close()
     except UserError as exc:
         pytest.skip(f"no offscreen OpenGL context can be created here: {exc}")
     return backend
@@ -70,3 +72,13 @@ def gif_frames(path) -> list[np.ndarray]:
     """The frames of a GIF as float RGB arrays."""
     with Image.open(path) as im:
         return [np.asarray(f.convert("RGB"), dtype=float) for f in ImageSequence.Iterator(im)]
+
+
+def saved(fig, path):
+    """``path``, after checking that a figure function returned its matplotlib ``Figure`` and wrote it
+    there (figure functions return the figure and save only when given a path)."""
+    from matplotlib.figure import Figure
+
+    assert isinstance(fig, Figure), type(fig)
+    assert path.is_file(), path
+    return path

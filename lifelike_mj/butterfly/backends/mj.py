@@ -480,27 +480,29 @@ def steppers_with(law) -> tuple[Callable, Callable]:
 def fly_one(m: mujoco.MjModel, controller: ButterflyController, params: ButterflyParams | None = None,
             condition: Condition | None = None, duration_s: float = 20.0, record_every: int = 1,
             force_mode: str = "tip", n_strips: int = 16, callback: str = "compiled") -> Trajectory:
-    """Fly one butterfly on model ``m`` (its timestep is the step). ``callback``: compiled|python."""
+    """Fly one butterfly on model ``m`` (its timestep is the step). ``callback``: ``compiled`` (a
+    :class:`~lifelike_mj.butterfly.sim.Flight` on this model) or ``python`` (the Python reference)."""
     cond = condition or Condition()
     dt = float(m.opt.timestep)
+    check_timing(duration_s, dt, record_every)
+    if callback == "compiled":
+        from lifelike_mj.butterfly.sim import Flight
+
+        config = "rich" if layout(m).rich else "paper"
+        flight = Flight(controller, params, cond, backend="mujoco", config=config, force_mode=force_mode, dt_s=dt,
+                        n_strips=n_strips, _model=m)
+        return flight.record(duration_s=duration_s, every=record_every)
+    if callback != "python":
+        raise UserError(f"unknown callback kind {callback!r}; choose compiled or python.")
     n_steps = check_timing(duration_s, dt, record_every)
     d = setup_data(m, controller, params, cond, force_mode, n_strips)
     lay = layout(m)
-    kind, cp = controller.compiled()
     n_rec = n_steps // record_every + 1
     out = np.empty((n_rec, 6))
     out[0] = (d.qpos[lay.q_height], d.qpos[lay.q_forward], 0.0, 0.0, 0.0, d.qpos[lay.q_flap_left])
     diverged = np.full(1, -1, dtype=np.int64)
     fit = np.zeros(1)
-    if callback == "compiled":
-        with passive_callback(COMPILED_PASSIVE):
-            record_steps(m._address, d._address, d.qpos, d.qvel, d.userdata, 0, n_steps, record_every, kind,
-                         np.ascontiguousarray(cp, dtype=float), controller.flap.as_array(), 0.0, lay.as_array(), dt,
-                         0.0, out, 1, diverged, fit)
-    elif callback == "python":
-        _run_python(m, d, n_steps, record_every, controller, cond, lay, dt, out, diverged, fit)
-    else:
-        raise UserError(f"unknown callback kind {callback!r}; choose compiled or python.")
+    _run_python(m, d, n_steps, record_every, controller, cond, lay, dt, out, diverged, fit)
     t = np.arange(n_rec) * (record_every * dt)
     return Trajectory(t=t, y=out[:, 0], z=out[:, 1], vy=out[:, 2], vz=out[:, 3], phi=out[:, 4], theta=out[:, 5],
                       y0=cond.y0_m, flap_period_s=1.0 / controller.flap.frequency_hz, backend="mujoco",

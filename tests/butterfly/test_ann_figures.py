@@ -7,8 +7,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import saved
 from PIL import Image
 
+from lifelike_mj.butterfly import ann_figures as af
 from lifelike_mj.butterfly.ann_experiments import (
     PAPER_WINDS,
     GlideResult,
@@ -19,7 +21,6 @@ from lifelike_mj.butterfly.ann_experiments import (
     flight_numbers,
 )
 from lifelike_mj.butterfly.flight import Trajectory
-from lifelike_mj.butterfly import ann_figures as af
 
 DT = 0.01  # s
 DURATION = 4.0  # s
@@ -81,17 +82,18 @@ def _windmap(inputs: str = "relative") -> WindMap:
 
 
 def test_fig7_fitness(tmp_path):
-    out = af.fig7_fitness(_history(), tmp_path / "fig7.png", label="synthetic")
-    assert out == tmp_path / "fig7.png"
-    _check_png(out)
+    fig = af.fig7_fitness(_history(), tmp_path / "fig7.png", label="synthetic")
+    _check_png(saved(fig, tmp_path / "fig7.png"))
+    assert af.fig7_fitness(_history()).axes  # without a path: the figure alone, nothing written
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fig7.png"]
     with pytest.raises(ValueError):
         af.fig7_fitness([], tmp_path / "empty.png")
 
 
 def test_fig8_and_fig9(tmp_path):
     level = _level()
-    _check_png(af.fig8_flight(level, tmp_path / "fig8.png"))
-    _check_png(af.fig9_phi(level, tmp_path / "sub" / "fig9.png"))  # creates the folder
+    _check_png(saved(af.fig8_flight(level, tmp_path / "fig8.png"), tmp_path / "fig8.png"))
+    _check_png(saved(af.fig9_phi(level, tmp_path / "sub" / "fig9.png"), tmp_path / "sub" / "fig9.png"))  # creates the folder
     bare = LevelResult({}, None, [], [], [], float("nan"))
     with pytest.raises(ValueError):
         af.fig8_flight(bare, tmp_path / "none.png")
@@ -99,10 +101,10 @@ def test_fig8_and_fig9(tmp_path):
 
 def test_fig11_and_fig13(tmp_path):
     above = StartsResult({"+10 m": flight_numbers(_traj(10.0))}, {"+10 m": _traj(10.0)})
-    _check_png(af.fig11_from_above(above, tmp_path / "fig11.png"))
+    _check_png(saved(af.fig11_from_above(above, tmp_path / "fig11.png"), tmp_path / "fig11.png"))
     trs = {"-10 m": _traj(-10.0, -100.0, speed=0.02), "-2 m": _traj(-2.0), "-1 m": _traj(-1.0, -1.2)}
     below = StartsResult({k: flight_numbers(t) for k, t in trs.items()}, trs)
-    _check_png(af.fig13_from_below(below, tmp_path / "fig13.png"))
+    _check_png(saved(af.fig13_from_below(below, tmp_path / "fig13.png"), tmp_path / "fig13.png"))
 
 
 def test_fig12_sink(tmp_path):
@@ -112,7 +114,7 @@ def test_fig12_sink(tmp_path):
     glide = Trajectory(t, 10.0 + np.cumsum(vy) * DT, 1.5 * t, vy, np.full_like(t, 1.5), 0 * t, np.full_like(t, np.radians(75)),
                        y0=10.0)
     g = GlideResult(float(-flap.vy.min()), 4.7, 4.7 / float(-flap.vy.min()), flap, glide)
-    _check_png(af.fig12_sink(g, tmp_path / "fig12.png"))
+    _check_png(saved(af.fig12_sink(g, tmp_path / "fig12.png"), tmp_path / "fig12.png"))
 
 
 def test_fig14_15_winds(tmp_path):
@@ -121,26 +123,29 @@ def test_fig14_15_winds(tmp_path):
         trajs[kind] = {w: _traj(0.0, offset * (i - 1.5), speed=3.0 - a) for i, (w, (a, _)) in enumerate(PAPER_WINDS.items())}
         trajs[kind]["behind (-2,0)"] = _traj(0.0, -50.0)  # a crash leaving the plot
         flights[kind] = {w: flight_numbers(t, 1.0) for w, t in trajs[kind].items()}
-    _check_png(af.fig14_15_winds(WindsResult(flights, trajs), tmp_path / "fig14_15.png"), min_width=900)
+    out = tmp_path / "fig14_15.png"
+    _check_png(saved(af.fig14_15_winds(WindsResult(flights, trajs), out), out), min_width=900)
 
 
 def test_fig_windmap(tmp_path):
     m = _windmap()
-    _check_png(af.fig_windmap(m, tmp_path / "map1.png"))
-    _check_png(af.fig_windmap([m, _windmap("ground")], tmp_path / "map2.png", titles=["paper", "robust"]), min_width=900)
+    _check_png(saved(af.fig_windmap(m, tmp_path / "map1.png"), tmp_path / "map1.png"))
+    out = tmp_path / "map2.png"
+    _check_png(saved(af.fig_windmap([m, _windmap("ground")], out, titles=["paper", "robust"]), out), min_width=900)
     with pytest.raises(ValueError):
         af.fig_windmap([m], tmp_path / "bad.png", titles=["a", "b"])
 
 
 def test_fig_compare_starts(tmp_path):
     trajs = {"ann_paper": _traj(-10.0, -60.0, speed=0.1), "ann_robust": _traj(-10.0, 0.0)}
-    _check_png(af.fig_compare_starts(trajs, tmp_path / "cmp.png", "cf. Oe 2010 Fig. 13 — from -10 m"))
+    out = tmp_path / "cmp.png"
+    _check_png(saved(af.fig_compare_starts(trajs, out, "cf. Oe 2010 Fig. 13 — from -10 m"), out))
 
 
 def test_fig_optimizer_convergence(tmp_path):
     runs = {"rcga": [_history(30, 40, s) for s in range(3)], "cmaes": [_history(60, 16, s) for s in range(2)]}
-    _check_png(af.fig_optimizer_convergence(runs, tmp_path / "conv.png"))
-    _check_png(af.fig_optimizer_convergence(runs, tmp_path / "conv_lin.png", log_x=False))
+    _check_png(saved(af.fig_optimizer_convergence(runs, tmp_path / "conv.png"), tmp_path / "conv.png"))
+    _check_png(saved(af.fig_optimizer_convergence(runs, tmp_path / "conv_lin.png", log_x=False), tmp_path / "conv_lin.png"))
     with pytest.raises(ValueError):
         af.fig_optimizer_convergence({"rcga": []}, tmp_path / "none.png")
 

@@ -8,9 +8,12 @@ from conftest import gif_frames
 from PIL import Image
 
 from lifelike_mj.butterfly import controllers
+from lifelike_mj.butterfly import render as video
 from lifelike_mj.butterfly.backends import mj as mjbackend
+from lifelike_mj.butterfly.sim import Flight
 from lifelike_mj.errors import UserError
-from lifelike_mj.viz import video, viewer
+from lifelike_mj.render import viewer
+from lifelike_mj.render.video import advance_to
 
 
 @pytest.fixture(scope="module")
@@ -43,16 +46,16 @@ def test_render_rejects_bad_requests(tmp_path, rule):
 
 
 def test_chunked_stepping_equals_fly_one(rule):
-    """The resumable loop used between frames reproduces the compiled ``_run`` bit for bit."""
+    """The flight stepped between frames (uneven chunks, drawing refreshes) is the recorded one, bit for bit."""
     for config, mode in (("paper", "tip"), ("rich", "strip")):
         m = mjbackend.build_model(None, config)
         m.opt.timestep = 1.0 / 1200.0
         ref = mjbackend.fly_one(m, rule, duration_s=0.5, force_mode=mode)
-        flight = video._Flight(rule, config=config, force_mode=mode)
+        flight = Flight(rule, backend="mujoco", config=config, force_mode=mode)
         for k in (1, 37, 40, 41, 400, 600):  # uneven chunks, drawing-refresh between them
-            flight.advance_to(k)
-        lay = mjbackend.layout(flight.m)
-        q, v = flight.d.qpos, flight.d.qvel
+            advance_to(flight, k)
+        lay = mjbackend.layout(flight.model)
+        q, v = flight.data.qpos, flight.data.qvel
         got = (q[lay.q_height], q[lay.q_forward], v[lay.d_height], v[lay.d_forward], q[lay.q_flap_left])
         want = (ref.y[-1], ref.z[-1], ref.vy[-1], ref.vz[-1], ref.theta[-1])
         assert got == want, config
@@ -73,7 +76,7 @@ def test_viewer_without_display_raises_user_error(monkeypatch, rule):
     monkeypatch.setattr(viewer.sys, "platform", "linux")
     assert viewer.has_display() is False
     with pytest.raises(UserError, match="no display"):
-        viewer.view_butterfly(rule, duration_s=0.1)
+        video.view_butterfly(rule, duration_s=0.1)
 
 
 def test_has_display_reads_environment(monkeypatch):

@@ -5,14 +5,16 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 import pytest
-from conftest import gif_frames
+from conftest import gif_frames, saved
 from PIL import Image
 
+from lifelike_mj.boids import figures as boids_figures
+from lifelike_mj.boids import render as boids_video
 from lifelike_mj.boids import scene
 from lifelike_mj.boids.engine import BoidParams, BoidRun, simulate
 from lifelike_mj.boids.presets import PATTERNS, homogeneous, load_preset
 from lifelike_mj.errors import UserError
-from lifelike_mj.viz import boids_figures, boids_video
+from lifelike_mj.render.video import advance_to
 
 
 def _x_axes(model, data, layout) -> np.ndarray:
@@ -120,11 +122,11 @@ def test_top_frame_of_a_2d_run(gl_backend):
 
 def test_streamed_run_is_the_simulated_run():
     params = load_preset("4c")
-    run = boids_video._Run(params, 30, 2)
-    run.advance(3)
-    run.advance(7)
+    run = boids_video._flock(params, 30, 2)
+    advance_to(run, 3)
+    advance_to(run, 7)
     ref = simulate(params, n=30, n_steps=7, seed=2, record_from=7)
-    np.testing.assert_array_equal(run.x, ref.positions[-1])
+    np.testing.assert_array_equal(run.state()["position"], ref.positions[-1])
     np.testing.assert_array_equal(run.types, ref.types)
     np.testing.assert_allclose(run.data.xpos[run.layout.body], ref.positions[-1], atol=1e-12)
 
@@ -207,18 +209,19 @@ def test_trails_are_the_last_five_steps_projected():
 
 def test_pattern_figures_write_pngs(tmp_path):
     runs = {p: _fake_run(load_preset(p), seed=i) for i, p in enumerate(PATTERNS)}
-    a = _png(boids_figures.pattern_figure(runs["4c"], tmp_path / "one.png"))
+    a = _png(saved(boids_figures.pattern_figure(runs["4c"], tmp_path / "one.png"), tmp_path / "one.png"))
     assert _colour_pixels(a)[0] > 20 and _colour_pixels(a)[1] > 20  # A red, B yellow-green trails
-    _png(boids_figures.patterns_grid_figure(runs, tmp_path / "grid.png"))
-    _png(boids_figures.pattern_figure(_fake_run(BoidParams(dims=2)), tmp_path / "flat.png", title="2D"))
+    _png(saved(boids_figures.patterns_grid_figure(runs, tmp_path / "grid.png"), tmp_path / "grid.png"))
+    flat = tmp_path / "flat.png"
+    _png(saved(boids_figures.pattern_figure(_fake_run(BoidParams(dims=2)), flat, title="2D"), flat))
     hom = {(a, c): _fake_run(homogeneous(a, c), seed=k) for k, (a, c) in
            enumerate((a, c) for a in (1.0, 0.1, 0.01, 0.001) for c in (0.1, 0.01, 0.001, 0.0))}
     hom[(1.0, 0.1)] = None  # diverged
-    img = _png(boids_figures.homogeneous_grid_figure(hom, tmp_path / "fig2.png"))
+    img = _png(saved(boids_figures.homogeneous_grid_figure(hom, tmp_path / "fig2.png"), tmp_path / "fig2.png"))
     assert _colour_pixels(img)[1] == 0  # one type: no yellow-green
     labels = np.array([["4a", "5a", "diverged"], ["5a", None, "unclassified"]], dtype=object)
-    _png(boids_figures.phase_diagram_figure(labels, [0.1, 0.01, 0.0], [0.5, -0.2], "w_c AB", "w_a AB",
-                                            tmp_path / "phase.png"), min_side=150)
+    _png(saved(boids_figures.phase_diagram_figure(labels, [0.1, 0.01, 0.0], [0.5, -0.2], "w_c AB", "w_a AB",
+                                            tmp_path / "phase.png"), tmp_path / "phase.png"), min_side=150)
     with pytest.raises(UserError, match="grid"):
         boids_figures.phase_diagram_figure(labels, [0.1, 0.01], [0.5, -0.2], "x", "y", tmp_path / "bad.png")
     with pytest.raises(UserError, match=r"\.png"):
@@ -232,7 +235,7 @@ def test_pattern_figures_write_pngs(tmp_path):
 
 
 def test_view_boids_without_display_raises_user_error(monkeypatch):
-    from lifelike_mj.viz import viewer
+    from lifelike_mj.render import viewer
 
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
@@ -245,7 +248,7 @@ def test_view_boids_loop_with_a_stand_in_viewer(monkeypatch, stand_in_viewer):
     """The viewer loop (camera set-up, stepping by the clock, stop after ``duration_steps``) on a fake window."""
     import mujoco.viewer
 
-    from lifelike_mj.viz import viewer
+    from lifelike_mj.render import viewer
 
     monkeypatch.setattr(viewer, "has_display", lambda: True)
     boids_video.view_boids(load_preset("4a"), n=20, seed=0, steps_per_s=2000.0, duration_steps=20, warmup_steps=10)

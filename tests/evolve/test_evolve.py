@@ -27,7 +27,7 @@ from lifelike_mj.evolve import rcga as ga
 from lifelike_mj.evolve.checkpoint import FORMAT, VERSION
 
 ROOT = Path(__file__).resolve().parents[1]
-WORKER = Path(__file__).with_name("evolve_worker.py")
+WORKER = Path(__file__).parent.parent / "evolve_worker.py"
 
 #: Small settings per optimiser (Sphere/Rastrigin in 3-4 dimensions): population, generations.
 SMALL = {"rcga": (12, 12), "cmaes": (8, 12), "crs2": (10, 12), "esch": (10, 12), "isres": (12, 12)}

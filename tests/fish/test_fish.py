@@ -65,7 +65,7 @@ def test_tank_scales_with_the_filmed_tank_and_names_fish():
 
 
 def test_compiled_callback_equals_python_reference():
-    sw = sim.Swimmer(BD, 4, seed=3)
+    sw = sim.Tank(BD, 4, seed=3)
     m, d = sw.scene.model, sw.data
     rng = np.random.default_rng(0)
     d.qvel[:] = rng.normal(scale=0.3, size=m.nv)
@@ -123,7 +123,7 @@ def test_mu_log_follows_the_chain():
 def test_balance_restores_pitch():
     """The third term of theta (eq. 2-9) must reduce |pitch|: start nose-up 30 deg, no random pitch."""
     p = replace(BD, theta_range_deg=0.0, phi_range_deg=0.0, P_b=1.0, vision_distance_m=1e-3)
-    sw = sim.Swimmer(p, 1, seed=0, size=tank_size(3.0))
+    sw = sim.Tank(p, 1, seed=0, size=tank_size(3.0))
     a = sw.scene.qadr[0]
     pitch = math.radians(30.0)
     sw.data.qpos[a + 3: a + 7] = [math.cos(pitch / 2), 0.0, -math.sin(pitch / 2), 0.0]  # nose up
@@ -137,7 +137,7 @@ def test_balance_restores_pitch():
     sw.run(180, record=False)
     assert abs(nose_up_deg()) < 10.0
     p0 = replace(p, balance_A_deg=0.0, buoyancy_offset_m=0.0)
-    sw0 = sim.Swimmer(p0, 1, seed=0, size=tank_size(3.0))
+    sw0 = sim.Tank(p0, 1, seed=0, size=tank_size(3.0))
     sw0.data.qpos[a + 3: a + 7] = sw.data.qpos[a + 3: a + 7] * 0 + [math.cos(pitch / 2), 0.0, -math.sin(pitch / 2), 0.0]
     sw0.run(180, record=False)
     w, x, y, z = sw0.data.qpos[a + 3: a + 7]
@@ -160,7 +160,7 @@ def test_vision_sees_an_obstacle_added_to_the_scene():
             spec.worldbody.add_geom(name="rock", type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.05, 0.2, 0.5],
                                     pos=[0.2, 0.0, 0.5], contype=0, conaffinity=1)
         scene = build_scene(1, tank_size(1.0), spec=spec, nuserdata=sim.U_FISH + sim.FISH_BLOCK)
-        sw = sim.Swimmer(replace(BD, theta_range_deg=0.0, phi_range_deg=0.0), 1, seed=0, scene=scene)
+        sw = sim.Tank(replace(BD, theta_range_deg=0.0, phi_range_deg=0.0), 1, seed=0, scene=scene)
         a = scene.qadr[0]
         sw.data.qpos[a: a + 7] = [0.0, 0.0, 0.5, 1.0, 0.0, 0.0, 0.0]  # heading +x towards the rock
         sw.data.qvel[:] = 0.0

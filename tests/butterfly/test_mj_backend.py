@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from lifelike_mj.butterfly import controllers
-from lifelike_mj.butterfly.backends import mj as mjbackend, paper
+from lifelike_mj.butterfly.backends import mj as mjbackend
+from lifelike_mj.butterfly.backends import paper
 from lifelike_mj.butterfly.compare import compare
 from lifelike_mj.butterfly.flight import Condition
 from lifelike_mj.physics import mjabi

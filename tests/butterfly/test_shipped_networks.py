@@ -7,7 +7,8 @@ import pytest
 
 from lifelike_mj.butterfly import ann_experiments as ax
 from lifelike_mj.butterfly import controllers
-from lifelike_mj.butterfly.backends import mj as mjbackend, paper
+from lifelike_mj.butterfly.backends import mj as mjbackend
+from lifelike_mj.butterfly.backends import paper
 from lifelike_mj.butterfly.evolution import make_problem
 from lifelike_mj.butterfly.flight import Condition
 

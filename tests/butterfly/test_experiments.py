@@ -1,5 +1,5 @@
 """Experiments E4-E5 of Oe 2010 section 5 (lifelike_mj/butterfly/experiments.py), their figures and
-the report (lifelike_mj/viz/figures.py, lifelike_mj/butterfly/report.py)."""
+the report (lifelike_mj/butterfly/figures.py, lifelike_mj/butterfly/report.py)."""
 
 from __future__ import annotations
 
@@ -8,11 +8,11 @@ import math
 
 import numpy as np
 import pytest
+from conftest import saved
 
-from lifelike_mj.butterfly import controllers, experiments, report
+from lifelike_mj.butterfly import controllers, experiments, figures, report
 from lifelike_mj.butterfly.backends import paper
 from lifelike_mj.errors import UserError
-from lifelike_mj.butterfly import figures
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -132,10 +132,10 @@ def _is_png(path) -> bool:
 
 def test_figures_write_pngs(tmp_path, trim, timestep):
     out = [
-        figures.fig3_forces(experiments.e2_fig3(), tmp_path / "f3.png"),
-        figures.fig_speed_limit(experiments.e3_speed_limit_vs_area(), tmp_path / "sl.png"),
-        figures.fig4_trim(trim, tmp_path / "sub" / "f4.png"),
-        figures.fig5_timestep(timestep, tmp_path / "f5.png"),
+        saved(figures.fig3_forces(experiments.e2_fig3(), tmp_path / "f3.png"), tmp_path / "f3.png"),
+        saved(figures.fig_speed_limit(experiments.e3_speed_limit_vs_area(), tmp_path / "sl.png"), tmp_path / "sl.png"),
+        saved(figures.fig4_trim(trim, tmp_path / "sub" / "f4.png"), tmp_path / "sub" / "f4.png"),
+        saved(figures.fig5_timestep(timestep, tmp_path / "f5.png"), tmp_path / "f5.png"),
     ]
     for path in out:
         assert path.exists() and _is_png(path), path
@@ -143,7 +143,7 @@ def test_figures_write_pngs(tmp_path, trim, timestep):
 
 
 def test_reproduce_writes_report_json_and_figures(tmp_path):
-    res = report.reproduce(tmp_path, extra_sections=[("Notes", "An extra *section*.")], progress=False)
+    res = report.report_e1_e5(tmp_path, extra_sections=[("Notes", "An extra *section*.")], progress=False)
     names = {p.name for p in tmp_path.iterdir()}
     assert names == {"fig3_forces.png", "fig_speed_limit.png", "fig4_trim.png", "fig5_timestep.png", "results.json",
                      "report.md"}

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from lifelike_mj.butterfly import ann, controllers
-from lifelike_mj.butterfly.backends import mj as mjbackend, paper
+from lifelike_mj.butterfly.backends import mj as mjbackend
+from lifelike_mj.butterfly.backends import paper
 from lifelike_mj.butterfly.evolution import PitchProblem, make_problem
 from lifelike_mj.butterfly.flight import Condition
 from lifelike_mj.cli import main
@@ -144,7 +145,7 @@ def test_checkpoint_of_another_problem_is_refused(tmp_path, capsys, monkeypatch)
             "serial", "--quiet", "--checkpoint", str(ck), "--out", str(tmp_path / "a.json")]
     from lifelike_mj.butterfly import evolution
 
-    def small(task, backend, inputs, params):
+    def small(task, backend, inputs, params, hidden=None):
         return evolution.PitchProblem(duration_s=0.2, inputs="relative" if task == "paper" else "ground")
 
     monkeypatch.setattr(evolution, "make_problem", small)

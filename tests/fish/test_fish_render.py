@@ -4,13 +4,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import gif_frames
+from conftest import gif_frames, saved
 from PIL import Image
 
 from lifelike_mj.errors import UserError
+from lifelike_mj.fish import figures as fish_figures
+from lifelike_mj.fish import render as fish_video
 from lifelike_mj.fish.params import load_preset
 from lifelike_mj.fish.sim import swim
-from lifelike_mj.viz import fish_figures, fish_video, viewer
+from lifelike_mj.render import viewer
+from lifelike_mj.render.video import advance_to
 
 
 @pytest.fixture(scope="module")
@@ -114,8 +117,8 @@ def _png(path):
 def test_tracks_and_histogram_figures(tmp_path, short_swim):
     tracks = fish_figures.tracks_figure(short_swim, tmp_path / "tracks.png", fish=1)
     hist = fish_figures.accel_histogram_figure(short_swim, tmp_path / "hist.png")
-    _png(tracks)
-    _png(hist)
+    _png(saved(tracks, tmp_path / "tracks.png"))
+    _png(saved(hist, tmp_path / "hist.png"))
     with pytest.raises(UserError, match="fish"):
         fish_figures.tracks_figure(short_swim, tmp_path / "bad.png", fish=3)
     with pytest.raises(UserError, match=r"\.png"):
@@ -136,7 +139,7 @@ def test_patterns_figure(tmp_path):
              "turn_entropy": rng.uniform(0, 3), "other": "ignored"}
             for p in ("B-D", "NB-ND", "B-ND", "NB-D") for s in range(3)]
     rows[0]["turn_entropy"] = float("nan")
-    _png(fish_figures.patterns_figure(rows, tmp_path / "patterns.png"))
+    _png(saved(fish_figures.patterns_figure(rows, tmp_path / "patterns.png"), tmp_path / "patterns.png"))
     with pytest.raises(UserError, match="turn_entropy"):
         fish_figures.patterns_figure([{"preset": "B-D", "burstiness": 0.1, "accel_kurtosis": 1.0}], tmp_path / "x.png")
     with pytest.raises(UserError, match="at least one row"):
@@ -170,8 +173,8 @@ def test_view_fish_loop_with_a_stand_in_viewer(monkeypatch, params, stand_in_vie
 def test_chunked_stepping_is_the_swim(params):
     """Advancing by frames (control steps 0, 3, 5, 8) reaches the state ``swim`` records."""
     ref = swim(params, n_fish=3, duration_s=8 / 60, seed=4)
-    sw = fish_video._swimmer(params, 3, 4, None)
+    sw = fish_video._tank(params, 3, 4, None)
     for k in fish_video.frame_steps(4, 24.0, 60.0):
-        fish_video._advance(sw, int(k))
+        advance_to(sw, int(k))
     pos, _quat = sw.snapshot()
     np.testing.assert_array_equal(pos, ref.positions[8])
