@@ -84,7 +84,7 @@ def playback(run: BoidRun) -> Playback:
         update(m, d, layout, run.positions[k], run.velocities[k])
 
     def state(k: int) -> dict:
-        return {"position": run.positions[k], "velocity": run.velocities[k], "type": run.types}
+        return {"position_box": run.positions[k], "velocity_box_per_step": run.velocities[k], "type": run.types}
 
     dt = float(run.steps[1] - run.steps[0]) if len(run.steps) > 1 else 1.0
     pb = Playback(m, d, len(run.steps), pose, dt, state)

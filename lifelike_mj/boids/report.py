@@ -142,3 +142,7 @@ def reproduce_boids(out: str | Path, seeds=SEEDS, executor: str = "process", wor
     write_text(out / "report.md", "\n".join(L))
     write_json(out / "results.json", results)
     return results
+
+
+#: ``lifelike-mj reproduce boids`` from Python (the package's common name).
+reproduce = reproduce_boids

@@ -29,8 +29,8 @@ from lifelike_mj.errors import Diverged, UserError
 
 #: Names of :meth:`Flock.state` and their units.
 STATE_UNITS = {
-    "position": "box units: each agent's position in the box [0, L]^D",
-    "velocity": "box units per step: each agent's velocity",
+    "position_box": "box units: each agent's position in the box [0, L]^D",
+    "velocity_box_per_step": "box units per step: each agent's velocity",
     "type": "each agent's type (0 = A, 1 = B, ...)",
 }
 
@@ -93,7 +93,8 @@ class Flock:
     def state(self) -> dict[str, np.ndarray]:
         """Positions, velocities (n, D) and types (n,) (:data:`STATE_UNITS`), as copies."""
         D = self.params.dims
-        return {"position": self._x[:, :D].copy(), "velocity": self._v[:, :D].copy(), "type": self.types.copy()}
+        return {"position_box": self._x[:, :D].copy(), "velocity_box_per_step": self._v[:, :D].copy(),
+                "type": self.types.copy()}
 
     def record(self, n_steps: int, every: int = 1, record_from: int = 0, extra_steps=(),
                progress: bool = False) -> BoidRun:

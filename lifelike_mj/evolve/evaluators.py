@@ -10,8 +10,11 @@ from __future__ import annotations
 import concurrent.futures
 import multiprocessing
 import os
+import pickle
 import signal
+import sys
 import time
+import warnings
 from typing import Any
 
 import numpy as np
@@ -157,6 +160,10 @@ class ProcessEvaluator(Evaluator):
         futures = [self._pool.submit(_process_chunk, c) for c in self._chunks(X)]
         try:
             return np.concatenate([fut.result() for fut in futures])
+        except concurrent.futures.process.BrokenProcessPool:
+            self._abandoned = True
+            raise RuntimeError("a worker process of the evaluation pool died (killed, out of memory, or the problem "
+                               "could not be rebuilt there); evaluate with executor='serial' to see the cause.") from None
         except BaseException:
             for fut in futures:
                 fut.cancel()
@@ -237,14 +244,33 @@ class RayEvaluator(Evaluator):
                 self._ray.shutdown()
 
 
+def pool_problem_error(problem: Any) -> str | None:
+    """Why ``problem`` cannot be sent to the workers of a process pool, or ``None`` if it can: it must
+    pickle, and its class must be importable in a fresh process (a class defined in a notebook or an
+    interactive session is not)."""
+    try:
+        pickle.dumps(problem)
+    except Exception as exc:  # noqa: BLE001 - any pickling failure is the answer
+        return f"the problem cannot be pickled ({exc.__class__.__name__}: {str(exc)[:120]})"
+    module = type(problem).__module__
+    if module == "__main__":
+        main = sys.modules.get("__main__")
+        if getattr(main, "__file__", None) is None:
+            return (f"the problem's class {type(problem).__qualname__} is defined in an interactive session or a "
+                    "notebook, where the workers cannot import it (define it in a module)")
+    return None
+
+
 def make_evaluator(problem: Any, executor: str = "process", workers: int | None = None,
                    ray_address: str | None = None) -> Evaluator:
     """An evaluator of ``problem`` on ``executor``: ``"serial"``, ``"process"`` (default) or ``"ray"``.
 
     ``workers``: number of processes (``process``: default ``os.cpu_count()``) or of chunks per batch
     (``ray``: default the cluster's CPUs); ignored by ``serial``. ``ray_address``: cluster to join when ray
-    is not initialised yet (``None``: start a local one). Raises :class:`UserError` for an unknown
-    executor, ``workers < 1``, or ray missing.
+    is not initialised yet (``None``: start a local one). A problem that a process pool cannot take
+    (:func:`pool_problem_error`: not picklable, or its class defined in a notebook) is evaluated
+    serially instead, with a ``RuntimeWarning`` naming the cause. Raises :class:`UserError` for an
+    unknown executor, ``workers < 1``, or ray missing.
     """
     if executor not in EXECUTORS:
         raise UserError(f"unknown executor {executor!r}; known executors are {', '.join(EXECUTORS)}.")
@@ -253,5 +279,9 @@ def make_evaluator(problem: Any, executor: str = "process", workers: int | None 
     if executor == "serial":
         return SerialEvaluator(problem, 1)
     if executor == "process":
+        why = pool_problem_error(problem)
+        if why is not None:
+            warnings.warn(f"evaluating serially in this process: {why}.", RuntimeWarning, stacklevel=2)
+            return SerialEvaluator(problem, 1)
         return ProcessEvaluator(problem, int(workers) if workers is not None else (os.cpu_count() or 1))
     return RayEvaluator(problem, None if workers is None else int(workers), ray_address)

@@ -114,7 +114,8 @@ class _SigtermAsInterrupt:
 def optimize(problem: Any, optimizer: str, *, seed: int, population: int | None = None, generations: int | None = None,
              evaluations: int | None = None, evaluator: Evaluator | Callable[[np.ndarray], np.ndarray] | None = None,
              checkpoint: str | Path | None = None, resume: bool = False, progress: bool = True,
-             on_generation: Callable[[dict[str, Any]], object] | None = None) -> OptimizationResult:
+             on_generation: Callable[[dict[str, Any]], object] | None = None, executor: str = "serial",
+             workers: int | None = None) -> OptimizationResult:
     """Optimise ``problem`` (see :class:`~lifelike_mj.evolve.problem.Problem`) with ``optimizer``.
 
     Args:
@@ -125,7 +126,9 @@ def optimize(problem: Any, optimizer: str, *, seed: int, population: int | None 
             :func:`minimum_population`.
         generations, evaluations: the budget; at most one (both ``None``: ``DEFAULT_GENERATIONS``).
         evaluator: from :func:`~lifelike_mj.evolve.evaluators.make_evaluator` (left open), or ``None``
-            for an in-process serial one.
+            for one made here on ``executor`` (``serial``, the default; ``process`` with ``workers``, where
+            a problem the pool cannot take runs serially with a warning naming the cause; ``ray``) and
+            closed at the end.
         checkpoint: file to write after every generation; ``resume=True`` continues from it.
         progress: show a tqdm progress bar on stderr.
         on_generation: called with each generation's record (a copy) after its checkpoint is written;
@@ -168,7 +171,7 @@ def optimize(problem: Any, optimizer: str, *, seed: int, population: int | None 
     with _SigtermAsInterrupt():
         try:
             if own_evaluator:
-                run.evaluator = make_evaluator(problem, "serial")
+                run.evaluator = make_evaluator(problem, executor, workers=workers)
             run.open_progress()
             if name == "rcga":
                 rcga.run_rcga(run)

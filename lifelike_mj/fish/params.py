@@ -14,7 +14,8 @@ Parameters (section numbers of the paper):
 * Markov chain of the motion units (MU) S1 accelerate, S2 coast, S3 cruise, S4 brake (3.3): five
   non-negative weights ``P_a`` (S1 -> S1), ``P_b`` (S2, S3, S4 -> S1), ``P_c`` (-> S2),
   ``P_d`` (-> S3), ``P_e`` (-> S4); each row of the 4 x 4 matrix is normalised
-  (:meth:`FishParams.transition_matrix`), redrawn every control step (``control_hz``).
+  (:meth:`FishParams.transition_matrix`), redrawn every control step (``control_hz``). A preset may
+  give its own 4 x 4 weights instead (``"transition": [[...], ...]``, rows from S1..S4).
 * Accelerate (3.4.1, eq. 2-9): force magnitude ``r ~ U(r_min_N, r_max_N)`` (N); direction angles
   ``theta = 90 + U(-theta_range_deg, theta_range_deg) + balance_A_deg sgn(p) / (1 + exp(-balance_k_per_deg |p|))``
   and ``phi = 90 + U(-phi_range_deg, phi_range_deg)`` (deg), ``p`` the fish's pitch (deg, nose up
@@ -93,12 +94,24 @@ class FishParams:
     runaway_speed_bl_s: float = 4.5
     control_hz: float = 60.0
     substeps: int = 4
+    #: A Markov matrix of your own (4 x 4 non-negative weights, rows normalised; row i: from MU i)
+    #: instead of the one P_a..P_e make; ``None``: the paper's structure.
+    transition: tuple | None = None
     name: str = field(default="", compare=False)
     description: str = field(default="", compare=False)
 
     def __post_init__(self) -> None:
+        if self.transition is not None:
+            try:
+                t = np.array(self.transition, dtype=float)
+            except (TypeError, ValueError):
+                raise UserError("transition must be a 4 x 4 matrix of numbers.") from None
+            if t.shape != (4, 4) or not np.all(np.isfinite(t)) or np.any(t < 0) or np.any(t.sum(axis=1) <= 0):
+                raise UserError("transition must be a 4 x 4 matrix of non-negative weights, each row with a "
+                                f"positive sum (rows: from accelerate, coast, cruise, brake), got {self.transition!r}.")
+            object.__setattr__(self, "transition", tuple(tuple(float(x) for x in row) for row in t))
         for f in fields(self):
-            if f.name in ("name", "description"):
+            if f.name in ("name", "description", "transition"):
                 continue
             v = getattr(self, f.name)
             vals = v if isinstance(v, tuple) else (v,)
@@ -141,8 +154,14 @@ class FishParams:
 
     # ---- the Markov chain (section 3.3) ----
     def transition_matrix(self, avoiding: bool = False) -> np.ndarray:
-        """The 4 x 4 row-stochastic matrix ``T[i, j] = P(next MU j | MU i)`` (spec section 1)."""
+        """The 4 x 4 row-stochastic matrix ``T[i, j] = P(next MU j | MU i)`` (Satoi 2015 section 3.3):
+        from ``P_a``..``P_e``, or the preset's own ``transition`` weights. While avoiding a wall
+        (section 3.7) the weights to accelerate (column 0) are multiplied by ``avoid_accel_gain``."""
         g = self.avoid_accel_gain if avoiding else 1.0
+        if self.transition is not None:
+            rows = np.array(self.transition, dtype=float)
+            rows[:, 0] *= g
+            return rows / rows.sum(axis=1, keepdims=True)
         pa, pb = g * self.P_a, g * self.P_b
         rows = np.array([[pa, self.P_c, self.P_d, self.P_e]] + [[pb, self.P_c, self.P_d, self.P_e]] * 3, dtype=float)
         return rows / rows.sum(axis=1, keepdims=True)
@@ -166,9 +185,11 @@ class FishParams:
         d = asdict(self)
         d.pop("name")
         d.pop("description")
+        if d["transition"] is None:
+            d.pop("transition")
         for k, v in d.items():
             if isinstance(v, tuple):
-                d[k] = list(v)
+                d[k] = [list(r) if isinstance(r, tuple) else r for r in v]
         return d
 
     def to_file_dict(self) -> dict:
@@ -209,3 +230,10 @@ def load_preset(name_or_path: str | Path | None = None, _seen: tuple[str, ...] =
         return FishParams(**{k: getattr(base, k) for k in _FIELDS}, name=str(data.get("name", p.stem)),
                           description=str(data.get("description", base.description)))
     return params_from_dict(data, p.stem)
+
+
+def preset_names() -> list[str]:
+    """Names of the presets shipped in ``controllers/fish/``."""
+    from lifelike_mj.paths import shipped_names
+
+    return shipped_names("fish")

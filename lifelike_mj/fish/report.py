@@ -87,3 +87,7 @@ def reproduce_fish(out: str | Path, seeds=PATTERN_SEEDS, pattern_s: float = PATT
     results = {"swim": summ, "accel_histogram": hist, "drag_check": drag, "patterns": table.to_dict()}
     write_json(out / "results.json", results)
     return results
+
+
+#: ``lifelike-mj reproduce fish`` from Python (the package's common name).
+reproduce = reproduce_fish

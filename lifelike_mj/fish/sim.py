@@ -243,8 +243,12 @@ def _look(vm, vd, pos, R, head, dist_m, ang, away, scratch, gid):
 
 
 @njit(cache=False)
-def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n):
-    """One control step for all fish: look, choose the MU, set the push (module docstring)."""
+def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n, forced_mu, forced_push):
+    """One control step for all fish: look, choose the MU, set the push (module docstring). A fish
+    whose ``forced_mu`` is >= 0 takes that MU instead of the chain's draw; an accelerating fish whose
+    ``forced_push`` row is finite pushes with that ``(r (N), theta (deg), phi (deg))`` instead of the
+    drawn one (the avoidance scaling and turn still apply). The random numbers are used the same way
+    either way, so forcing one fish does not change the draws of the others."""
     R = np.empty(9)
     away = np.empty(3)
     scratch = np.empty(9)
@@ -285,6 +289,8 @@ def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n):
             if u[i, 0] < tab[mu, j]:
                 nxt = j
                 break
+        if forced_mu[i] >= 0:
+            nxt = forced_mu[i]
         state[i, S_MU] = nxt
         ud[base + 2] = nxt
         ud[base + 3] = 0.0
@@ -299,6 +305,10 @@ def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n):
         sg = 1.0 if pitch > 0 else (-1.0 if pitch < 0 else 0.0)
         theta = 90.0 + c[C_THR] * (2.0 * u[i, 2] - 1.0) + c[C_BA] * sg / (1.0 + math.exp(-c[C_BK] * abs(pitch)))
         phi = 90.0 + c[C_PHR] * (2.0 * u[i, 3] - 1.0)
+        if math.isfinite(forced_push[i, 0]):
+            r = scale * forced_push[i, 0]
+            theta = forced_push[i, 1]
+            phi = forced_push[i, 2]
         if avoiding:
             # turn until the heading no longer points into the wall (parallel to it is enough:
             # facing straight away from one wall of a long tank means facing the opposite one)
@@ -322,13 +332,13 @@ def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n):
 
 @njit(cache=False)
 def _run_chunk(mptr, dptr, vm, vd, qpos, qvel, ud, state, cum, cum_avoid, U, c, n, substeps, out_pos, out_quat,
-               out_mu, record, err):
+               out_mu, record, err, forced_mu, forced_push):
     """Control steps ``U.shape[0]`` (each: :func:`_control`, then ``substeps`` ``mj_step``), recording
     positions, orientations and MUs after each when ``record``. On a runaway (the running mean speed
     above ``C_VMAX``) or NaN writes ``err = (kind, step, fish, speed)`` (kind 1 runaway, 2 not
     finite) and returns."""
     for k in range(U.shape[0]):
-        _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, U[k], c, n)
+        _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, U[k], c, n, forced_mu, forced_push)
         for _ in range(substeps):
             _mj_step(mptr, dptr)
         for i in range(n):
@@ -404,10 +414,22 @@ class Tank:
     start and every random draw. One step is one control step (``params.control_hz``, 60 per second:
     look, choose the motion unit, push), then ``params.substeps`` MuJoCo steps. One tank per thread
     (it owns its ``MjData``).
+
+    Behaviours of your own, called once per control step with the tank (read ``tank.state()``,
+    ``tank.time``):
+
+    * ``mu_policy(tank)``: ``n_fish`` motion units (0 accelerate, 1 coast, 2 cruise, 3 brake), or -1
+      for a fish left to the Markov chain (Satoi 2015 section 3.3);
+    * ``push_policy(tank)``: an ``(n_fish, 3)`` array of pushes ``(r (N), theta (deg), phi (deg))``
+      (eq. 2-9's magnitude and angles) for the fish that accelerate this step, NaN rows for the drawn
+      push.
+
+    Each draws the same random numbers as without it, so the other fish swim as they would have.
+    With a policy the control steps run one by one from Python (tens of microseconds each).
     """
 
     def __init__(self, params: FishParams | None = None, n_fish: int = 10, seed: int = 0, size=None,
-                 scene: FishScene | None = None):
+                 scene: FishScene | None = None, mu_policy=None, push_policy=None):
         from lifelike_mj.fish.params import load_preset
 
         self.params = params if params is not None else load_preset("B-D")
@@ -418,6 +440,10 @@ class Tank:
             raise RuntimeError("internal: the scene was compiled without room for the fish userdata")
         self.vision_data = mujoco.MjData(self.scene.vision_model)
         mujoco.mj_kinematics(self.scene.vision_model, self.vision_data)
+        for name, fn in (("mu_policy", mu_policy), ("push_policy", push_policy)):
+            if fn is not None and not callable(fn):
+                raise UserError(f"{name} must be a function of the tank, got {fn!r}.")
+        self.mu_policy, self.push_policy = mu_policy, push_policy
         self.reset()
 
     @property
@@ -524,9 +550,34 @@ class Tank:
     def run(self, n_control_steps: int, record: bool = True):
         """Advance ``n_control_steps`` control steps. Returns ``(pos, quat, mu)`` for them (empty
         arrays when not recording). Raises :class:`~lifelike_mj.errors.Diverged` on a runaway speed."""
+        k = int(n_control_steps)
+        if self.mu_policy is None and self.push_policy is None:
+            n = self.scene.n
+            return self._run(k, record, np.full(n, -1, dtype=np.int64), np.full((n, 3), np.nan))
+        parts = [self._run(1, record, *self._forced()) for _ in range(k)]
+        return tuple(np.concatenate([p[j] for p in parts]) for j in range(3))
+
+    def _forced(self) -> tuple[np.ndarray, np.ndarray]:
+        """The policies' choices for the next control step, checked."""
+        n = self.scene.n
+        mu = np.full(n, -1, dtype=np.int64)
+        push = np.full((n, 3), np.nan)
+        if self.mu_policy is not None:
+            got = np.asarray(self.mu_policy(self), dtype=float).reshape(-1)
+            if got.shape != (n,) or not np.all(np.isin(got, (-1, 0, 1, 2, 3))):
+                raise UserError(f"mu_policy must return {n} motion units, each 0, 1, 2, 3 or -1 (the chain's choice).")
+            mu = got.astype(np.int64)
+        if self.push_policy is not None:
+            got = np.asarray(self.push_policy(self), dtype=float)
+            if got.shape != (n, 3) or np.any(np.isinf(got)) or np.any(got[:, 0] < 0):
+                raise UserError(f"push_policy must return an ({n}, 3) array of (r >= 0 N, theta deg, phi deg), "
+                                "NaN rows for the drawn push.")
+            push = got
+        return mu, push
+
+    def _run(self, k: int, record: bool, forced_mu: np.ndarray, forced_push: np.ndarray):
         sc = self.scene
         n = sc.n
-        k = int(n_control_steps)
         U = self._randoms(k)
         shape = (k if record else 0, n)
         pos = np.zeros((*shape, 3))
@@ -536,7 +587,7 @@ class Tank:
         with passive_callback(COMPILED_PASSIVE):
             _run_chunk(sc.model._address, self.data._address, sc.vision_model._address, self.vision_data._address,
                        self.data.qpos, self.data.qvel, self.data.userdata, self.state_array, self.cum, self.cum_avoid,
-                       U, self.c, n, int(self.params.substeps), pos, quat, mu, record, err)
+                       U, self.c, n, int(self.params.substeps), pos, quat, mu, record, err, forced_mu, forced_push)
         if err[0] != 0:
             t = (self._k + err[1] + 1) * self.params.control_dt_s
             self._k += int(err[1]) + 1
@@ -601,6 +652,9 @@ class Tank:
         p = self.params
         T = p.transition_matrix(False)
         name, val, prob = ("P_a", p.P_a, T[0, 0]) if T[0, 0] >= T[1, 0] else ("P_b", p.P_b, T[1, 0])
+        if p.transition is not None:
+            return (f"the speed ran away: fish {fish} at t = {t:.2f} s; the preset's transition weights to "
+                    f"accelerate are too high (from accelerate: {T[0, 0]:.2f}, from coast: {T[1, 0]:.2f} per step).")
         what = "became NaN" if kind == 2 else (f"kept up {speed:.2f} m/s ({speed / BODY_LENGTH_M:.1f} body lengths/s over "
                                                 f"{RUNAWAY_TAU_S:g} s, above runaway_speed_bl_s = {p.runaway_speed_bl_s:g})")
         return (f"the speed ran away: fish {fish} {what} at t = {t:.2f} s; {name} = {val:g} is too high "

@@ -126,7 +126,7 @@ def test_streamed_run_is_the_simulated_run():
     advance_to(run, 3)
     advance_to(run, 7)
     ref = simulate(params, n=30, n_steps=7, seed=2, record_from=7)
-    np.testing.assert_array_equal(run.state()["position"], ref.positions[-1])
+    np.testing.assert_array_equal(run.state()["position_box"], ref.positions[-1])
     np.testing.assert_array_equal(run.types, ref.types)
     np.testing.assert_allclose(run.data.xpos[run.layout.body], ref.positions[-1], atol=1e-12)
 
