@@ -458,3 +458,20 @@ def test_progress_bar_goes_to_stderr(capsys):
     captured = capsys.readouterr()
     assert captured.out == ""
     assert "3/3" in captured.err and "best=" in captured.err
+
+
+def test_a_problem_the_pool_cannot_take_runs_serially_with_a_warning():
+    from lifelike_mj.evolve import Sphere, make_evaluator
+    from lifelike_mj.evolve.evaluators import SerialEvaluator, pool_problem_error
+
+    class Local(Sphere):  # defined in a function: not picklable
+        pass
+
+    problem = Local(dim=2)
+    assert "pickled" in pool_problem_error(problem)
+    assert pool_problem_error(Sphere(dim=2)) is None
+    with pytest.warns(RuntimeWarning, match="serially"):
+        ev = make_evaluator(problem, "process", workers=2)
+    with ev:
+        assert isinstance(ev, SerialEvaluator)
+        assert ev(np.zeros((3, 2))).shape == (3,)
