@@ -26,15 +26,17 @@ from lifelike_mj.butterfly.backends import mj as mjbackend
 from lifelike_mj.butterfly.backends import paper
 from lifelike_mj.butterfly.flight import Condition
 from lifelike_mj.machine import machine_info
+from lifelike_mj.physics import mjabi
 from lifelike_mj.physics.callbacks import passive_callback
 
-_mj_step = mjbackend._mj_step
+_mj_step = mjabi.mj_step
+_vp = mjabi.voidptr_from_int
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _bare_loop(mptr, dptr, n):
     for _ in range(n):
-        _mj_step(mptr, dptr)
+        _mj_step(_vp(mptr), _vp(dptr))
 
 
 def _time_mujoco(m, ctrl, mode: str | None, n: int) -> float:

@@ -64,11 +64,11 @@ U_FISH = 18  # per fish: qadr, dadr, mu, F_forward (N), torque_y, torque_z (N m,
 FISH_BLOCK = 6
 MAGIC = 7.25e5
 
-_OFF = mjabi.data_offsets()
-_OFF_QPOS, _OFF_QVEL, _OFF_QFRC, _OFF_UD = _OFF["qpos"], _OFF["qvel"], _OFF["qfrc_passive"], _OFF["userdata"]
-_LIB = mjabi.libmujoco()
-_mj_step = _LIB.mj_step
-_mj_ray = _LIB.mj_ray
+#: Offsets of the mjData fields the passive kernel reads (its argument; see physics/mjabi.py).
+_OFFSETS = mjabi.offsets_tuple()
+_O_QPOS, _O_QVEL, _O_QFRC, _O_UD = mjabi.O_QPOS, mjabi.O_QVEL, mjabi.O_QFRC, mjabi.O_UD
+_mj_step = mjabi.mj_step
+_mj_ray = mjabi.mj_ray
 _vp = mjabi.voidptr_from_int
 _addr = mjabi.int_from_voidptr
 
@@ -132,26 +132,27 @@ def fish_forces(ud, qpos, qvel, qfrc):
         qfrc[da + 5] += R[2] * tx + R[5] * ty + ud[base + 5]
 
 
-@njit(cache=False)
-def _passive_kernel(m, d):
+@njit(cache=True)
+def _passive_kernel(m, d, off):
     base = _addr(d)
-    ud = _f64(_ptr_at(base + _OFF_UD), U_FISH)
+    ud = _f64(_ptr_at(base + off[_O_UD]), U_FISH)
     if ud[U_MAGIC] != MAGIC:
         return
     n = int(ud[U_N])
-    ud = _f64(_ptr_at(base + _OFF_UD), U_FISH + FISH_BLOCK * n)
+    ud = _f64(_ptr_at(base + off[_O_UD]), U_FISH + FISH_BLOCK * n)
     last = U_FISH + FISH_BLOCK * (n - 1)
     nq = int(ud[last]) + 7
     nv = int(ud[last + 1]) + 6
-    qpos = _f64(_ptr_at(base + _OFF_QPOS), nq)
-    qvel = _f64(_ptr_at(base + _OFF_QVEL), nv)
-    qfrc = _f64(_ptr_at(base + _OFF_QFRC), nv)
+    qpos = _f64(_ptr_at(base + off[_O_QPOS]), nq)
+    qvel = _f64(_ptr_at(base + off[_O_QVEL]), nv)
+    qfrc = _f64(_ptr_at(base + off[_O_QFRC]), nv)
     fish_forces(ud, qpos, qvel, qfrc)
 
 
 @cfunc(types.void(types.voidptr, types.voidptr), cache=False)
 def _passive_cfunc(m, d):
-    _passive_kernel(m, d)
+    # compiled in each process (it holds this process's offsets); the kernel it calls is cached
+    _passive_kernel(m, d, _OFFSETS)
 
 
 #: The compiled passive callback (a ctypes function pointer MuJoCo accepts).
@@ -204,7 +205,7 @@ APPROACH_MIN = 0.2
 TURN_FLIP = 0.3
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _look(vm, vd, pos, R, head, dist_m, ang, away, scratch, gid):
     """Five rays (ahead, left, right, up, down at ``ang`` rad) from the snout; returns True when
     one hits, within ``dist_m``, a surface that the fish is heading into (at more than
@@ -231,7 +232,7 @@ def _look(vm, vd, pos, R, head, dist_m, ang, away, scratch, gid):
             bx, bz = c, -s
         for a in range(3):
             vec[a] = R[3 * a] * bx + R[3 * a + 1] * by + R[3 * a + 2] * bz
-        dist = _mj_ray(vm, vd, _vp(pnt.ctypes.data), _vp(vec.ctypes.data), _vp(0), 1, -1,
+        dist = _mj_ray(_vp(vm), _vp(vd), _vp(pnt.ctypes.data), _vp(vec.ctypes.data), _vp(0), np.uint8(1), np.int32(-1),
                        _vp(gid.ctypes.data), _vp(nrm.ctypes.data))
         approach = -(R[0] * nrm[0] + R[3] * nrm[1] + R[6] * nrm[2])  # heading . (-normal)
         if dist >= 0.0 and dist <= dist_m and approach > APPROACH_MIN:
@@ -242,7 +243,7 @@ def _look(vm, vd, pos, R, head, dist_m, ang, away, scratch, gid):
     return seen
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n, forced_mu, forced_push):
     """One control step for all fish: look, choose the MU, set the push (module docstring). A fish
     whose ``forced_mu`` is >= 0 takes that MU instead of the chain's draw; an accelerating fish whose
@@ -330,7 +331,7 @@ def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n, forced_mu, 
         ud[base + 5] = c[C_IZ] * lateral / mr2  # about the up axis: positive = turn left
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _run_chunk(mptr, dptr, vm, vd, qpos, qvel, ud, state, cum, cum_avoid, U, c, n, substeps, out_pos, out_quat,
                out_mu, record, err, forced_mu, forced_push):
     """Control steps ``U.shape[0]`` (each: :func:`_control`, then ``substeps`` ``mj_step``), recording
@@ -340,7 +341,7 @@ def _run_chunk(mptr, dptr, vm, vd, qpos, qvel, ud, state, cum, cum_avoid, U, c, 
     for k in range(U.shape[0]):
         _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, U[k], c, n, forced_mu, forced_push)
         for _ in range(substeps):
-            _mj_step(mptr, dptr)
+            _mj_step(_vp(mptr), _vp(dptr))
         for i in range(n):
             qa = int(ud[U_FISH + FISH_BLOCK * i])
             da = int(ud[U_FISH + FISH_BLOCK * i + 1])

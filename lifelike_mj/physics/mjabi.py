@@ -9,8 +9,16 @@ follows ``time``, ``energy[2]``, ``buffer`` and ``arena`` in declaration order. 
 addresses of the arrays that the Python bindings expose; a mismatch (a MuJoCo version whose
 layout we do not understand) raises instead of corrupting memory.
 
-The same module gives ctypes handles on ``libmujoco`` (the very library the bindings loaded), so
-compiled code can call ``mj_step``, ``mj_applyFT`` and ``mj_objectVelocity`` without Python.
+The same module declares MuJoCo's functions to numba (:data:`mj_step`, :data:`mj_applyFT`,
+:data:`mj_objectVelocity`, :data:`mj_ray`) as external functions resolved by name in ``libmujoco``
+(the very library the bindings loaded), so compiled code calls them without Python.
+
+**Caching.** A compiled function is cached on disk (numba ``cache=True``) only if it holds nothing
+that belongs to one process: the functions above are linked by name, not by address, and the
+offsets are passed as an argument (:func:`offsets_tuple`), never baked in, so cached code stays right
+when the MuJoCo version (and the layout of ``mjData``) changes. The one function that cannot take
+them as an argument, the ``cfunc`` MuJoCo calls with ``(m, d)``, is a two-line trampoline compiled in
+each process that passes the offsets to a cached kernel.
 """
 
 from __future__ import annotations
@@ -23,6 +31,7 @@ import re
 
 import mujoco
 import numpy as np
+from llvmlite import binding as llvm
 from llvmlite import ir
 from numba import carray, njit, types
 from numba.core import cgutils
@@ -54,13 +63,13 @@ def int_from_voidptr(typingctx, pointer):
     return sig, codegen
 
 
-@njit(cache=False, inline="always")
+@njit(cache=True, inline="always")
 def ptr_at(address):
     """Compiled: the pointer (as uint64) stored at ``address`` (e.g. an ``mjData`` field)."""
     return carray(voidptr_from_int(address), (1,), np.uint64)[0]
 
 
-@njit(cache=False, inline="always")
+@njit(cache=True, inline="always")
 def f64_at(address, n):
     """Compiled: a float64 array view of ``n`` values at ``address``."""
     return carray(voidptr_from_int(address), (n,), np.float64)
@@ -156,3 +165,32 @@ def verify_offsets(d: mujoco.MjData, fields=USED_FIELDS) -> None:
     d.time = t
     if not ok:
         raise RuntimeError("mjData layout check failed for field 'time'")
+
+
+#: Positions of the fields in :func:`offsets_tuple`.
+O_TIME, O_QPOS, O_QVEL, O_QFRC, O_UD, O_XPOS, O_XMAT, O_XIPOS = range(8)
+
+
+@functools.lru_cache(maxsize=1)
+def offsets_tuple() -> tuple[int, ...]:
+    """Byte offsets in ``mjData`` of ``time, qpos, qvel, qfrc_passive, userdata, xpos, xmat, xipos``
+    (index with :data:`O_TIME` ...): the argument compiled kernels read ``mjData`` with."""
+    o = data_offsets()
+    return tuple(int(o[k]) for k in ("time", "qpos", "qvel", "qfrc_passive", "userdata", "xpos", "xmat", "xipos"))
+
+
+def _external(name: str, sig):
+    """MuJoCo's C function ``name`` for numba, linked by symbol name (cache-safe)."""
+    llvm.add_symbol(name, ctypes.cast(getattr(libmujoco(), name), ctypes.c_void_p).value)
+    return types.ExternalFunction(name, sig)
+
+
+_vp_t, _i32 = types.voidptr, types.int32
+#: ``void mj_step(const mjModel* m, mjData* d)``
+mj_step = _external("mj_step", types.void(_vp_t, _vp_t))
+#: ``void mj_applyFT(m, d, force[3], torque[3], point[3], int body, qfrc_target)``
+mj_applyFT = _external("mj_applyFT", types.void(_vp_t, _vp_t, _vp_t, _vp_t, _vp_t, _i32, _vp_t))
+#: ``void mj_objectVelocity(m, d, int objtype, int objid, res[6], int flg_local)``
+mj_objectVelocity = _external("mj_objectVelocity", types.void(_vp_t, _vp_t, _i32, _i32, _vp_t, _i32))
+#: ``mjtNum mj_ray(m, d, pnt[3], vec[3], geomgroup, mjtBool flg_static, int bodyexclude, geomid[1], normal[3])``
+mj_ray = _external("mj_ray", types.float64(_vp_t, _vp_t, _vp_t, _vp_t, _vp_t, types.uint8, _i32, _vp_t, _vp_t))

@@ -78,20 +78,14 @@ U_STRIP = 61  # n x positions (m), then n areas (m^2)
 MAX_STRIPS = 64
 N_USERDATA = U_STRIP + 2 * MAX_STRIPS
 
-_OFF = mjabi.data_offsets()
-_OFF_TIME = _OFF["time"]
-_OFF_QPOS = _OFF["qpos"]
-_OFF_QVEL = _OFF["qvel"]
-_OFF_QFRC = _OFF["qfrc_passive"]
-_OFF_UD = _OFF["userdata"]
-_OFF_XPOS = _OFF["xpos"]
-_OFF_XMAT = _OFF["xmat"]
-_OFF_XIPOS = _OFF["xipos"]
+#: Offsets of the mjData fields the kernels read (an argument of every cached kernel; mjabi).
+_OFFSETS = mjabi.offsets_tuple()
+_O_TIME, _O_QPOS, _O_QVEL, _O_QFRC, _O_UD = mjabi.O_TIME, mjabi.O_QPOS, mjabi.O_QVEL, mjabi.O_QFRC, mjabi.O_UD
+_O_XPOS, _O_XMAT, _O_XIPOS = mjabi.O_XPOS, mjabi.O_XMAT, mjabi.O_XIPOS
 
-_LIB = mjabi.libmujoco()
-_mj_step = _LIB.mj_step
-_mj_applyFT = _LIB.mj_applyFT
-_mj_objectVelocity = _LIB.mj_objectVelocity
+_mj_step = mjabi.mj_step
+_mj_applyFT = mjabi.mj_applyFT
+_mj_objectVelocity = mjabi.mj_objectVelocity
 _OBJ_BODY = int(mujoco.mjtObj.mjOBJ_BODY)
 _OBJ_XBODY = int(mujoco.mjtObj.mjOBJ_XBODY)
 
@@ -103,24 +97,25 @@ _ptr_at = mjabi.ptr_at
 _f64 = mjabi.f64_at
 
 
-@njit(cache=False)
-def _passive_kernel(m, d):
-    """Body of the passive callback (see module docstring); adds to ``qfrc_passive``."""
+@njit(cache=True)
+def _passive_kernel(m, d, off):
+    """Body of the passive callback (see module docstring); adds to ``qfrc_passive``. ``off``: the
+    mjData offsets (:func:`lifelike_mj.physics.mjabi.offsets_tuple`)."""
     base = _addr(d)
-    uda = _ptr_at(base + _OFF_UD)
+    uda = _ptr_at(base + off[_O_UD])
     ud = _f64(uda, N_USERDATA)
     mode = int(ud[U_MODE])
     nq = int(ud[U_NQ])
     nv = int(ud[U_NV])
-    qpos = _f64(_ptr_at(base + _OFF_QPOS), nq)
-    qvel = _f64(_ptr_at(base + _OFF_QVEL), nv)
-    qfrc_addr = _ptr_at(base + _OFF_QFRC)
+    qpos = _f64(_ptr_at(base + off[_O_QPOS]), nq)
+    qvel = _f64(_ptr_at(base + off[_O_QVEL]), nv)
+    qfrc_addr = _ptr_at(base + off[_O_QFRC])
     qfrc = _f64(qfrc_addr, nv)
-    t = _f64(base + _OFF_TIME, 1)[0]
+    t = _f64(base + off[_O_TIME], 1)[0]
     nbody = int(ud[U_NBODY])
-    xpos = _f64(_ptr_at(base + _OFF_XPOS), 3 * nbody)
-    xmat = _f64(_ptr_at(base + _OFF_XMAT), 9 * nbody)
-    xipos = _f64(_ptr_at(base + _OFF_XIPOS), 3 * nbody)
+    xpos = _f64(_ptr_at(base + off[_O_XPOS]), 3 * nbody)
+    xmat = _f64(_ptr_at(base + off[_O_XMAT]), 9 * nbody)
+    xipos = _f64(_ptr_at(base + off[_O_XIPOS]), 3 * nbody)
     force = uda + 8 * U_SCR
     torque = uda + 8 * (U_SCR + 3)
     point = uda + 8 * (U_SCR + 6)
@@ -144,7 +139,7 @@ def _passive_kernel(m, d):
     # thorax pitch (nose up) from its forward axis, and air-relative velocity at its COM
     mb = 9 * thorax
     phi = math.atan2(xmat[mb + 6], xmat[mb + 0])
-    _mj_objectVelocity(m, d, _OBJ_BODY, thorax, _vp(vel), 0)
+    _mj_objectVelocity(m, d, np.int32(_OBJ_BODY), np.int32(thorax), _vp(vel), np.int32(0))
     v6 = _f64(vel, 6)
     vbx = v6[3] - ax
     vby = v6[4] - ay
@@ -164,7 +159,7 @@ def _passive_kernel(m, d):
         pt[0] = xipos[3 * thorax]
         pt[1] = xipos[3 * thorax + 1]
         pt[2] = xipos[3 * thorax + 2]
-        _mj_applyFT(m, d, _vp(force), _vp(torque), _vp(point), thorax, _vp(qfrc_addr))
+        _mj_applyFT(m, d, _vp(force), _vp(torque), _vp(point), np.int32(thorax), _vp(qfrc_addr))
 
         sphi = math.sin(phi)
         for i in range(2):
@@ -190,7 +185,7 @@ def _passive_kernel(m, d):
                 pt[2] = oz + xmat[mw + 7] * r
             else:
                 # strip integration of eq. 1 over dS = W x/L dx (eq. 3)
-                _mj_objectVelocity(m, d, _OBJ_XBODY, wing, _vp(vel), 0)
+                _mj_objectVelocity(m, d, np.int32(_OBJ_XBODY), np.int32(wing), _vp(vel), np.int32(0))
                 wx = v6[0]
                 wy = v6[1]
                 wz = v6[2]
@@ -226,7 +221,7 @@ def _passive_kernel(m, d):
                 pt[0] = ox
                 pt[1] = oy
                 pt[2] = oz
-            _mj_applyFT(m, d, _vp(force), _vp(torque), _vp(point), wing, _vp(qfrc_addr))
+            _mj_applyFT(m, d, _vp(force), _vp(torque), _vp(point), np.int32(wing), _vp(qfrc_addr))
             tq[0] = 0.0
             tq[1] = 0.0
             tq[2] = 0.0
@@ -243,7 +238,7 @@ def _passive_kernel(m, d):
         ex = 0.5 * ((bx1 * sp - bx2 * 0.0) + (by1 * 0.0 - by2 * 1.0) + (bz1 * cp - bz2 * 0.0))
         ey = 0.5 * ((bx2 * cp - bx0 * sp) + (by2 * 0.0 - by0 * 0.0) + (bz2 * (-sp) - bz0 * cp))
         ez = 0.5 * ((bx0 * 0.0 - bx1 * cp) + (by0 * 1.0 - by1 * 0.0) + (bz0 * 0.0 - bz1 * (-sp)))
-        _mj_objectVelocity(m, d, _OBJ_XBODY, thorax, _vp(vel), 0)
+        _mj_objectVelocity(m, d, np.int32(_OBJ_XBODY), np.int32(thorax), _vp(vel), np.int32(0))
         v6 = _f64(vel, 6)
         sw = ud[U_SERVO_WN]
         si = ud[U_SERVO_I]
@@ -259,12 +254,13 @@ def _passive_kernel(m, d):
         pt[0] = xipos[3 * thorax]
         pt[1] = xipos[3 * thorax + 1]
         pt[2] = xipos[3 * thorax + 2]
-        _mj_applyFT(m, d, _vp(force), _vp(torque), _vp(point), thorax, _vp(qfrc_addr))
+        _mj_applyFT(m, d, _vp(force), _vp(torque), _vp(point), np.int32(thorax), _vp(qfrc_addr))
 
 
 @cfunc(types.void(types.voidptr, types.voidptr), cache=False)
 def _passive_cfunc(m, d):
-    _passive_kernel(m, d)
+    # compiled in each process (it holds this process's offsets); the kernel it calls is cached
+    _passive_kernel(m, d, _OFFSETS)
 
 
 #: The compiled passive callback (a ctypes function pointer MuJoCo accepts).
@@ -401,7 +397,7 @@ def _advance_loop(mptr, dptr, qpos, qvel, ud, k0, n_steps, kind, cp, flap, y_ref
         else:
             qpos[qp] = phi
             qvel[dp] = 0.0
-        _mj_step(mptr, dptr)
+        _mj_step(_vp(mptr), _vp(dptr))
         if not (abs(qvel[dh]) + abs(qvel[df]) < 1e4):
             diverged[0] = k + 1
             return phi
@@ -411,21 +407,21 @@ def _advance_loop(mptr, dptr, qpos, qvel, ud, k0, n_steps, kind, cp, flap, y_ref
 
 _law = builtin_law
 #: :func:`_advance_loop` with the built-in pitch laws.
-advance = njit(cache=False)(_advance_loop)
+advance = njit(cache=True)(_advance_loop)
 
 
-@njit(cache=False, parallel=True)
-def _fitness_batch(mptr, dptrs, kinds, cparams, flap, lay, dt, n_steps, diverged, fitness):
+@njit(cache=True, parallel=True)
+def _fitness_batch(mptr, dptrs, kinds, cparams, flap, lay, dt, n_steps, diverged, fitness, off):
     """Fly ``len(dptrs)`` butterflies (one ``mjData`` each, sharing model ``mptr``) on parallel
     threads; writes each one's eq. 13 fitness and divergence step."""
     for b in prange(len(dptrs)):
         base = dptrs[b]
-        ud = _f64(_ptr_at(base + _OFF_UD), N_USERDATA)
-        qpos = _f64(_ptr_at(base + _OFF_QPOS), int(ud[U_NQ]))
-        qvel = _f64(_ptr_at(base + _OFF_QVEL), int(ud[U_NV]))
+        ud = _f64(_ptr_at(base + off[_O_UD]), N_USERDATA)
+        qpos = _f64(_ptr_at(base + off[_O_QPOS]), int(ud[U_NQ]))
+        qvel = _f64(_ptr_at(base + off[_O_QVEL]), int(ud[U_NV]))
         dv = np.full(1, -1, dtype=np.int64)
         fit = np.zeros(1)
-        advance(mptr, _vp(base), qpos, qvel, ud, 0, n_steps, kinds[b], cparams[b], flap, 0.0, lay, dt, 0.0, dv, fit)
+        advance(mptr, base, qpos, qvel, ud, 0, n_steps, kinds[b], cparams[b], flap, 0.0, lay, dt, 0.0, dv, fit)
         diverged[b] = dv[0]
         fitness[b] = fit[0]
 
@@ -465,7 +461,7 @@ def _record_loop(mptr, dptr, qpos, qvel, ud, k0, n_steps, every, kind, cp, flap,
 
 _advance = advance
 #: :func:`_record_loop` with the built-in pitch laws.
-record_steps = njit(cache=False)(_record_loop)
+record_steps = njit(cache=True)(_record_loop)
 
 
 @functools.lru_cache(maxsize=64)
@@ -536,7 +532,7 @@ def fitness_batch(cparams: np.ndarray, flap, params: ButterflyParams | None, con
     with passive_callback(COMPILED_PASSIVE):
         kinds = np.full(n, KIND_ANN if kind is None else kind, dtype=np.int64)
         _fitness_batch(m._address, dptrs, kinds, np.ascontiguousarray(cparams),
-                       flap.as_array(), layout(m).as_array(), float(dt_s), int(n_steps), diverged, fitness)
+                       flap.as_array(), layout(m).as_array(), float(dt_s), int(n_steps), diverged, fitness, _OFFSETS)
     del datas
     return fitness
 
