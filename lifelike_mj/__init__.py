@@ -23,5 +23,5 @@ __version__ = "0.2.0"
 __getattr__, __dir__, __all__ = attach(__name__, {
     "butterfly": ".", "fish": ".", "boids": ".", "evolve": ".", "render": ".", "physics": ".", "stepper": ".",
     "Stepper": "stepper", "Playback": "stepper", "UserError": "errors", "Diverged": "errors",
-})
+}, globals())
 __all__ = [*__all__, "__version__"]

@@ -48,4 +48,4 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "experiments": ".", "ann_experiments": ".", "figures": ".", "ann_figures": ".", "backends": ".", "aero": ".",
     "controllers": ".", "ann": ".", "render": ".", "report": ".", "sim": ".", "flight": ".", "params": ".",
     "model": ".", "evolution": ".",
-})
+}, globals())

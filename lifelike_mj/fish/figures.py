@@ -7,7 +7,6 @@
 * :func:`patterns_figure`: the four motion patterns NB-ND, NB-D, B-ND, B-D on the objective measures
   (burstiness, kurtosis of the acceleration, turning entropy) that stand in for the paper's
   questionnaire (Satoi 2015 Fig. 10-12);
-* :func:`tank_snapshot`: one rendered frame of the tank (:mod:`lifelike_mj.fish.render`).
 
 The figures are built on :class:`matplotlib.figure.Figure` with the Agg canvas, without pyplot (the
 process's matplotlib backend is never changed); every PNG is written atomically (a temporary file
@@ -17,19 +16,16 @@ beside it, then renamed).
 from __future__ import annotations
 
 import os
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.figure import Figure
 
 from lifelike_mj.errors import UserError
-from lifelike_mj.io import atomic_path
 from lifelike_mj.render.plot import finish, png_path
 from lifelike_mj.render.plot import new_figure as _new_figure
 
 if TYPE_CHECKING:  # pragma: no cover
-    from lifelike_mj.fish.params import FishParams
     from lifelike_mj.fish.sim import SwimResult
 
 #: The paper's four motion patterns (Satoi 2015 section 5.1.1), in the order of its figures.
@@ -239,24 +235,4 @@ def patterns_figure(rows: list[dict], out_path: str | os.PathLike | None = None)
     return finish(fig, out)
 
 
-def tank_snapshot(out_path: str | os.PathLike, params: FishParams, n_fish: int = 10, seed: int = 0, t_s: float = 5.0,
-                  camera: str = "side", width: int = 640, height: int = 480, size=None) -> Path:
-    """One rendered frame of the swim at time ``t_s`` (s), as a PNG of ``width`` x ``height`` pixels.
-
-    ``camera``: ``side`` (the whole tank, Satoi 2015's view), ``oblique`` or ``follow`` (1 m of tank
-    around fish 0); ``size``: the water volume (m). See :func:`lifelike_mj.fish.render.render_frame`.
-    Written atomically; returns the path.
-    """
-    from PIL import Image
-
-    from lifelike_mj.fish.render import render_frame
-
-    out = None if out_path is None else png_path(out_path, "snapshot")
-    img = render_frame(params, t_s=t_s, n_fish=n_fish, seed=seed, size=size, camera=camera, width=width, height=height)
-    with atomic_path(out) as tmp:
-        Image.fromarray(img).save(tmp, format="PNG")
-    return out
-
-
-__all__ = ["PATTERN_ORDER", "accel_histogram_figure", "patterns_figure", "side_accelerations_bl", "tank_snapshot",
-           "tracks_figure"]
+__all__ = ["PATTERN_ORDER", "accel_histogram_figure", "patterns_figure", "side_accelerations_bl", "tracks_figure"]

@@ -32,7 +32,8 @@ def _f(x: float, d: int = 2) -> str:
 def reproduce_fish(out: str | Path, seeds=PATTERN_SEEDS, pattern_s: float = PATTERN_S, swim_s: float = SWIM_S,
                    progress: bool = True) -> dict:
     """Run everything; returns the results dictionary (also written as ``results.json``)."""
-    from lifelike_mj.fish.figures import accel_histogram_figure, patterns_figure, tank_snapshot, tracks_figure
+    from lifelike_mj.fish.figures import accel_histogram_figure, patterns_figure, tracks_figure
+    from lifelike_mj.fish.render import frame_png
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -49,7 +50,7 @@ def reproduce_fish(out: str | Path, seeds=PATTERN_SEEDS, pattern_s: float = PATT
     table = pattern_table(seeds, pattern_s, N_FISH, progress=progress)
     patterns_figure(table.rows, out / "fig11_patterns.png")
     try:
-        tank_snapshot(out / "tank.png", bd, N_FISH, 0, t_s=5.0, camera="follow")
+        frame_png(out / "tank.png", bd, n_fish=N_FISH, seed=0, t_s=5.0, camera="follow")
         snap = "![tank](tank.png)\n"
     except (UserError, ImportError, RuntimeError) as exc:
         snap = f"(no rendered frame on this machine: {exc})\n"

@@ -13,20 +13,10 @@ one viewer loop, cameras and plot helpers.
 Importing this package does not import ``mujoco``.
 """
 
-from __future__ import annotations
+from lifelike_mj._lazy import attach
 
-import importlib
-
-_NAMES = {
+__getattr__, __dir__, __all__ = attach(__name__, {
     "ensure_gl_backend": "gl", "Offscreen": "offscreen", "film": "video", "write_png": "video", "has_display": "viewer",
     "require_display": "viewer", "view": "viewer", "new_figure": "plot", "save": "plot",
-}
-
-
-def __getattr__(name: str):
-    if name in _NAMES:
-        return getattr(importlib.import_module(f"lifelike_mj.render.{_NAMES[name]}"), name)
-    raise AttributeError(f"module 'lifelike_mj.render' has no attribute {name!r}")
-
-
-__all__ = sorted(_NAMES)
+    "gl": ".", "offscreen": ".", "video": ".", "viewer": ".", "camera": ".", "plot": ".",
+}, globals())

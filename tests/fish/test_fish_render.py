@@ -82,7 +82,7 @@ def test_render_rejects_bad_requests(tmp_path, params):
     with pytest.raises(UserError, match="width"):
         fish_video.render_frame(params, width=0)
     with pytest.raises(UserError, match="width"):
-        fish_figures.tank_snapshot(tmp_path / "s.png", params, width=3)
+        fish_video.frame_png(tmp_path / "s.png", params, width=3)
     with pytest.raises(UserError, match="camera"):
         fish_video.render_benchmark(n_frames=1, camera="nope")
     assert not list(tmp_path.iterdir())
@@ -95,7 +95,7 @@ def test_follow_fish_out_of_range(tmp_path, params):
 
 def test_tank_snapshot_png(tmp_path, params, gl_backend):
     out = tmp_path / "snap.png"
-    assert fish_figures.tank_snapshot(out, params, n_fish=3, t_s=0.2, camera="oblique", width=96, height=72) == out
+    assert fish_video.frame_png(out, params, n_fish=3, t_s=0.2, camera="oblique", width=96, height=72) == out
     with Image.open(out) as im:
         assert im.format == "PNG" and im.size == (96, 72)
         assert np.asarray(im.convert("L"), dtype=float).std() > 3.0
