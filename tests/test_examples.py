@@ -1,0 +1,30 @@
+"""Every script in examples/ runs as a user would run it (a fresh process, from the repository)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+EXAMPLES = sorted((Path(__file__).resolve().parent.parent / "examples").glob("*.py"))
+NEEDS_GL = {"render_your_run.py"}
+
+
+def test_there_are_examples():
+    assert len(EXAMPLES) >= 5
+
+
+@pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.name)
+def test_example_runs(script, tmp_path, request):
+    if script.name in NEEDS_GL:
+        request.getfixturevalue("gl_backend")
+    args = [str(tmp_path)] if script.name in NEEDS_GL else []
+    r = subprocess.run([sys.executable, str(script), *args], capture_output=True, text=True, cwd=tmp_path,
+                       env=dict(os.environ), timeout=600)
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-3000:]
+    assert r.stdout.strip()
+    if script.name in NEEDS_GL:
+        assert {p.name for p in tmp_path.iterdir()} >= {"flight.gif", "flock.png", "tank.gif"}
