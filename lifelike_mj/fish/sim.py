@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
-from numba import cfunc, njit, types
+from numba import njit
 
 from lifelike_mj import checks
 from lifelike_mj.errors import Diverged, UserError
@@ -149,10 +149,12 @@ def _passive_kernel(m, d, off):
     fish_forces(ud, qpos, qvel, qfrc)
 
 
-@cfunc(types.void(types.voidptr, types.voidptr), cache=False)
-def _passive_cfunc(m, d):
-    # compiled in each process (it holds this process's offsets); the kernel it calls is cached
+def _passive_entry(m, d):
+    # the trampoline MuJoCo calls: this process's offsets into the cached kernel (mjabi.cached_cfunc)
     _passive_kernel(m, d, _OFFSETS)
+
+
+_passive_cfunc = mjabi.cached_cfunc(_passive_entry, "_passive_cfunc")
 
 
 #: The compiled passive callback (a ctypes function pointer MuJoCo accepts).

@@ -17,8 +17,9 @@ The same module declares MuJoCo's functions to numba (:data:`mj_step`, :data:`mj
 that belongs to one process: the functions above are linked by name, not by address, and the
 offsets are passed as an argument (:func:`offsets_tuple`), never baked in, so cached code stays right
 when the MuJoCo version (and the layout of ``mjData``) changes. The one function that cannot take
-them as an argument, the ``cfunc`` MuJoCo calls with ``(m, d)``, is a two-line trampoline compiled in
-each process that passes the offsets to a cached kernel.
+them as an argument, the ``cfunc`` MuJoCo calls with ``(m, d)``, is a two-line trampoline that
+passes the offsets to a cached kernel; it is cached under a name that carries a hash of the MuJoCo
+version and the offsets (:func:`cached_cfunc`), so another layout compiles (and caches) its own.
 """
 
 from __future__ import annotations
@@ -26,14 +27,16 @@ from __future__ import annotations
 import ctypes
 import functools
 import glob
+import hashlib
 import os
 import re
+import types as pytypes
 
 import mujoco
 import numpy as np
 from llvmlite import binding as llvm
 from llvmlite import ir
-from numba import carray, njit, types
+from numba import carray, cfunc, njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
@@ -194,3 +197,19 @@ mj_applyFT = _external("mj_applyFT", types.void(_vp_t, _vp_t, _vp_t, _vp_t, _vp_
 mj_objectVelocity = _external("mj_objectVelocity", types.void(_vp_t, _vp_t, _i32, _i32, _vp_t, _i32))
 #: ``mjtNum mj_ray(m, d, pnt[3], vec[3], geomgroup, mjtBool flg_static, int bodyexclude, geomid[1], normal[3])``
 mj_ray = _external("mj_ray", types.float64(_vp_t, _vp_t, _vp_t, _vp_t, _vp_t, types.uint8, _i32, _vp_t, _vp_t))
+
+
+def layout_tag() -> str:
+    """A short hash of the MuJoCo version and the ``mjData`` offsets this process uses."""
+    text = f"{mujoco.__version__}:{offsets_tuple()}"
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def cached_cfunc(fn, name: str):
+    """``numba.cfunc(void(void*, void*), cache=True)`` of the plain function ``fn(m, d)`` (a passive
+    callback's trampoline, which reads this process's offsets from its module's globals), compiled
+    under the name ``name + "_" + layout_tag()``: cached on disk, and never reused for another layout."""
+    tagged = f"{name}_{layout_tag()}"
+    copy = pytypes.FunctionType(fn.__code__, fn.__globals__, tagged, fn.__defaults__, fn.__closure__)
+    copy.__qualname__ = tagged
+    return cfunc(types.void(types.voidptr, types.voidptr), cache=True)(copy)

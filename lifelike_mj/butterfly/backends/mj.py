@@ -38,7 +38,7 @@ from collections.abc import Callable
 
 import mujoco
 import numpy as np
-from numba import cfunc, njit, prange, types
+from numba import njit, prange
 
 from lifelike_mj.butterfly.aero import strip_nodes
 from lifelike_mj.butterfly.controllers import ButterflyController
@@ -257,10 +257,12 @@ def _passive_kernel(m, d, off):
         _mj_applyFT(m, d, _vp(force), _vp(torque), _vp(point), np.int32(thorax), _vp(qfrc_addr))
 
 
-@cfunc(types.void(types.voidptr, types.voidptr), cache=False)
-def _passive_cfunc(m, d):
-    # compiled in each process (it holds this process's offsets); the kernel it calls is cached
+def _passive_entry(m, d):
+    # the trampoline MuJoCo calls: this process's offsets into the cached kernel (mjabi.cached_cfunc)
     _passive_kernel(m, d, _OFFSETS)
+
+
+_passive_cfunc = mjabi.cached_cfunc(_passive_entry, "_passive_cfunc")
 
 
 #: The compiled passive callback (a ctypes function pointer MuJoCo accepts).
