@@ -74,7 +74,7 @@ def laws(repeats: int, n_steps: int = 24000) -> dict:
     result = {}
     for backend in ("paper", "mujoco"):
         kinds = {"built-in": None, "numba": nb_rule, "python": py_rule}
-        for k, law in kinds.items():  # warm-up: compile
+        for law in kinds.values():  # warm-up: compile
             butterfly.Flight(rule, backend=backend, pitch_law=law).record(n_steps=100)
         samples = {k: [] for k in kinds}
         ratios = []

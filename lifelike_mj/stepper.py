@@ -52,7 +52,24 @@ class Stepper(Protocol):
     def data(self) -> Any: ...
 
 
-class Playback:
+class StepCounter:
+    """``steps`` and ``time`` of a stepper that counts its steps in ``_k`` and has a ``dt``."""
+
+    _k: int = 0
+    dt: float
+
+    @property
+    def steps(self) -> int:
+        """Steps taken since the start (or the last ``reset``)."""
+        return self._k
+
+    @property
+    def time(self) -> float:
+        """``steps * dt``: simulated time (s; the boids' steps have no seconds and ``dt = 1``)."""
+        return self._k * self.dt
+
+
+class Playback(StepCounter):
     """A recorded run in the stepper shape: step ``k`` shows frame ``k`` of the recording.
 
     ``model``/``data``: the MuJoCo model and data that show it; ``pose(k)`` places ``data`` at frame
@@ -67,14 +84,6 @@ class Playback:
         self.model, self.data, self.n_frames, self._pose, self.dt = model, data, int(n_frames), pose, float(dt)
         self._state = state
         self._k = 0
-
-    @property
-    def steps(self) -> int:
-        return self._k
-
-    @property
-    def time(self) -> float:
-        return self._k * self.dt
 
     def reset(self, seed: int | None = None) -> None:
         self._k = 0

@@ -26,6 +26,7 @@ from lifelike_mj.boids.engine import (
     initial_state,
 )
 from lifelike_mj.errors import Diverged, UserError
+from lifelike_mj.stepper import StepCounter
 
 #: Names of :meth:`Flock.state` and their units.
 STATE_UNITS = {
@@ -35,7 +36,7 @@ STATE_UNITS = {
 }
 
 
-class Flock:
+class Flock(StepCounter):
     """``n`` agents with parameters ``params`` (:class:`~lifelike_mj.boids.engine.BoidParams`; default
     the paper's 5a weights) started from ``seed`` (:func:`~lifelike_mj.boids.engine.initial_state`).
     One step is one engine step (eq. 1-2 with ``dt = 1``)."""
@@ -60,14 +61,6 @@ class Flock:
     def dt(self) -> float:
         """Time per step (the engine's dt, in steps: 1)."""
         return float(self.params.dt)
-
-    @property
-    def steps(self) -> int:
-        return self._k
-
-    @property
-    def time(self) -> float:
-        return self._k * self.dt
 
     @property
     def n(self) -> int:

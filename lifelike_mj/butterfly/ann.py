@@ -71,19 +71,22 @@ def transfer(u):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def scaled_inputs(cp, theta, omega, y, vy, vz, air_y, air_z, phi_prev):
+    """The network's six inputs in the paper's order (module docstring), divided by their scales;
+    velocities air-relative when the controller says so (section 7.2)."""
+    if cp[A_RELATIVE] > 0.5:
+        vy = vy - air_y
+        vz = vz - air_z
+    return (phi_prev * cp[A_SCALE], omega * cp[A_SCALE + 1], (theta - cp[A_THETA_C]) * cp[A_SCALE + 2],
+            vy * cp[A_SCALE + 3], y * cp[A_SCALE + 4], vz * cp[A_SCALE + 5])
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def ann_pitch(cp, theta, omega, y, vy, vz, air_y, air_z, phi_prev):
     """New pitch (rad) from the previous pitch ``phi_prev`` (rad), flap angle ``theta`` (rad) and
     rate ``omega`` (rad/s), altitude ``y`` (m, relative to the start), ground velocities ``vy``
     (up), ``vz`` (forward) and the air velocity (m/s)."""
-    if cp[A_RELATIVE] > 0.5:
-        vy = vy - air_y
-        vz = vz - air_z
-    x0 = phi_prev * cp[A_SCALE]
-    x1 = omega * cp[A_SCALE + 1]
-    x2 = (theta - cp[A_THETA_C]) * cp[A_SCALE + 2]
-    x3 = vy * cp[A_SCALE + 3]
-    x4 = y * cp[A_SCALE + 4]
-    x5 = vz * cp[A_SCALE + 5]
+    x0, x1, x2, x3, x4, x5 = scaled_inputs(cp, theta, omega, y, vy, vz, air_y, air_z, phi_prev)
     out = cp[A_W + 48]
     for h in range(N_HIDDEN):
         b = A_W + 7 * h
@@ -180,9 +183,6 @@ def mlp_pitch(cp, theta, omega, y, vy, vz, air_y, air_z, phi_prev):
     ``b + sum_i w_i x_i`` passed through ``G`` as the pitch change (the sums in the order of
     :func:`ann_pitch`, so that a ``[6, 6, 1]`` network gives its numbers bit for bit). The
     activations are kept in the array's last ``2 * max(layers)`` entries."""
-    if cp[A_RELATIVE] > 0.5:
-        vy = vy - air_y
-        vz = vz - air_z
     nl = int(cp[A_NLAYERS])
     w0 = A_NLAYERS + 1 + nl
     width = 0
@@ -193,12 +193,9 @@ def mlp_pitch(cp, theta, omega, y, vy, vz, air_y, air_z, phi_prev):
         nw += (int(cp[A_NLAYERS + 1 + k]) + 1) * int(cp[A_NLAYERS + 2 + k])
     a = w0 + nw  # activations of the current layer's inputs
     b = a + width  # ... and its outputs
-    cp[a] = phi_prev * cp[A_SCALE]
-    cp[a + 1] = omega * cp[A_SCALE + 1]
-    cp[a + 2] = (theta - cp[A_THETA_C]) * cp[A_SCALE + 2]
-    cp[a + 3] = vy * cp[A_SCALE + 3]
-    cp[a + 4] = y * cp[A_SCALE + 4]
-    cp[a + 5] = vz * cp[A_SCALE + 5]
+    x = scaled_inputs(cp, theta, omega, y, vy, vz, air_y, air_z, phi_prev)
+    for i in range(N_INPUTS):
+        cp[a + i] = x[i]
     w = w0
     out = 0.0
     for k in range(nl - 1):

@@ -32,6 +32,7 @@ from lifelike_mj.butterfly.controllers import KIND_CONSTANT, ButterflyController
 from lifelike_mj.butterfly.flight import Condition, PitchObservation, Trajectory, check_timing, kernel_law
 from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.errors import Diverged, UserError
+from lifelike_mj.stepper import StepCounter
 
 #: Names of :meth:`Flight.state` and their units.
 STATE_UNITS = {
@@ -52,7 +53,7 @@ def _is_numba(fn: object) -> bool:
     return isinstance(fn, Dispatcher)
 
 
-class Flight:
+class Flight(StepCounter):
     """One butterfly flight (Oe 2010), stepped on the ``paper`` or ``mujoco`` backend.
 
     ``controller``: a :class:`~lifelike_mj.butterfly.controllers.ButterflyController`, or the name or
@@ -116,16 +117,6 @@ class Flight:
         self._phi = 0.0
         self._diverged = np.full(1, -1, dtype=np.int64)
         self._fit = np.zeros(1)
-
-    @property
-    def steps(self) -> int:
-        """Steps taken since the start."""
-        return self._k
-
-    @property
-    def time(self) -> float:
-        """Simulated time of the current state, s."""
-        return self._k * self.dt
 
     @property
     def fitness(self) -> float:

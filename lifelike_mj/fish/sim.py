@@ -49,6 +49,7 @@ from lifelike_mj.fish.scene import BODY_LENGTH_M, FishScene, box_areas, build_sc
 from lifelike_mj.physics import mjabi
 from lifelike_mj.physics.callbacks import passive_callback
 from lifelike_mj.physics.fluid import normal_drag_scalar
+from lifelike_mj.stepper import StepCounter
 
 # ---- userdata layout (per model; the callback is process-global) ----------------------------------
 U_MAGIC = 0  # identifies a fish model's userdata (the callback ignores other models)
@@ -64,8 +65,6 @@ U_FISH = 18  # per fish: qadr, dadr, mu, F_forward (N), torque_y, torque_z (N m,
 FISH_BLOCK = 6
 MAGIC = 7.25e5
 
-#: Offsets of the mjData fields the passive kernel reads (its argument; see physics/mjabi.py).
-_OFFSETS = mjabi.offsets_tuple()
 _O_QPOS, _O_QVEL, _O_QFRC, _O_UD = mjabi.O_QPOS, mjabi.O_QVEL, mjabi.O_QFRC, mjabi.O_UD
 _mj_step = mjabi.mj_step
 _mj_ray = mjabi.mj_ray
@@ -149,16 +148,9 @@ def _passive_kernel(m, d, off):
     fish_forces(ud, qpos, qvel, qfrc)
 
 
-def _passive_entry(m, d):
-    # the trampoline MuJoCo calls: this process's offsets into the cached kernel (mjabi.cached_cfunc)
-    _passive_kernel(m, d, _OFFSETS)
-
-
-_passive_cfunc = mjabi.cached_cfunc(_passive_entry, "_passive_cfunc")
-
-
-#: The compiled passive callback (a ctypes function pointer MuJoCo accepts).
-COMPILED_PASSIVE = _passive_cfunc.ctypes
+#: The compiled passive callback (a ctypes function pointer MuJoCo accepts; mjabi.compiled_passive).
+_PASSIVE = mjabi.compiled_passive(_passive_kernel, "fish")
+COMPILED_PASSIVE = _PASSIVE.ctypes
 
 
 def python_passive(m: mujoco.MjModel, d: mujoco.MjData) -> None:
@@ -409,7 +401,7 @@ STATE_UNITS = {
 }
 
 
-class Tank:
+class Tank(StepCounter):
     """A tank of fish (Satoi 2015), in the stepper shape every creature shares (:mod:`lifelike_mj.stepper`).
 
     ``params``: a preset (:class:`~lifelike_mj.fish.params.FishParams`; default ``B-D``); ``n_fish``
@@ -457,16 +449,6 @@ class Tank:
     def dt(self) -> float:
         """Seconds per step (one control step)."""
         return self.params.control_dt_s
-
-    @property
-    def steps(self) -> int:
-        """Control steps taken since the start."""
-        return self._k
-
-    @property
-    def time(self) -> float:
-        """Simulated time, s."""
-        return self._k * self.params.control_dt_s
 
     @property
     def model(self) -> mujoco.MjModel:

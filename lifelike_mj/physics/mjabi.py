@@ -213,3 +213,22 @@ def cached_cfunc(fn, name: str):
     copy = pytypes.FunctionType(fn.__code__, fn.__globals__, tagged, fn.__defaults__, fn.__closure__)
     copy.__qualname__ = tagged
     return cfunc(types.void(types.voidptr, types.voidptr), cache=True)(copy)
+
+
+#: Filled in each copy of :func:`_passive_entry` by :func:`compiled_passive`.
+_KERNEL = None
+_OFFS: tuple[int, ...] = ()
+
+
+def _passive_entry(m, d):
+    # the trampoline MuJoCo calls: this process's offsets into the cached kernel (see compiled_passive)
+    _KERNEL(m, d, _OFFS)
+
+
+def compiled_passive(kernel, name: str):
+    """The passive callback MuJoCo calls as ``cb(m, d)`` (a numba ``cfunc``; ``.ctypes`` is the pointer), made of the cached
+    kernel ``kernel(m, d, offsets)``: a trampoline that passes this process's :func:`offsets_tuple`,
+    cached under ``name`` and the layout's hash (:func:`cached_cfunc`)."""
+    g = dict(_passive_entry.__globals__, _KERNEL=kernel, _OFFS=offsets_tuple())
+    entry = pytypes.FunctionType(_passive_entry.__code__, g, "_passive_entry")
+    return cached_cfunc(entry, f"passive_{name}")

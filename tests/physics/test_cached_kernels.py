@@ -25,7 +25,7 @@ CODE = (
     "from lifelike_mj.fish import sim\n"
     "stats = [f.stats for f in (mj.advance, mj.record_steps, mj._passive_kernel, sim._run_chunk)]\n"
     "misses = sum(sum(s.cache_misses.values()) for s in stats)\n"
-    "out.append(f'misses={misses},cfunc_hits={mj._passive_cfunc.cache_hits + sim._passive_cfunc.cache_hits}')\n"
+    "out.append(f'misses={misses},cfunc_hits={mj._PASSIVE.cache_hits + sim._PASSIVE.cache_hits}')\n"
     "print(' '.join(out))\n"
 )
 

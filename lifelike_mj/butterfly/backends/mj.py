@@ -257,16 +257,9 @@ def _passive_kernel(m, d, off):
         _mj_applyFT(m, d, _vp(force), _vp(torque), _vp(point), np.int32(thorax), _vp(qfrc_addr))
 
 
-def _passive_entry(m, d):
-    # the trampoline MuJoCo calls: this process's offsets into the cached kernel (mjabi.cached_cfunc)
-    _passive_kernel(m, d, _OFFSETS)
-
-
-_passive_cfunc = mjabi.cached_cfunc(_passive_entry, "_passive_cfunc")
-
-
-#: The compiled passive callback (a ctypes function pointer MuJoCo accepts).
-COMPILED_PASSIVE = _passive_cfunc.ctypes
+#: The compiled passive callback (a ctypes function pointer MuJoCo accepts; mjabi.compiled_passive).
+_PASSIVE = mjabi.compiled_passive(_passive_kernel, "butterfly")
+COMPILED_PASSIVE = _PASSIVE.ctypes
 
 
 def python_passive(m: mujoco.MjModel, d: mujoco.MjData) -> None:
