@@ -28,3 +28,16 @@ def test_example_runs(script, tmp_path, request):
     assert r.stdout.strip()
     if script.name in NEEDS_GL:
         assert {p.name for p in tmp_path.iterdir()} >= {"flight.gif", "flock.png", "tank.gif"}
+
+
+def test_readme_python_runs(tmp_path):
+    """The README's Python section runs as written (its blocks one after another, as in a notebook)."""
+    import re
+
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    section = readme[readme.index("## From Python"):]
+    blocks = re.findall(r"```python\n(.*?)```", section, flags=re.S)
+    assert blocks
+    r = subprocess.run([sys.executable, "-c", "\n".join(blocks)], capture_output=True, text=True, cwd=tmp_path,
+                       timeout=600)
+    assert r.returncode == 0, r.stderr[-3000:]

@@ -1,4 +1,4 @@
-"""Heterogeneous boids of Nakamura 2013 (spec/boids.md sections 1-2): a compiled cell-list engine
+"""Heterogeneous boids of Nakamura 2013 (docs/models/boids.md): a compiled cell-list engine
 and a plain all-pairs reference.
 
 Each agent ``i`` (type ``t_i`` of ``k`` types) feels, from the agents ``j`` within the nested

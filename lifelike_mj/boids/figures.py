@@ -47,7 +47,7 @@ if TYPE_CHECKING:  # pragma: no cover
 TRAIL_STEPS = 5
 #: Colours of the types: A red, B yellow-green (the paper's), then more (as the 3D scene's).
 TYPE_COLOURS = ("#dc140f", "#9acd32", "#1f77b4", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf")
-#: Short names of the eight patterns (Nakamura 2013 section 3.2; spec/boids.md section 2).
+#: Short names of the eight patterns (Nakamura 2013 section 3.2).
 PATTERN_NAMES = {
     "4a": "two ellipsoidal groups, small interface",
     "4b": "wide interface, loose swarms",

@@ -1,5 +1,5 @@
 """Measures of how the types of heterogeneous boids mix, and a hand-written classifier of the eight
-patterns of Nakamura 2013 (spec/boids.md section 3: the paper's missing "objective index").
+patterns of Nakamura 2013 (docs/models/boids.md: the paper's missing "objective index").
 
 Every measure is a function of one frame ``(positions, velocities, types)`` (:func:`frame_measures`);
 :func:`measures` evaluates it on the recorded frames of a late window of a run and averages it over

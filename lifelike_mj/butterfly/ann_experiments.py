@@ -1,4 +1,4 @@
-"""The evolved controller's experiments E6-E11 (Oe 2010 sections 6.4 and 7; spec/butterfly.md §5).
+"""The evolved controller's experiments E6-E11 (Oe 2010 sections 6.4 and 7).
 
 * E6 :func:`e6_level`: the evolved network in still air from 0 m (Fig. 7-10).
 * E7 :func:`e7_from_above`: start at +10 m (Fig. 11).

@@ -1,4 +1,4 @@
-"""The paper's experiments E1-E5 (Oe 2010 sections 4-5; spec/butterfly.md section 5).
+"""The paper's experiments E1-E5 (Oe 2010 sections 4-5).
 
 Each experiment is a function returning a small frozen dataclass with ``to_dict()`` (plain JSON
 data). Arrays needed only for figures (trajectories) are kept as attributes and left out of

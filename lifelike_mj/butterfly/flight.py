@@ -38,7 +38,7 @@ class Condition:
     wind_m_s: tuple[float, float] = (0.0, 0.0)
 
     def air_velocity(self) -> tuple[float, float]:
-        """Air velocity (forward, up) in m/s: ``-(a, b)`` (spec section 3)."""
+        """Air velocity (forward, up) in m/s: ``-(a, b)`` (docs/models/butterfly.md)."""
         return (-float(self.wind_m_s[0]), -float(self.wind_m_s[1]))
 
 

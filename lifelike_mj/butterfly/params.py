@@ -8,7 +8,7 @@ from dataclasses import asdict, dataclass, replace
 from lifelike_mj.errors import UserError
 from lifelike_mj.physics.fluid import CD_PAPER, RHO_AIR
 
-#: Gravity, m/s^2 (spec/butterfly.md section 3: the printed eq. 11 omits -m g; the text needs it).
+#: Gravity, m/s^2 (the printed Oe 2010 eq. 11 omits -m g; the text needs it: docs/models/butterfly.md).
 GRAVITY: float = 9.8
 
 
@@ -17,7 +17,7 @@ class ButterflyParams:
     """Constants of the swallowtail model (Oe 2010 sections 3, 4.3), SI units.
 
     ``body_area_m2`` (``A_b`` of eq. 10) is not given by the paper: 1.0 cm^2 reproduces the
-    straight flight of section 5.1, 1.53 cm^2 the speed limit of section 4.3 (spec section 3).
+    straight flight of section 5.1, 1.53 cm^2 the speed limit of section 4.3 (docs/models/butterfly.md).
     """
 
     mass_kg: float = 0.319e-3  #: m, kg (Oe 2010 section 4.2)

@@ -3,7 +3,7 @@ no-escape run, and offscreen rendering frames per second.
 
 Goals (issue 4): 10 fish at least 200x real time, 1,000 fish at least real time at 60 Hz control,
 rendering at least 60 frames per second at 640 x 480. Simulation is headless and does not record
-tracks; times are medians of ``repeats`` runs of a warmed-up :class:`~lifelike_mj.fish.sim.Swimmer`
+tracks; times are medians of ``repeats`` runs of a warmed-up :class:`~lifelike_mj.fish.sim.Tank`
 (scene building is timed separately).
 """
 
@@ -15,14 +15,14 @@ import time
 import numpy as np
 
 from lifelike_mj.fish.params import load_preset
-from lifelike_mj.fish.sim import Swimmer, swim
+from lifelike_mj.fish.sim import Tank, swim
 from lifelike_mj.machine import machine_info
 
 
 def _realtime(n_fish: int, sim_s: float, repeats: int) -> dict:
     p = load_preset("B-D")
     t0 = time.perf_counter()
-    sw = Swimmer(p, n_fish, seed=0)
+    sw = Tank(p, n_fish, seed=0)
     build = time.perf_counter() - t0
     sw.run(int(p.control_hz), record=False)  # warm-up: compile, settle
     k = int(round(sim_s * p.control_hz))

@@ -6,7 +6,7 @@ paper's 60 frames per second) each fish
 1. looks (3.6): five MuJoCo ray casts of length ``vision_distance_m`` from its snout into the
    fish-free vision model of the tank (``fish/scene.py``); a hit starts (or renews) wall avoidance
    for ``avoid_duration_s``, remembering the direction away from the wall (the hit normals);
-2. draws its next motion unit (MU) from the Markov chain (3.3; spec section 1), with the avoidance
+2. draws its next motion unit (MU) from the Markov chain (3.3; docs/models/fish.md), with the avoidance
    weights while avoiding (3.7);
 3. if the MU is *accelerate*, draws a push (3.4.1, eq. 2-9): ``r ~ U(r_min, r_max)``,
    ``theta = 90 + U(-theta_range, theta_range) + A sgn(p) / (1 + exp(-k |p|))`` with the pitch ``p``
