@@ -126,4 +126,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("lifelike-mj: interrupted.", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader went away (`lifelike-mj ... | head`): stop quietly
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     return 0
