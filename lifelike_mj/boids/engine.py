@@ -34,6 +34,7 @@ import numba
 import numpy as np
 from numba import njit, prange
 
+from lifelike_mj import checks
 from lifelike_mj.errors import UserError
 
 #: The paper's settings (section 2): zones, separation weight, box side, agents.
@@ -74,7 +75,7 @@ class BoidParams:
         object.__setattr__(self, "wc", tuple(map(tuple, wc.tolist())))
         for k in ("r_s", "r_a", "r_c", "w_s", "box", "dt", "mass"):
             v = getattr(self, k)
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            if not checks.is_number(v) or not math.isfinite(v):
                 raise UserError(f"{k} must be a finite number, got {v!r}.")
         if not (0 < self.r_s < self.r_a < self.r_c):
             raise UserError(f"the zones must nest: 0 < R_s < R_a < R_c, got R_s = {self.r_s}, R_a = {self.r_a}, "
@@ -128,9 +129,9 @@ def initial_state(params: BoidParams, n: int, seed: int, margin: float | None = 
     walls), tiny random velocities (uniform in ``[-0.01, 0.01]`` per axis), and types drawn
     independently (each of the ``k`` types equally likely: A or B with probability 0.5 in the
     paper's case). One ``numpy.random.Generator`` seeded with ``seed``."""
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
+    if not checks.is_whole(n) or n < 2:
         raise UserError(f"the number of agents must be a whole number of at least 2, got {n!r}.")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+    if not checks.is_whole(seed) or seed < 0:
         raise UserError(f"seed must be a non-negative whole number, got {seed!r}.")
     rng = np.random.default_rng(seed)
     m = params.r_c if margin is None else margin

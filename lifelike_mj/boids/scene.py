@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from lifelike_mj import checks
 from lifelike_mj.errors import UserError
 
 #: Semi-axes (box units) of an agent's ellipsoid: along its velocity, across, and up.
@@ -150,12 +151,12 @@ def build_scene(n: int, types=None, box: float = 20.0, dims: int = 3, semi_axes=
     Agent ``i`` is body ``boid<i>``, its geom ``boid<i>``; the cameras are named in :data:`CAMERAS`.
     Returns ``(model, layout)``; the agents start at the box's centre, pointing along +x: call
     :func:`update` before drawing."""
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+    if not checks.is_whole(n) or n < 1:
         raise UserError(f"the number of agents must be a whole number of at least 1, got {n!r}.")
     n = int(n)
     if dims not in (2, 3):
         raise UserError(f"dims must be 2 or 3, got {dims!r}.")
-    if isinstance(box, bool) or not isinstance(box, (int, float, np.integer, np.floating)) or not (
+    if not checks.is_number(box) or not (
             math.isfinite(box) and box > 0):
         raise UserError(f"the box side must be a positive number, got {box!r}.")
     box = float(box)

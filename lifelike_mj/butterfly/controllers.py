@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lifelike_mj import checks
 from lifelike_mj.butterfly import ann
 from lifelike_mj.butterfly.params import FlapPattern
 from lifelike_mj.errors import UserError
@@ -75,7 +76,7 @@ class ButterflyController:
             return
         for k in needed:
             v = self.parameters[k]
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            if not checks.is_number(v) or not math.isfinite(v):
                 raise UserError(f"controller parameter {k} must be a finite number, got {v!r}.")
 
     def compiled(self) -> tuple[int, np.ndarray]:
@@ -182,7 +183,7 @@ def _check_ann(p: dict, where: str) -> None:
         raise UserError(f"{where} needs 'inputs' to be one of {', '.join(ann.INPUT_KINDS)}.")
     for key in ("max_dphi_deg", "phi_limit_deg"):
         v = p.get(key)
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not (math.isfinite(v) and 0 < v <= 90):
+        if not checks.is_number(v) or not (math.isfinite(v) and 0 < v <= 90):
             raise UserError(f"{where} needs '{key}' to be a number of degrees in (0, 90].")
     scales = p.get("input_scale", {})
     if not isinstance(scales, dict):

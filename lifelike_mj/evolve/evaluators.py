@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from lifelike_mj import checks
 from lifelike_mj.errors import UserError
 from lifelike_mj.evolve.problem import check_problem
 
@@ -274,7 +275,7 @@ def make_evaluator(problem: Any, executor: str = "process", workers: int | None 
     """
     if executor not in EXECUTORS:
         raise UserError(f"unknown executor {executor!r}; known executors are {', '.join(EXECUTORS)}.")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1):
+    if workers is not None and (not checks.is_whole(workers) or workers < 1):
         raise UserError(f"workers must be a positive integer, not {workers!r}.")
     if executor == "serial":
         return SerialEvaluator(problem, 1)

@@ -11,6 +11,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from lifelike_mj import checks
 from lifelike_mj.errors import UserError
 
 
@@ -52,7 +53,7 @@ def check_problem(problem: object, *, needs_bounds: bool) -> tuple[int, np.ndarr
     if missing:
         raise UserError(f"the problem {type(problem).__name__} lacks {', '.join(missing)} (see lifelike_mj.evolve.Problem).")
     dim = problem.dim
-    if isinstance(dim, bool) or not isinstance(dim, (int, np.integer)) or dim < 1:
+    if not checks.is_whole(dim) or dim < 1:
         raise UserError(f"the problem's dim must be a positive integer, not {dim!r}.")
     dim = int(dim)
     lower = np.asarray(problem.lower, dtype=np.float64).reshape(-1)

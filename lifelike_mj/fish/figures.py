@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from matplotlib.figure import Figure
 
+from lifelike_mj import checks
 from lifelike_mj.errors import UserError
 from lifelike_mj.render.plot import finish, png_path
 from lifelike_mj.render.plot import new_figure as _new_figure
@@ -70,9 +71,9 @@ def tracks_figure(result: SwimResult, out_path: str | os.PathLike | None = None,
     """
     out = None if out_path is None else png_path(out_path, "tracks figure")
     n = result.n_fish
-    if isinstance(fish, bool) or not isinstance(fish, (int, np.integer)) or not 0 <= fish < n:
+    if not checks.is_whole(fish) or not 0 <= fish < n:
         raise UserError(f"fish must be a whole number from 0 to {n - 1}, got {fish!r}.")
-    if isinstance(duration_s, bool) or not isinstance(duration_s, (int, float)) or not duration_s > 0:
+    if not checks.is_number(duration_s) or not duration_s > 0:
         raise UserError(f"duration must be a positive number of seconds, got {duration_s!r}.")
     t_all = np.asarray(result.times_s, dtype=float)
     keep = t_all <= t_all[0] + duration_s + 1e-9
@@ -150,7 +151,7 @@ def accel_histogram_figure(result: SwimResult, out_path: str | os.PathLike | Non
     from lifelike_mj.fish.metrics import VIDEO_FPS, accel_histogram, histogram_summary, kurtosis
 
     out = None if out_path is None else png_path(out_path, "acceleration histogram")
-    if isinstance(body_length_m, bool) or not isinstance(body_length_m, (int, float)) or not body_length_m > 0:
+    if not checks.is_number(body_length_m) or not body_length_m > 0:
         raise UserError(f"the body length must be a positive number of m, got {body_length_m!r}.")
     a = side_accelerations_bl(result, body_length_m)
     finite = a[np.isfinite(a)]

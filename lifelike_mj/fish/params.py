@@ -52,6 +52,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lifelike_mj import checks
 from lifelike_mj.errors import UserError
 from lifelike_mj.paths import controllers_dir, load_named_json
 
@@ -116,7 +117,7 @@ class FishParams:
             v = getattr(self, f.name)
             vals = v if isinstance(v, tuple) else (v,)
             for x in vals:
-                if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+                if not checks.is_number(x) or not math.isfinite(x):
                     raise UserError(f"fish parameter {f.name} must be a finite number, got {v!r}.")
             if isinstance(v, tuple) and len(v) != 3:
                 raise UserError(f"fish parameter {f.name} must have 3 values (x, y, z), got {len(v)}.")

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from lifelike_mj import checks
 from lifelike_mj.errors import UserError
 from lifelike_mj.paths import model_path
 
@@ -104,7 +105,7 @@ def build_scene(n_fish: int, size=None, spec: mujoco.MjSpec | None = None, nuser
     The fish are attached in groups of 32 (MjSpec's attach slows down as the target grows; groups
     keep 1,000 fish under a second). Fish ``i`` is body ``s<i // 32>/f<i>/fish``. ``nuserdata``: size of
     ``mjData.userdata`` (the simulation's per-model parameters)."""
-    if isinstance(n_fish, bool) or not isinstance(n_fish, (int, np.integer)) or n_fish < 1:
+    if not checks.is_whole(n_fish) or n_fish < 1:
         raise UserError(f"the number of fish must be a whole number of at least 1, got {n_fish!r}.")
     n_fish = int(n_fish)
     if spec is None:

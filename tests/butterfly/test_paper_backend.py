@@ -127,3 +127,16 @@ def test_gravity_only_glide_starts_as_free_fall():
     assert np.all(tr.y - free <= drag_bound + 1e-15)
     assert abs(tr.y[-1] / free[-1] - 1.0) < 1e-3
     assert np.all(tr.z == 0.0) and np.all(tr.vz == 0.0)
+
+
+def test_the_paper_backend_does_not_import_mujoco():
+    """`butterfly fly` on the paper backend must not pay for MuJoCo (issue 12, start-up)."""
+    import subprocess
+    import sys
+
+    code = ("import sys\nimport lifelike_mj\nassert 'mujoco' not in sys.modules and 'numba' not in sys.modules\n"
+            "from lifelike_mj.cli import main\nmain(['butterfly', 'fly', '--controller', 'simple_rule', '--duration', "
+            "'1', '--json'])\nprint('mujoco' in sys.modules)\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert r.stdout.strip().splitlines()[-1] == "False"
