@@ -196,3 +196,23 @@ def write_sweep(result: dict, sweep: Sweep, values: list[list[float]], out_dir: 
         phase_diagram_figure(labels, values[0], values[1], sweep.axes[0], sweep.axes[1], out / "phase_diagram.png")
         files.append(out / "phase_diagram.png")
     return [str(f) for f in files]
+
+
+def measured_run(params: BoidParams, n: int = N_AGENTS, seed: int = 0, n_steps: int | None = None,
+                 progress: bool = False) -> tuple[BoidRun, dict]:
+    """:func:`classified_run` as ``boids run`` reports it: ``(run, result)`` with ``result`` holding the
+    label, the classifier's reasons, every measure, and the run's settings and wall time."""
+    run, m, label, reasons = classified_run(params, n, seed, n_steps, progress=progress)
+    result = {"label": label, "reasons": reasons, **m, "preset": params.name, "n": n, "seed": seed,
+              "steps": int(run.steps[-1]), "dims": params.dims, "wall_time_s": run.wall_time_s}
+    return run, result
+
+
+def write_run(run: BoidRun, result: dict, out_dir: str | Path) -> list[str]:
+    """A run's files, as ``boids run --out`` writes them: the trajectories (npz, CSV) and
+    ``measures.json`` (``result`` of :func:`measured_run`). Atomic; returns the trajectory files."""
+    from lifelike_mj.io import write_json
+
+    files = write_trajectories(run, out_dir)
+    write_json(Path(out_dir) / "measures.json", result)
+    return [str(f) for f in files.values()]

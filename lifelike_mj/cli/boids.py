@@ -52,28 +52,24 @@ def _axis(spec: str) -> tuple[str, list[float]]:
 
 
 def cmd_run(args) -> None:
-    from lifelike_mj.boids.experiments import classified_run, write_trajectories
+    from lifelike_mj.boids.experiments import measured_run, write_run
 
     params = _params(args)
     if args.n < 2:
         raise UserError(f"--n must be at least 2, got {args.n}.")
     if args.steps is not None and args.steps < 10:
         raise UserError(f"--steps must be at least 10, got {args.steps}.")
-    run, m, label, reasons = classified_run(params, args.n, args.seed, args.steps, progress=not args.json)
-    out = {"label": label, "reasons": reasons, **m, "preset": params.name, "n": args.n, "seed": args.seed,
-           "steps": int(run.steps[-1]), "dims": params.dims, "wall_time_s": run.wall_time_s}
+    run, out = measured_run(params, args.n, args.seed, args.steps, progress=not args.json)
     if args.plot:
         from lifelike_mj.boids.figures import pattern_figure
 
-        pattern_figure(run, args.plot, title=f"{params.name}: classified {label}")
+        pattern_figure(run, args.plot, title=f"{params.name}: classified {out['label']}")
     if args.out:
-        from lifelike_mj.io import write_json
-
-        files = write_trajectories(run, args.out)
-        write_json(Path(args.out) / "measures.json", out)
-        out["files"] = [str(f) for f in files.values()]
-    emit(args, out, f"{params.name}, n = {args.n}, seed {args.seed}, {out['steps']} steps: classified {label} "
-         f"(segregation index {m.get('segregation_index', float('nan')):.2f}, groups {m.get('n_groups')})")
+        out["files"] = write_run(run, dict(out), args.out)
+    seg = out.get("segregation_index")
+    seg_text = "n/a (one type)" if seg is None else f"{seg:.2f}"
+    emit(args, out, f"{params.name}, n = {args.n}, seed {args.seed}, {out['steps']} steps: classified {out['label']} "
+         f"(segregation index {seg_text}, groups {out.get('n_groups')})")
 
 
 def cmd_sweep(args) -> None:
