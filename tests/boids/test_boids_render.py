@@ -13,6 +13,7 @@ from lifelike_mj.boids import render as boids_video
 from lifelike_mj.boids import scene
 from lifelike_mj.boids.engine import BoidParams, BoidRun, simulate
 from lifelike_mj.boids.presets import PATTERNS, homogeneous, load_preset
+from lifelike_mj.boids.sim import Flock
 from lifelike_mj.errors import UserError
 from lifelike_mj.render.video import advance_to
 
@@ -122,7 +123,7 @@ def test_top_frame_of_a_2d_run(gl_backend):
 
 def test_streamed_run_is_the_simulated_run():
     params = load_preset("4c")
-    run = boids_video._flock(params, 30, 2)
+    run = Flock(params, 30, 2)
     advance_to(run, 3)
     advance_to(run, 7)
     ref = simulate(params, n=30, n_steps=7, seed=2, record_from=7)

@@ -11,7 +11,7 @@ from lifelike_mj.errors import UserError
 from lifelike_mj.fish import figures as fish_figures
 from lifelike_mj.fish import render as fish_video
 from lifelike_mj.fish.params import load_preset
-from lifelike_mj.fish.sim import swim
+from lifelike_mj.fish.sim import Tank, swim
 from lifelike_mj.render import viewer
 from lifelike_mj.render.video import advance_to
 
@@ -173,7 +173,7 @@ def test_view_fish_loop_with_a_stand_in_viewer(monkeypatch, params, stand_in_vie
 def test_chunked_stepping_is_the_swim(params):
     """Advancing by frames (control steps 0, 3, 5, 8) reaches the state ``swim`` records."""
     ref = swim(params, n_fish=3, duration_s=8 / 60, seed=4)
-    sw = fish_video._tank(params, 3, 4, None)
+    sw = Tank(params, 3, 4)
     for k in fish_video.frame_steps(4, 24.0, 60.0):
         advance_to(sw, int(k))
     pos, _quat = sw.snapshot()
