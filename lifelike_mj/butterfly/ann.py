@@ -82,6 +82,19 @@ def scaled_inputs(cp, theta, omega, y, vy, vz, air_y, air_z, phi_prev):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def pitch_step(cp, phi_prev, out):
+    """The new pitch (rad) from the output neuron's sum ``out``: a change of at most ``max_dphi``
+    (``G(out)`` scaled), the pitch clipped to ``[-phi_limit, phi_limit]`` (section 6.3)."""
+    phi = phi_prev + cp[A_DMAX] * transfer(out)
+    lim = cp[A_LIMIT]
+    if phi > lim:
+        phi = lim
+    elif phi < -lim:
+        phi = -lim
+    return phi
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def ann_pitch(cp, theta, omega, y, vy, vz, air_y, air_z, phi_prev):
     """New pitch (rad) from the previous pitch ``phi_prev`` (rad), flap angle ``theta`` (rad) and
     rate ``omega`` (rad/s), altitude ``y`` (m, relative to the start), ground velocities ``vy``
@@ -92,13 +105,7 @@ def ann_pitch(cp, theta, omega, y, vy, vz, air_y, air_z, phi_prev):
         b = A_W + 7 * h
         s = cp[b] * x0 + cp[b + 1] * x1 + cp[b + 2] * x2 + cp[b + 3] * x3 + cp[b + 4] * x4 + cp[b + 5] * x5 + cp[b + 6]
         out += cp[A_W + 42 + h] * transfer(s)
-    phi = phi_prev + cp[A_DMAX] * transfer(out)
-    lim = cp[A_LIMIT]
-    if phi > lim:
-        phi = lim
-    elif phi < -lim:
-        phi = -lim
-    return phi
+    return pitch_step(cp, phi_prev, out)
 
 
 def default_scales(flap) -> dict:
@@ -215,10 +222,4 @@ def mlp_pitch(cp, theta, omega, y, vy, vz, air_y, air_z, phi_prev):
                 cp[b + j] = transfer(s + cp[w + n_in])
             w += n_in + 1
         a, b = b, a
-    phi = phi_prev + cp[A_DMAX] * transfer(out)
-    lim = cp[A_LIMIT]
-    if phi > lim:
-        phi = lim
-    elif phi < -lim:
-        phi = -lim
-    return phi
+    return pitch_step(cp, phi_prev, out)
