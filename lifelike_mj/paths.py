@@ -68,13 +68,12 @@ def read_json(path: str | Path, what: str) -> object:
     not readable UTF-8 JSON, or larger than :data:`MAX_JSON_BYTES`, is a :class:`UserError`."""
     p = Path(path)
     try:
-        if p.stat().st_size > MAX_JSON_BYTES:
-            raise UserError(f"{what} file {p} is larger than {MAX_JSON_BYTES // 1_000_000} MB; it cannot be one.")
-        return json.loads(p.read_text(encoding="utf-8"), parse_constant=_no_constant)
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError, ValueError) as exc:
-        if isinstance(exc, UserError):
-            raise
+        too_big = p.stat().st_size > MAX_JSON_BYTES
+        if not too_big:
+            return json.loads(p.read_text(encoding="utf-8"), parse_constant=_no_constant)
+    except (OSError, ValueError) as exc:  # UnicodeDecodeError and JSONDecodeError are ValueErrors
         raise UserError(f"{what} file {p} is not readable JSON ({exc.__class__.__name__}).") from None
+    raise UserError(f"{what} file {p} is larger than {MAX_JSON_BYTES // 1_000_000} MB; it cannot be one.")
 
 
 def load_named_json(creature: str, name_or_path: str | Path, what: str) -> tuple[object, Path]:

@@ -102,7 +102,3 @@ class Playback(StepCounter):
     def sync(self) -> None:
         self._pose(self.frame)
 
-
-def frames_at(times_s: np.ndarray, dt: float) -> np.ndarray:
-    """The step nearest to each time in ``times_s`` (s) for steps ``dt`` seconds apart, halves up."""
-    return np.floor(np.asarray(times_s, dtype=float) / dt + 0.5 + 1e-9).astype(np.int64)

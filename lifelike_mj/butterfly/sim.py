@@ -90,7 +90,20 @@ class Flight(StepCounter):
         self._air_z, self._air_y = self.condition.air_velocity()
         self._model = _model
         self._view = None
+        self._kernels()
         self.reset()
+
+    def _kernels(self) -> None:
+        """The compiled stepping functions of this backend and pitch law, resolved once."""
+        law = self._compiled_law
+        if self.backend == "paper":
+            from lifelike_mj.butterfly.backends import paper
+
+            self._fly = paper.fly_steps if law is None else paper.fly_steps_with(law)
+            return
+        from lifelike_mj.butterfly.backends import mj
+
+        self._advance_fn, self._record_fn = (mj.advance, mj.record_steps) if law is None else mj.steppers_with(law)
 
     # ---- the stepper shape ---------------------------------------------------------------------
 
@@ -121,7 +134,11 @@ class Flight(StepCounter):
     @property
     def fitness(self) -> float:
         """``H`` of Oe 2010 eq. 13 summed over the steps flown (dimensionless)."""
-        return float(self._s[7]) if self.backend == "paper" else float(self._fit[0])
+        if self.backend == "paper":
+            from lifelike_mj.butterfly.backends.paper import S_FIT
+
+            return float(self._s[S_FIT])
+        return float(self._fit[0])
 
     def step(self, n: int = 1) -> None:
         """Advance ``n`` time steps. A runaway speed raises :class:`~lifelike_mj.errors.Diverged`
@@ -233,16 +250,22 @@ class Flight(StepCounter):
         return (q[lay.q_height], q[lay.q_forward], v[lay.d_height], v[lay.d_forward], phi, q[lay.q_flap_left])
 
     def _advance(self, n: int, every: int, out: np.ndarray, r0: int) -> None:
-        """``n`` steps, recording every ``every`` (0: no recording) into ``out`` from row ``r0``."""
-        if self._python_law:
-            self._advance_python(n, every, out, r0)
-        elif self.backend == "paper":
-            self._paper(self._kind, self._cp, n, every, out, r0)
-        else:
-            self._mujoco(self._kind, self._cp, n, every, out, r0)
+        """``n`` steps, recording every ``every`` (0: no recording) into ``out`` from row ``r0``. On the
+        MuJoCo backend the compiled passive callback is installed for the whole call."""
+        if self.backend == "paper":
+            self._steps(self._paper, n, every, out, r0)
+            return
+        from lifelike_mj.butterfly.backends.mj import COMPILED_PASSIVE
+        from lifelike_mj.physics.callbacks import passive_callback
 
-    def _advance_python(self, n: int, every: int, out: np.ndarray, r0: int) -> None:
-        """Steps of a Python pitch law: the law from Python, then one compiled step at that pitch."""
+        with passive_callback(COMPILED_PASSIVE):
+            self._steps(self._mujoco, n, every, out, r0)
+
+    def _steps(self, kernel, n: int, every: int, out: np.ndarray, r0: int) -> None:
+        if not self._python_law:
+            kernel(self._kind, self._cp, n, every, out, r0)
+            return
+        # a Python pitch law: the law from Python, then one compiled step at that pitch
         for i in range(n):
             obs = self.observation()
             try:
@@ -253,19 +276,15 @@ class Flight(StepCounter):
                 raise UserError(f"the pitch law returned {phi} at step {self._k}; a pitch is a finite angle in rad.")
             rec = bool(every) and (i + 1) % every == 0
             row = r0 + (i + 1) // every - 1 if every else 0
-            step = self._paper if self.backend == "paper" else self._mujoco
-            step(KIND_CONSTANT, np.array([phi]), 1, 1 if rec else 0, out if rec else out[:0], row)
+            kernel(KIND_CONSTANT, np.array([phi]), 1, 1 if rec else 0, out if rec else out[:0], row)
             if self.diverged_step >= 0:
                 if every:
                     out[r0 + i // every:] = np.nan
                 return
 
     def _paper(self, kind: int, cp: np.ndarray, n: int, every: int, out: np.ndarray, r0: int) -> None:
-        from lifelike_mj.butterfly.backends import paper
-
-        fn = paper.fly_steps if self._compiled_law is None else paper.fly_steps_with(self._compiled_law)
-        dv, _ = fn(kind, cp, self._flap, self._air_z, self._air_y, self._consts, self._s, self._k, n, self.dt,
-                   every if every else n + 1, out, r0)
+        dv, _ = self._fly(kind, cp, self._flap, self._air_z, self._air_y, self._consts, self._s, self._k, n, self.dt,
+                          every if every else n + 1, out, r0)
         if dv >= 0:
             self.diverged_step = int(dv)
             self._k = int(dv)
@@ -273,19 +292,14 @@ class Flight(StepCounter):
             self._k += n
 
     def _mujoco(self, kind: int, cp: np.ndarray, n: int, every: int, out: np.ndarray, r0: int) -> None:
-        from lifelike_mj.butterfly.backends import mj
-        from lifelike_mj.physics.callbacks import passive_callback
-
         m, d = self._model, self._data
-        with passive_callback(mj.COMPILED_PASSIVE):
-            if every:
-                fn = mj.record_steps if self._compiled_law is None else mj.steppers_with(self._compiled_law)[1]
-                self._phi = fn(m._address, d._address, d.qpos, d.qvel, d.userdata, self._k, n, every, kind, cp,
-                               self._flap, 0.0, self._lay_a, self.dt, self._phi, out, r0, self._diverged, self._fit)
-            else:
-                fn = mj.advance if self._compiled_law is None else mj.steppers_with(self._compiled_law)[0]
-                self._phi = fn(m._address, d._address, d.qpos, d.qvel, d.userdata, self._k, n, kind, cp, self._flap,
-                               0.0, self._lay_a, self.dt, self._phi, self._diverged, self._fit)
+        if every:
+            self._phi = self._record_fn(m._address, d._address, d.qpos, d.qvel, d.userdata, self._k, n, every, kind, cp,
+                                        self._flap, 0.0, self._lay_a, self.dt, self._phi, out, r0, self._diverged,
+                                        self._fit)
+        else:
+            self._phi = self._advance_fn(m._address, d._address, d.qpos, d.qvel, d.userdata, self._k, n, kind, cp,
+                                         self._flap, 0.0, self._lay_a, self.dt, self._phi, self._diverged, self._fit)
         if self._diverged[0] >= 0:
             self.diverged_step = int(self._diverged[0])
             self._k = self.diverged_step

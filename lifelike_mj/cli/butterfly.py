@@ -7,7 +7,8 @@ import math
 import sys
 from pathlib import Path
 
-from lifelike_mj.cli.common import add_json, emit, positive
+from lifelike_mj.checks import positive
+from lifelike_mj.cli.common import add_json, emit
 from lifelike_mj.errors import UserError
 
 NAME = "butterfly"

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 
 from lifelike_mj.errors import UserError
 
@@ -20,13 +19,6 @@ class Parser(argparse.ArgumentParser):
 def emit(args: argparse.Namespace, data: dict, human: str) -> None:
     """Print ``data`` as strict-ish indented JSON with ``--json``, else the sentence ``human``."""
     print(json.dumps(data, indent=2) if getattr(args, "json", False) else human)
-
-
-def positive(name: str, value: float) -> float:
-    """``value`` if it is a finite number > 0, else a :class:`UserError` naming the option."""
-    if not (math.isfinite(value) and value > 0):
-        raise UserError(f"{name} must be a positive number, got {value}.")
-    return value
 
 
 def add_json(p: argparse.ArgumentParser) -> None:

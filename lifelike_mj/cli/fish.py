@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from lifelike_mj.cli.common import add_json, emit, positive
+from lifelike_mj.checks import positive
+from lifelike_mj.cli.common import add_json, emit
 from lifelike_mj.errors import UserError
 
 NAME = "fish"
