@@ -9,6 +9,8 @@ Both hold one folder per creature: ``models/butterfly/butterfly.xml``,
 from __future__ import annotations
 
 import json
+import os
+from collections.abc import Iterable
 from pathlib import Path
 
 from lifelike_mj.errors import UserError
@@ -53,14 +55,79 @@ def resolve(creature: str, name_or_path: str | Path, what: str) -> Path:
     text = str(name_or_path)
     path = Path(text)
     if text.endswith(".json") or path.exists():
-        if not path.is_file():
-            raise UserError(f"{what} file {text} does not exist.")
-        return path
+        return existing_file(path, what)
     path = controllers_dir() / creature / f"{text}.json"
     if not path.is_file():
         raise UserError(f"unknown {what} {text!r}; shipped: {', '.join(shipped_names(creature))} "
                         "(or give the path of a JSON file).")
     return path
+
+
+def existing_file(path: str | Path, what: str) -> Path:
+    """``path`` if it is an existing regular file; else a :class:`UserError` saying what it is instead."""
+    p = Path(path)
+    if not p.exists():
+        raise UserError(f"{what} file {p} does not exist.")
+    if p.is_dir():
+        raise UserError(f"{what} file {p} is a folder, not a file.")
+    if not p.is_file():
+        raise UserError(f"{what} file {p} is not a regular file (a pipe or a device?).")
+    return p
+
+
+def _existing_parent(path: Path) -> Path:
+    parent = path.absolute().parent
+    while not parent.exists():
+        parent = parent.parent
+    return parent
+
+
+def check_writable(path: str | Path, what: str = "output") -> Path:
+    """Before any work: :class:`UserError` unless a file could be written at ``path`` (its folder exists
+    or can be made, and is writable; ``path`` itself is not a folder or another kind of file)."""
+    p = Path(path)
+    if p.exists() and p.is_dir():
+        raise UserError(f"{what} {p} is a folder; give a file name.")
+    if p.exists() and not p.is_file():
+        raise UserError(f"{what} {p} exists and is not a regular file.")
+    parent = _existing_parent(p)
+    if not parent.is_dir():
+        raise UserError(f"{what} {p} cannot be written: {parent} is a file, not a folder.")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise UserError(f"{what} {p} cannot be written: no permission to write in {parent}.")
+    return p
+
+
+def check_output_file(path: str | Path, what: str, *, suffixes: Iterable[str] = (), overwrite: bool = False) -> Path:
+    """Before any work: the file ``path`` may be written (:func:`check_writable`), ends in one of
+    ``suffixes`` (if given), and does not exist unless ``overwrite``."""
+    p = Path(path)
+    suffixes = tuple(suffixes)
+    if suffixes and p.suffix.lower() not in suffixes:
+        raise UserError(f"{what} must end in {' or '.join(suffixes)}, got {str(p)!r}.")
+    check_writable(p, what)
+    if p.exists() and not overwrite:
+        raise UserError(f"{what} {p} already exists; add --overwrite to replace it.")
+    return p
+
+
+def check_output_dir(path: str | Path, what: str, names: Iterable[str] = (), *, overwrite: bool = False) -> Path:
+    """Before any work: the folder ``path`` may be made or written into, and none of the files ``names``
+    it will hold exists yet unless ``overwrite``."""
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        raise UserError(f"{what} {p} is a file; give a folder.")
+    parent = p if p.exists() else _existing_parent(p)
+    if not parent.is_dir():
+        raise UserError(f"{what} {p} cannot be made: {parent} is a file, not a folder.")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise UserError(f"{what} {p} cannot be written: no permission to write in {parent}.")
+    if not overwrite:
+        there = [n for n in names if (p / n).exists()]
+        if there:
+            raise UserError(f"{what} {p} already holds {', '.join(there[:3])}{' ...' if len(there) > 3 else ''}; "
+                            "add --overwrite to replace them, or choose another folder.")
+    return p
 
 
 def read_json(path: str | Path, what: str) -> object:

@@ -248,24 +248,46 @@ def evolve_controller(problem: PitchProblem, optimizer: str, seed: int, out: str
                       population: int | None = None, generations: int | None = None, evaluations: int | None = None,
                       executor: str = "process", workers: int | None = None, ray_address: str | None = None,
                       checkpoint: str | Path | None = None, resume: bool = False, progress: bool = True,
-                      task: str = "", command: str = ""):
+                      task: str = "", command: str = "", overwrite: bool = False):
     """Run an optimiser on ``problem`` and write the best network as a controller file ``out``
     (atomically, also when stopped by Ctrl-C: then with ``"interrupted": true`` in its provenance).
 
-    Returns ``(result, controller)``. The checkpoint (default ``out`` + ``.ckpt``) is written every
-    generation; ``resume`` continues from it."""
+    Returns ``(result, controller)``; the controller is ``None`` when the run was stopped before its
+    first generation was evaluated (nothing is written then). The checkpoint (default ``out`` +
+    ``.ckpt``) is written every generation; ``resume`` continues from it.
+
+    Nothing is lost: before any work, an existing ``out`` or checkpoint is refused unless ``resume`` or
+    ``overwrite`` is given, a checkpoint equal to ``out`` is refused, and both files are locked for the
+    whole run, so a second run on the same files stops at once with a sentence.
+    """
     from lifelike_mj import __version__
     from lifelike_mj.evolve import make_evaluator, optimize
-    from lifelike_mj.io import write_json
+    from lifelike_mj.evolve.checkpoint import check_checkpoint_path
+    from lifelike_mj.io import exclusive, write_json
+    from lifelike_mj.paths import check_output_file, check_writable
 
     out = Path(out)
     ckpt = Path(checkpoint) if checkpoint else out.with_name(out.name + ".ckpt")
-    with make_evaluator(problem, executor=executor, workers=workers, ray_address=ray_address) as ev:
-        res = optimize(problem, optimizer, seed=seed, population=population, generations=generations,
-                       evaluations=evaluations, evaluator=ev, checkpoint=ckpt, resume=resume, progress=progress)
-    if not np.all(np.isfinite(res.best_x)):
-        raise UserError(f"stopped before the first generation was evaluated; no controller written "
-                        f"(the checkpoint {ckpt} holds nothing yet).")
+    if ckpt.absolute().resolve() == out.absolute().resolve():
+        raise UserError(f"the checkpoint and the controller file are the same file ({out}); give another --checkpoint.")
+    check_output_file(out, "--out", suffixes=(".json",), overwrite=True)
+    check_writable(ckpt, "checkpoint")
+    with exclusive(out, "--out"), exclusive(ckpt, "checkpoint"):
+        check_output_file(out, "--out", suffixes=(".json",), overwrite=overwrite or resume)
+        check_checkpoint_path(ckpt, resume=resume, overwrite=overwrite)
+        with make_evaluator(problem, executor=executor, workers=workers, ray_address=ray_address) as ev:
+            res = optimize(problem, optimizer, seed=seed, population=population, generations=generations,
+                           evaluations=evaluations, evaluator=ev, checkpoint=ckpt, resume=resume, progress=progress,
+                           overwrite=overwrite)
+        if not np.all(np.isfinite(res.best_x)):
+            return res, None
+        ctrl = _evolved_controller(problem, res, out, task, command, generations, evaluations, executor, __version__)
+        write_json(out, ctrl.to_dict())
+    return res, ctrl
+
+
+def _evolved_controller(problem: PitchProblem, res, out: Path, task: str, command: str, generations: int | None,
+                        evaluations: int | None, executor: str, version: str):
     prov = {
         "source": "lifelike-mj butterfly evolve",
         "command": command,
@@ -283,10 +305,8 @@ def evolve_controller(problem: PitchProblem, optimizer: str, seed: int, out: str
         "resumed": bool(res.resumed),
         "executor": executor,
         "wall_time_s": float(res.wall_time_s),
-        "package_version": __version__,
+        "package_version": version,
         "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
         "fitness_history": [dict(h) for h in res.history],
     }
-    ctrl = problem.controller(res.best_x, prov, out.stem)
-    write_json(out, ctrl.to_dict())
-    return res, ctrl
+    return problem.controller(res.best_x, prov, out.stem)

@@ -123,8 +123,9 @@ def main(argv: list[str] | None = None) -> int:
     except UserError as exc:
         print(f"lifelike-mj: error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("lifelike-mj: interrupted.", file=sys.stderr)
+    except KeyboardInterrupt as exc:
+        why = f": {exc.args[0]}" if exc.args and isinstance(exc.args[0], str) and " " in exc.args[0] else ""
+        print(f"lifelike-mj: interrupted{why}.", file=sys.stderr)
         return 130
     except BrokenPipeError:  # the reader went away (`lifelike-mj ... | head`): stop quietly
         import os

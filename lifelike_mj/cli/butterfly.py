@@ -154,13 +154,13 @@ def cmd_evolve(args) -> None:
         gens = 1000  # the paper's budget (section 6.3)
     problem = make_problem(args.task, args.backend, args.inputs, params(args), hidden=args.hidden)
     out = Path(args.out or f"butterfly_{args.optimizer}_{args.task}_s{args.seed}.json")
-    if out.suffix != ".json":
-        raise UserError(f"--out must be a .json file, got {str(out)!r}.")
     res, ctrl = evolve_controller(problem, args.optimizer, args.seed, out, population=args.population,
                                   generations=gens, evaluations=args.evaluations, executor=args.executor,
                                   workers=args.workers, ray_address=args.ray_address, checkpoint=args.checkpoint,
                                   resume=args.resume, progress=not args.quiet, task=args.task,
-                                  command="lifelike-mj " + " ".join(sys.argv[1:]))
+                                  command="lifelike-mj " + " ".join(sys.argv[1:]), overwrite=args.overwrite)
+    if ctrl is None:
+        raise KeyboardInterrupt("stopped before the first generation was evaluated; nothing was written")
     d = {"out": str(out), **{k: v for k, v in ctrl.provenance.items() if k not in ("fitness_history", "problem")}}
     state = "stopped early (Ctrl-C); best so far" if res.interrupted else "done"
     emit(args, d, f"{state}: best fitness H = {res.best_f:.1f} after {res.evaluations} evaluations "
@@ -267,6 +267,7 @@ def add_commands(sub) -> None:
     p.add_argument("--ray-address", default=None, help="Ray cluster address (default: start a local one)")
     p.add_argument("--checkpoint", default=None, help="checkpoint file (default: OUT.ckpt), written every generation")
     p.add_argument("--resume", action="store_true", help="continue from the checkpoint")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --out and checkpoint (a new run)")
     p.add_argument("--out", default=None, help="controller file to write (.json)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_json(p)

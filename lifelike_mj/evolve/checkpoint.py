@@ -1,63 +1,190 @@
-"""Checkpoint files: one pickled dict, replaced atomically after every generation.
+"""Checkpoint files: data only (an ``.npz`` read with ``allow_pickle=False``), replaced atomically after
+every generation.
 
-Layout (``version`` 1)::
+A checkpoint is a NumPy zip archive. Its member ``meta`` holds UTF-8 JSON (as ``uint8``); every array of
+the checkpoint is its own member ``a0``, ``a1``, ..., referred to from the JSON as ``{"__array__": "a0"}``.
+Non-finite floats are written as ``{"__float__": "nan" | "inf" | "-inf"}`` so the JSON stays strict.
+Reading one never runs code from the file: ``numpy.load(..., allow_pickle=False)`` refuses object
+arrays, and the JSON decoder builds only dicts, lists, strings and numbers.
+
+Layout of ``meta`` (``version`` 2)::
 
     format       "lifelike_mj.evolve.checkpoint"
-    version      1
+    version      2
     fingerprint  problem.fingerprint()
     dim, maximize
     optimizer    "rcga" | "cmaes" | "crs2" | "esch" | "isres"
     seed         int
     population   the resolved population size (int)
     budget       {"kind": "generations" | "evaluations", "value": int}
-    state        the optimiser's full state (its own dict: populations, RNG states, pickled CMA-ES, ...)
+    state        the optimiser's state: arrays, numbers and strings only
+                 (rcga: population, fitness, PCG64 state; cmaes: the fitness log that replays it;
+                 nlopt: the log of points and values)
     history      list of per-generation records
     best_x, best_f, evaluations, generations
     elapsed_s    optimisation seconds so far (summed over sessions)
     finished     True once the budget is spent
     saved_at     time.time() of writing
+    package      lifelike-mj version that wrote it
 
-Checkpoints are pickles: load only files you (or your runs) wrote.
+Version 1 files (lifelike-mj 0.2 and earlier) were pickles; they are refused, not read.
 """
 
 from __future__ import annotations
 
-import pickle
+import json
+import math
+import os
 import time
+import zipfile
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import atomic_path
 
 FORMAT = "lifelike_mj.evolve.checkpoint"
-VERSION = 1
+VERSION = 2
+#: Largest checkpoint read (bytes): a bigger file is refused before it is opened.
+MAX_BYTES = 2 * 1024**3
+_PICKLE_MAGIC = (b"\x80",)
+
+
+def _encode(value: Any, arrays: dict[str, np.ndarray]) -> Any:
+    if isinstance(value, np.ndarray):
+        if value.dtype == object:
+            raise TypeError("a checkpoint cannot hold object arrays")
+        key = f"a{len(arrays)}"
+        arrays[key] = value
+        return {"__array__": key}
+    if isinstance(value, dict):
+        if not all(isinstance(k, str) for k in value):
+            raise TypeError("checkpoint dict keys must be strings")
+        return {k: _encode(v, arrays) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_encode(v, arrays) for v in value]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        v = float(value)
+        return v if math.isfinite(v) else {"__float__": repr(v)}
+    if value is None or isinstance(value, str):
+        return value
+    raise TypeError(f"a checkpoint cannot hold a {type(value).__name__}")
+
+
+def _decode(value: Any, arrays: Any, path: Path) -> Any:
+    if isinstance(value, dict):
+        if set(value) == {"__array__"}:
+            key = value["__array__"]
+            if not isinstance(key, str) or key not in arrays.files:
+                raise UserError(f"checkpoint {path} is damaged (it refers to a missing array {key!r}).")
+            return arrays[key]
+        if set(value) == {"__float__"}:
+            if value["__float__"] not in ("nan", "inf", "-inf"):
+                raise UserError(f"checkpoint {path} is damaged (bad number {value['__float__']!r}).")
+            return float(value["__float__"])
+        return {k: _decode(v, arrays, path) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_decode(v, arrays, path) for v in value]
+    return value
 
 
 def save_checkpoint(path: str | Path, data: dict[str, Any]) -> None:
-    """Write ``data`` (without ``format``/``version``, which are added) atomically to ``path``."""
-    payload = {"format": FORMAT, "version": VERSION, **data, "saved_at": time.time()}
-    blob = pickle.dumps(payload, protocol=pickle.HIGHEST_PROTOCOL)
+    """Write ``data`` (without ``format``/``version``, which are added) atomically and durably to ``path``.
+
+    ``data`` may hold dicts with string keys, lists, tuples (read back as lists), strings, numbers,
+    booleans, ``None`` and NumPy arrays of numbers; anything else is a ``TypeError``.
+    """
+    from lifelike_mj import __version__
+
+    payload = {"format": FORMAT, "version": VERSION, **data, "saved_at": time.time(), "package": __version__}
+    arrays: dict[str, np.ndarray] = {}
+    meta = json.dumps(_encode(payload, arrays), allow_nan=False).encode("utf-8")
     with atomic_path(path) as tmp:
         with open(tmp, "wb") as fh:
-            fh.write(blob)
+            np.savez(fh, meta=np.frombuffer(meta, dtype=np.uint8), **arrays)
             fh.flush()
+            os.fsync(fh.fileno())
+
+
+def is_checkpoint(path: str | Path) -> bool:
+    """Whether ``path`` looks like a checkpoint of any version (a zip with ``meta``, or an old pickle)."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4)
+    except OSError:
+        return False
+    if head[:1] in _PICKLE_MAGIC:
+        return True
+    if head != b"PK\x03\x04":
+        return False
+    try:
+        with zipfile.ZipFile(path) as z:
+            return "meta.npy" in z.namelist()
+    except (zipfile.BadZipFile, OSError):
+        return False
+
+
+def check_checkpoint_path(path: str | Path, *, resume: bool, overwrite: bool) -> None:
+    """Before a run starts: :class:`UserError` unless ``path`` may be used as its checkpoint.
+
+    A path that is not a regular file is refused; an existing checkpoint without ``resume`` needs
+    ``overwrite``; an existing file that is not a checkpoint is never replaced; the folder must be writable.
+    """
+    path = Path(path)
+    if path.exists() and not path.is_file():
+        raise UserError(f"checkpoint {path} is not a regular file.")
+    if path.exists() and not resume:
+        if not is_checkpoint(path):
+            raise UserError(f"{path} exists and is not a checkpoint; it is not replaced (choose another --checkpoint).")
+        if not overwrite:
+            raise UserError(f"checkpoint {path} already exists: continue it with --resume, or replace it with "
+                            "--overwrite.")
+    from lifelike_mj.paths import check_writable
+
+    check_writable(path, what="checkpoint")
 
 
 def load_checkpoint(path: str | Path) -> dict[str, Any]:
-    """Read a checkpoint; :class:`UserError` if it is unreadable or not a checkpoint of this version."""
+    """Read a checkpoint; :class:`UserError` if it is unreadable, an old pickle, or not a checkpoint of this
+    version. ``FileNotFoundError`` if there is no file."""
     path = Path(path)
-    try:
-        with open(path, "rb") as fh:
-            data = pickle.load(fh)
-    except FileNotFoundError:
-        raise
-    except Exception as exc:  # truncated, not a pickle, classes that no longer exist, ...
-        raise UserError(f"checkpoint {path} is unreadable ({type(exc).__name__}: {exc}).") from exc
-    if not isinstance(data, dict) or data.get("format") != FORMAT:
+    if not path.exists():
+        raise FileNotFoundError(path)
+    if not path.is_file():
+        raise UserError(f"checkpoint {path} is not a regular file.")
+    if path.stat().st_size > MAX_BYTES:
+        raise UserError(f"checkpoint {path} is larger than {MAX_BYTES // 1024**3} GiB; not read.")
+    with open(path, "rb") as fh:
+        head = fh.read(4)
+    if head[:1] in _PICKLE_MAGIC:
+        raise UserError(f"checkpoint {path} is an old pickled checkpoint (lifelike-mj 0.2 or earlier); it is not "
+                        "read because a pickle can run code: start the run again without --resume.")
+    if head != b"PK\x03\x04":
         raise UserError(f"checkpoint {path} is not a lifelike_mj.evolve checkpoint.")
-    if data.get("version") != VERSION:
-        raise UserError(f"checkpoint {path} has format version {data.get('version')!r}, but this code reads version {VERSION}.")
+    try:
+        with np.load(path, allow_pickle=False) as arrays:
+            if "meta" not in arrays.files:
+                raise UserError(f"checkpoint {path} is not a lifelike_mj.evolve checkpoint.")
+            meta_raw = arrays["meta"]
+            if meta_raw.dtype != np.uint8 or meta_raw.ndim != 1:
+                raise UserError(f"checkpoint {path} is damaged (its meta is not text).")
+            meta = json.loads(meta_raw.tobytes().decode("utf-8"))
+            if not isinstance(meta, dict) or meta.get("format") != FORMAT:
+                raise UserError(f"checkpoint {path} is not a lifelike_mj.evolve checkpoint.")
+            if meta.get("version") != VERSION:
+                raise UserError(f"checkpoint {path} has format version {meta.get('version')!r}, but this code reads "
+                                f"version {VERSION}.")
+            data = _decode(meta, arrays, path)
+    except UserError:
+        raise
+    except Exception as exc:  # truncated zip, bad JSON, object arrays refused by allow_pickle=False, ...
+        raise UserError(f"checkpoint {path} is unreadable ({type(exc).__name__}: {str(exc)[:160]}).") from None
     return data
 
 

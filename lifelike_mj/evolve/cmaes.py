@@ -10,21 +10,27 @@
 * IPOP: when ``es.stop()`` reports any condition (pycma's own iteration/evaluation/time budgets are
   switched off, as the budget is ours), a new strategy starts with the population doubled.
 * Randomness: pycma draws its samples through its ``randn`` option. We give it its own
-  ``Generator(PCG64(SeedSequence([seed, restart])))`` (:class:`Randn`), which is pickled along with the
-  strategy, so a pickled ``es`` continues exactly. (pycma's ``seed`` option would instead seed numpy's
-  global RNG, and a pickled ``es`` would then sample from a detached copy of it.) For the few pycma
-  paths that use numpy's global RNG directly, we seed it per restart from ``SeedSequence([seed,
-  restart, 1])``, save its state in every checkpoint, and restore the caller's global state on return.
+  ``Generator(PCG64(SeedSequence([seed, restart])))`` (:class:`Randn`). (pycma's ``seed`` option would
+  instead seed numpy's global RNG.) For the few pycma paths that use numpy's global RNG directly, we
+  seed it per restart from ``SeedSequence([seed, restart, 1])`` and restore the caller's global state
+  on return. A run is therefore a deterministic function of the seed and the fitness values told.
+* Checkpoints hold data only: the fitness values of every generation so far (and their sizes), not
+  pycma's objects. Resuming rebuilds the strategy from the seed and replays every logged generation
+  (``ask``, then ``tell`` with the logged values; no fitness is evaluated), which reproduces the
+  interrupted run bit for bit. A SHA-256 of every candidate asked is stored and checked at the end of
+  the replay, so a different pycma that would ask other points is refused with a sentence. Replaying
+  costs pycma's own time only (about 3 ms per generation for 49 genes: 590 generations in 1.9 s).
 """
 
 from __future__ import annotations
 
+import hashlib
 import math
-import pickle
 from typing import Any
 
 import numpy as np
 
+from lifelike_mj.errors import UserError
 from lifelike_mj.evolve.driver import Run
 
 MIN_POPULATION = 4
@@ -38,7 +44,7 @@ def default_population(dim: int) -> int:
 
 
 class Randn:
-    """Picklable ``randn(*shape)`` for pycma, drawing from its own PCG64 generator."""
+    """``randn(*shape)`` for pycma, drawing from its own PCG64 generator."""
 
     def __init__(self, seed_sequence: np.random.SeedSequence) -> None:
         self.rng = np.random.Generator(np.random.PCG64(seed_sequence))
@@ -67,32 +73,61 @@ def _should_restart(es: Any) -> bool:
     return any(key not in BUDGET_KEYS for key in es.stop())
 
 
+def _cma_version() -> str:
+    import cma
+
+    return str(getattr(cma, "__version__", "unknown"))
+
+
 def run_cmaes(run: Run, lower: np.ndarray, upper: np.ndarray) -> None:
-    """Run IPOP-CMA-ES until ``run``'s budget is spent (continuing from ``run.state`` when resuming)."""
+    """Run IPOP-CMA-ES until ``run``'s budget is spent (replaying ``run.state``'s log when resuming)."""
     width = upper - lower
     sigma0 = 0.25 * float(np.mean(width))
     stds = None if np.all(width == width[0]) else width / np.mean(width)
+    replay: list[np.ndarray] = []
+    want_digest = ""
+    if run.state is not None:
+        F = np.asarray(run.state["F"], dtype=np.float64).reshape(-1)
+        sizes = np.asarray(run.state["sizes"], dtype=np.int64).reshape(-1)
+        if sizes.sum() != F.size or np.any(sizes < 1):
+            raise UserError(f"checkpoint {run.checkpoint} is damaged (its fitness log does not add up).")
+        replay = np.split(F, np.cumsum(sizes)[:-1]) if sizes.size else []
+        want_digest = str(run.state["digest"])
+    log_f: list[np.ndarray] = [f.copy() for f in replay]
+    digest = hashlib.sha256()
     caller_state = np.random.get_state()
+
+    def state() -> dict:
+        return {"F": np.concatenate(log_f) if log_f else np.zeros(0), "sizes": np.array([len(f) for f in log_f]),
+                "digest": digest.hexdigest(), "cma_version": _cma_version()}
+
     try:
-        if run.state is None:
-            rng = np.random.Generator(np.random.PCG64(run.seed))
-            es, restart = None, 0
-        else:
-            rng = np.random.Generator(np.random.PCG64())
-            rng.bit_generator.state = run.state["rng"]
-            es, restart = pickle.loads(run.state["es"]), int(run.state["restart"])
-            np.random.set_state(run.state["np_random"])
-        while not run.budget_reached():
+        rng = np.random.Generator(np.random.PCG64(run.seed))
+        es, restart, g = None, 0, 0
+        while g < len(replay) or not run.budget_reached():
             if es is None or _should_restart(es):
                 if es is not None:
                     restart += 1
                 x0 = 0.5 * (lower + upper) if restart == 0 else rng.uniform(lower, upper)
                 es = _new_strategy(x0, sigma0, stds, lower, upper, run.population * 2**restart, run.seed, restart)
             asked = es.ask()
-            f = run.evaluate(np.array(asked, dtype=np.float64))
+            X = np.array(asked, dtype=np.float64)
+            digest.update(X.tobytes())
+            if g < len(replay):
+                f = replay[g]
+                if len(f) != len(X):
+                    raise UserError(f"checkpoint {run.checkpoint} cannot be resumed: pycma asked for {len(X)} "
+                                    f"candidates in generation {g + 1}, the log has {len(f)} (another pycma version?).")
+            else:
+                f = run.evaluate(X)
+                log_f.append(f.copy())
             es.tell(asked, (-f if run.maximize else f).tolist())
-            run.end_generation(float(np.mean(f)), {
-                "es": pickle.dumps(es, protocol=pickle.HIGHEST_PROTOCOL), "restart": restart,
-                "popsize": int(es.popsize), "rng": rng.bit_generator.state, "np_random": np.random.get_state()})
+            g += 1
+            if g == len(replay) and digest.hexdigest() != want_digest:
+                raise UserError(f"checkpoint {run.checkpoint} cannot be resumed: replaying its {g} generations asked "
+                                f"for other points than the logged run (written by pycma "
+                                f"{run.state.get('cma_version')}, this is {_cma_version()}).")
+            if g > len(replay):
+                run.end_generation(float(np.mean(f)), state())
     finally:
         np.random.set_state(caller_state)

@@ -12,8 +12,9 @@ Common behaviour:
   :mod:`lifelike_mj.evolve.checkpoint`). ``resume=True`` continues from it; with no file there the run
   starts fresh; a checkpoint of a different problem, optimiser, seed, population or budget, or an
   unreadable file, raises :class:`UserError`; a finished checkpoint returns its result at once. Without
-  ``resume`` an existing file is overwritten. A resumed run ends with exactly the result (best, history,
-  evaluations) of an uninterrupted run with the same seed; only the times differ.
+  ``resume`` an existing checkpoint is refused unless ``overwrite=True`` (and a file that is not a
+  checkpoint is never replaced). Checkpoints hold data only (no pickle). A resumed run ends with
+  exactly the result (best, history, evaluations) of an uninterrupted run with the same seed; only the times differ.
 * Ctrl-C (KeyboardInterrupt, and SIGTERM while in the main thread) stops the run: the result has
   ``interrupted=True`` and the best so far; the checkpoint of the last finished generation stays valid.
 """
@@ -31,6 +32,7 @@ import numpy as np
 
 from lifelike_mj.errors import UserError
 from lifelike_mj.evolve import cmaes, nloptalgs, rcga
+from lifelike_mj.evolve.checkpoint import check_checkpoint_path
 from lifelike_mj.evolve.driver import Budget, OptimizationResult, Run
 from lifelike_mj.evolve.evaluators import Evaluator, make_evaluator
 from lifelike_mj.evolve.problem import check_problem
@@ -115,7 +117,7 @@ def optimize(problem: Any, optimizer: str, *, seed: int, population: int | None 
              evaluations: int | None = None, evaluator: Evaluator | Callable[[np.ndarray], np.ndarray] | None = None,
              checkpoint: str | Path | None = None, resume: bool = False, progress: bool = True,
              on_generation: Callable[[dict[str, Any]], object] | None = None, executor: str = "serial",
-             workers: int | None = None) -> OptimizationResult:
+             workers: int | None = None, overwrite: bool = False) -> OptimizationResult:
     """Optimise ``problem`` (see :class:`~lifelike_mj.evolve.problem.Problem`) with ``optimizer``.
 
     Args:
@@ -130,6 +132,7 @@ def optimize(problem: Any, optimizer: str, *, seed: int, population: int | None 
             a problem the pool cannot take runs serially with a warning naming the cause; ``ray``) and
             closed at the end.
         checkpoint: file to write after every generation; ``resume=True`` continues from it.
+        overwrite: replace an existing checkpoint when not resuming (otherwise refused).
         progress: show a tqdm progress bar on stderr.
         on_generation: called with each generation's record (a copy) after its checkpoint is written;
             raising KeyboardInterrupt there stops the run as Ctrl-C would.
@@ -154,6 +157,8 @@ def optimize(problem: Any, optimizer: str, *, seed: int, population: int | None 
     population = int(population)
     if resume and checkpoint is None:
         raise UserError("resume=True needs a checkpoint path.")
+    if checkpoint is not None:
+        check_checkpoint_path(checkpoint, resume=resume, overwrite=overwrite)
     own_evaluator = evaluator is None
     if evaluator is not None:
         other = getattr(evaluator, "problem", None)

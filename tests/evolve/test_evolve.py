@@ -24,7 +24,7 @@ from lifelike_mj.evolve import (
     optimize,
 )
 from lifelike_mj.evolve import rcga as ga
-from lifelike_mj.evolve.checkpoint import FORMAT, VERSION
+from lifelike_mj.evolve.checkpoint import FORMAT, VERSION, load_checkpoint, save_checkpoint
 
 ROOT = Path(__file__).resolve().parents[1]
 WORKER = Path(__file__).parent.parent / "evolve_worker.py"
@@ -240,13 +240,13 @@ def test_interrupt_then_resume_equals_uninterrupted(tmp_path, name, budget):
     part = _run(p, name, seed=3, checkpoint=ckpt, on_generation=_stop_at(4), **budget)
     assert part.interrupted and part.generations == 4
     assert part.best_f == full.history[3]["best"]
-    data = pickle.loads(ckpt.read_bytes())
+    data = load_checkpoint(ckpt)
     assert data["format"] == FORMAT and data["version"] == VERSION and not data["finished"]
     assert data["generations"] == 4 and data["optimizer"] == name
     rest = _run(p, name, seed=3, checkpoint=ckpt, resume=True, **budget)
     assert rest.resumed and not rest.interrupted
     _same(rest, full)
-    assert pickle.loads(ckpt.read_bytes())["finished"]
+    assert load_checkpoint(ckpt)["finished"]
     # a finished checkpoint returns its result without evaluating anything
     with make_evaluator(p, "serial") as ev:
         again = _run(p, name, seed=3, checkpoint=ckpt, resume=True, evaluator=ev, **budget)
@@ -257,14 +257,14 @@ def test_interrupt_then_resume_equals_uninterrupted(tmp_path, name, budget):
 def test_cmaes_resume_across_ipop_restart(tmp_path):
     p = Sphere(dim=2)
     ckpt = tmp_path / "c.ckpt"
-    restarts = []
+    sizes = []
     full = optimize(p, "cmaes", seed=5, population=4, generations=140, progress=False, checkpoint=ckpt,
-                    on_generation=lambda rec: restarts.append(pickle.loads(ckpt.read_bytes())["state"]["restart"]))
-    assert max(restarts) >= 1  # converged and restarted with a doubled population
-    first = restarts.index(1) + 1
+                    on_generation=lambda rec: sizes.append(int(load_checkpoint(ckpt)["state"]["sizes"][-1])))
+    assert max(sizes) >= 8  # converged and restarted with a doubled population
+    first = sizes.index(8) + 1
     for k in (first - 1, first + 3):
         optimize(p, "cmaes", seed=5, population=4, generations=140, progress=False, checkpoint=ckpt,
-                 on_generation=_stop_at(k))
+                 on_generation=_stop_at(k), overwrite=True)
         rest = optimize(p, "cmaes", seed=5, population=4, generations=140, progress=False, checkpoint=ckpt, resume=True)
         _same(rest, full)
 
@@ -288,9 +288,9 @@ def test_nlopt_replay_divergence_is_reported(tmp_path):
     p = Sphere(dim=3)
     ckpt = tmp_path / "n.ckpt"
     _run(p, "crs2", checkpoint=ckpt, on_generation=_stop_at(3))
-    data = pickle.loads(ckpt.read_bytes())
+    data = load_checkpoint(ckpt)
     data["state"]["X"][5, 0] += 1e-12
-    ckpt.write_bytes(pickle.dumps(data))
+    save_checkpoint(ckpt, {k: v for k, v in data.items() if k not in ("format", "version", "saved_at", "package")})
     with pytest.raises(UserError, match="diverged"):
         _run(p, "crs2", checkpoint=ckpt, resume=True)
 
@@ -313,7 +313,7 @@ def _wait_for_generation(proc, ckpt, k, timeout=30.0):
             pytest.fail(f"worker exited early: {proc.communicate()}")
         if ckpt.exists():
             try:
-                if pickle.loads(ckpt.read_bytes())["generations"] >= k:
+                if load_checkpoint(ckpt)["generations"] >= k:
                     return
             except Exception:
                 pass
@@ -352,7 +352,7 @@ def test_real_signal_then_resume(tmp_path, name, sig, executor):
         assert proc.returncode == 0, err
         result = json.loads(out.strip().splitlines()[-1])
         assert result["interrupted"] and result["generations"] < generations
-    done = pickle.loads(ckpt.read_bytes())["generations"]
+    done = load_checkpoint(ckpt)["generations"]
     assert 3 <= done < generations
     rest = optimize(p, name, seed=3, population=population, generations=generations, checkpoint=ckpt, resume=True,
                     progress=False)
@@ -445,12 +445,53 @@ def test_checkpoint_mismatches(tmp_path):
         _run(Sphere(dim=3), "rcga", population=13, checkpoint=ckpt, resume=True)
     with pytest.raises(UserError, match="budget generations=12"):
         _run(Sphere(dim=3), "rcga", generations=20, checkpoint=ckpt, resume=True)
-    ckpt.write_bytes(b"not a pickle")
-    with pytest.raises(UserError, match="unreadable"):
-        _run(Sphere(dim=3), "rcga", checkpoint=ckpt, resume=True)
-    ckpt.write_bytes(pickle.dumps({"format": "something else"}))
+    ckpt.write_bytes(b"not a checkpoint")
     with pytest.raises(UserError, match="not a lifelike_mj.evolve checkpoint"):
         _run(Sphere(dim=3), "rcga", checkpoint=ckpt, resume=True)
+    np.savez(ckpt.with_suffix(".npz"), meta=np.frombuffer(b'{"format": "something else"}', dtype=np.uint8))
+    ckpt.with_suffix(".npz").replace(ckpt)
+    with pytest.raises(UserError, match="not a lifelike_mj.evolve checkpoint"):
+        _run(Sphere(dim=3), "rcga", checkpoint=ckpt, resume=True)
+
+
+class _Marker:
+    """Unpickling this would write a marker file (what a crafted checkpoint would do)."""
+
+    def __init__(self, path):
+        self.path = str(path)
+
+    def __reduce__(self):
+        return (open, (self.path, "w"))
+
+
+def test_a_crafted_checkpoint_runs_no_code(tmp_path):
+    ckpt, marker = tmp_path / "evil.ckpt", tmp_path / "marker"
+    # an old-style pickled checkpoint whose loading would create the marker
+    ckpt.write_bytes(pickle.dumps({"format": FORMAT, "version": 1, "x": _Marker(marker)}))
+    with pytest.raises(UserError, match="pickle can run code"):
+        _run(Sphere(dim=3), "rcga", checkpoint=ckpt, resume=True)
+    # a zip checkpoint smuggling a pickled object array into one of its members
+    with open(ckpt, "wb") as fh:
+        np.savez(fh, meta=np.frombuffer(b'{"format": "%s", "version": %d, "state": {"__array__": "a0"}}'
+                                        % (FORMAT.encode(), VERSION), dtype=np.uint8),
+                 a0=np.array([_Marker(marker)], dtype=object))
+    with pytest.raises(UserError, match="unreadable"):
+        _run(Sphere(dim=3), "rcga", checkpoint=ckpt, resume=True)
+    assert not marker.exists()
+
+
+def test_checkpoint_is_strict_data(tmp_path):
+    """The checkpoint is a zip of .npy members; its meta is strict JSON (no NaN), readable without this package."""
+    import json
+    import zipfile
+
+    ckpt = tmp_path / "run.ckpt"
+    _run(Sphere(dim=3), "cmaes", checkpoint=ckpt, on_generation=_stop_at(3))
+    with zipfile.ZipFile(ckpt) as z:
+        assert all(n.endswith(".npy") for n in z.namelist())
+    with np.load(ckpt, allow_pickle=False) as z:
+        meta = json.loads(z["meta"].tobytes().decode(), parse_constant=lambda c: pytest.fail(f"bare {c} in meta"))
+        assert meta["format"] == FORMAT and meta["version"] == VERSION and meta["generations"] == 3
 
 
 def test_progress_bar_goes_to_stderr(capsys):

@@ -1,0 +1,92 @@
+"""Nothing a user made is lost: evolve refuses to replace a finished run, a checkpoint that is the
+controller file, or a file that is not a checkpoint; two runs cannot write one output."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from lifelike_mj.cli import main
+from lifelike_mj.io import exclusive
+
+
+@pytest.fixture
+def small_problem(monkeypatch):
+    from lifelike_mj.butterfly import evolution
+
+    def small(task, backend, inputs, params, hidden=None):
+        return evolution.PitchProblem(duration_s=0.2)
+
+    monkeypatch.setattr(evolution, "make_problem", small)
+
+
+def _evolve(tmp_path, *extra, out="ctrl.json"):
+    return ["butterfly", "evolve", "--optimizer", "rcga", "--population", "6", "--generations", "2", "--executor",
+            "serial", "--quiet", "--out", str(tmp_path / out), *extra]
+
+
+def test_rerun_on_a_finished_out_is_refused_and_changes_nothing(tmp_path, capsys, small_problem):
+    assert main(_evolve(tmp_path)) == 0
+    ctrl, ckpt = tmp_path / "ctrl.json", tmp_path / "ctrl.json.ckpt"
+    before = (ctrl.read_bytes(), ckpt.read_bytes())
+    capsys.readouterr()
+    assert main(_evolve(tmp_path, "--seed", "1")) == 2
+    err = capsys.readouterr().err
+    assert "already exists" in err and "--overwrite" in err and "Traceback" not in err
+    assert (ctrl.read_bytes(), ckpt.read_bytes()) == before
+    # --resume on the finished run returns it unchanged; --overwrite starts a new one
+    assert main(_evolve(tmp_path, "--resume")) == 0
+    assert json.loads(ctrl.read_text())["parameters"] == json.loads(before[0])["parameters"]
+    assert main(_evolve(tmp_path, "--seed", "1", "--overwrite")) == 0
+    assert json.loads(ctrl.read_text())["provenance"]["seed"] == 1
+
+
+def test_checkpoint_equal_to_out_is_refused(tmp_path, capsys, small_problem):
+    assert main(_evolve(tmp_path, "--checkpoint", str(tmp_path / "ctrl.json"))) == 2
+    assert "same file" in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())
+
+
+def test_an_unrelated_file_is_never_turned_into_a_checkpoint(tmp_path, capsys, small_problem):
+    notes = tmp_path / "notes.txt"
+    notes.write_text("my notes\n")
+    for extra in ([], ["--overwrite"], ["--resume"]):
+        assert main(_evolve(tmp_path, "--checkpoint", str(notes), *extra)) == 2
+        assert "not a" in capsys.readouterr().err
+        assert notes.read_text() == "my notes\n"
+    assert not (tmp_path / "ctrl.json").exists()
+
+
+def test_a_second_run_on_the_same_out_stops_at_once(tmp_path, capsys, small_problem):
+    with exclusive(tmp_path / "ctrl.json", "--out"):
+        t0 = time.perf_counter()
+        assert main(_evolve(tmp_path)) == 2
+        assert time.perf_counter() - t0 < 5
+    err = capsys.readouterr().err
+    assert "another run is writing" in err and str(os.getpid()) in err
+    assert not (tmp_path / "ctrl.json").exists()
+    assert main(_evolve(tmp_path)) == 0  # the lock is released with its holder
+    assert not (tmp_path / "ctrl.json.lock").exists()
+
+
+def test_two_concurrent_processes_one_wins(tmp_path):
+    """Two real processes on one --out: the second stops with exit 2 while the first goes on to finish."""
+    argv = [sys.executable, "-m", "lifelike_mj", "butterfly", "evolve", "--optimizer", "rcga", "--population", "6",
+            "--generations", "400", "--executor", "serial", "--quiet", "--out", str(tmp_path / "c.json")]
+    first = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.time() + 60
+        while not (tmp_path / "c.json.ckpt").exists() and time.time() < deadline:
+            time.sleep(0.1)
+        second = subprocess.run(argv, capture_output=True, text=True, timeout=60)
+        assert second.returncode == 2 and "another run is writing" in second.stderr, second.stderr
+        first.send_signal(signal.SIGINT)
+        out, err = first.communicate(timeout=60)
+        assert first.returncode == 130 and json.loads((tmp_path / "c.json").read_text())["provenance"]["interrupted"]
+    finally:
+        if first.poll() is None:
+            first.kill()
