@@ -80,9 +80,43 @@ def write_text(path: str | Path, text: str) -> Path:
     return Path(path)
 
 
+def strict(data: object) -> object:
+    """``data`` made fit for strict JSON: every NaN or infinite float becomes ``null``, and a dict that
+    held one gains ``"undefined": {key: reason}`` naming it (NaN: not defined for this run; +-inf: unbounded)."""
+    import math
+
+    def walk(v: object, notes: dict | None) -> object:
+        if isinstance(v, dict):
+            mine: dict = {}
+            out = {k: walk(x, mine) if not isinstance(x, float) else _num(k, x, mine) for k, x in v.items()}
+            if mine:
+                out["undefined"] = {**out.get("undefined", {}), **mine} if isinstance(out.get("undefined"), dict) else mine
+            return out
+        if isinstance(v, (list, tuple)):
+            return [walk(x, notes) for x in v]
+        if isinstance(v, float) and not math.isfinite(v):
+            return None
+        if hasattr(v, "item") and hasattr(v, "dtype") and getattr(v, "shape", None) == ():  # a NumPy scalar
+            return walk(v.item(), notes)
+        return v
+
+    def _num(key: str, x: float, notes: dict) -> float | None:
+        if math.isfinite(x):
+            return x
+        notes[str(key)] = "not defined for this run (NaN)" if math.isnan(x) else f"unbounded ({x})"
+        return None
+
+    return walk(data, None)
+
+
+def dumps(data: object, indent: int | None = 2) -> str:
+    """Strict JSON text of ``data`` (see :func:`strict`): never a bare ``NaN`` or ``Infinity``."""
+    return json.dumps(strict(data), indent=indent, allow_nan=False)
+
+
 def write_json(path: str | Path, data: object) -> Path:
-    """Write ``data`` as indented JSON, atomically."""
-    return write_text(path, json.dumps(data, indent=2, sort_keys=False) + "\n")
+    """Write ``data`` as indented strict JSON (:func:`strict`), atomically."""
+    return write_text(path, dumps(data) + "\n")
 
 
 def write_npz(path: str | Path, **arrays: object) -> Path:

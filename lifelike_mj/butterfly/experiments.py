@@ -494,5 +494,8 @@ def fly(controller: controllers.ButterflyController, params: ButterflyParams | N
                              dt_s, 1, **opts)[0]
     summary = {"controller": controller.name or name, **traj.summary(), **({"config": opts} if opts else {})}
     if traj.diverged_step >= 0:
-        raise Diverged(f"the flight diverged (runaway speed) at step {traj.diverged_step}.", traj.diverged_step)
+        from lifelike_mj.butterfly.sim import runaway_message
+
+        raise Diverged(traj.diverged_cause or runaway_message(traj.diverged_step, dt_s, params or ButterflyParams()),
+                       traj.diverged_step)
     return FlyResult(traj, summary)

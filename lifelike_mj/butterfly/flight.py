@@ -29,6 +29,11 @@ from lifelike_mj.butterfly.ann import ann_pitch, mlp_pitch
 from lifelike_mj.butterfly.controllers import KIND_ANN, KIND_MLP, KIND_SIMPLE_RULE, OMEGA_EPS
 from lifelike_mj.errors import UserError
 
+#: Bounds of a flight's conditions: start altitudes within +-1 km, winds within +-50 m/s (a storm;
+#: the paper's winds are within +-3 m/s).
+MAX_ALTITUDE_M = 1000.0
+MAX_WIND_M_S = 50.0
+
 
 @dataclass(frozen=True)
 class Condition:
@@ -36,6 +41,16 @@ class Condition:
 
     y0_m: float = 0.0
     wind_m_s: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        from lifelike_mj import checks
+
+        checks.number("the start altitude y0", self.y0_m, -MAX_ALTITUDE_M, MAX_ALTITUDE_M, unit="m")
+        w = self.wind_m_s
+        if not (isinstance(w, (tuple, list)) and len(w) == 2):
+            raise UserError(f"the wind must be two numbers (a, b) in m/s, got {w!r}.")
+        for name, v in zip(("a", "b"), w):
+            checks.number(f"the wind component {name}", v, -MAX_WIND_M_S, MAX_WIND_M_S, unit="m/s")
 
     def air_velocity(self) -> tuple[float, float]:
         """Air velocity (forward, up) in m/s: ``-(a, b)`` (docs/models/butterfly.md)."""
@@ -137,6 +152,8 @@ class Trajectory:
     backend: str = "paper"
     diverged_step: int = -1
     fitness: float = float("nan")  #: ``H`` of Oe 2010 eq. 13 over the flight (dimensionless)
+    #: Why the flight diverged, when it did (a sentence); empty for a runaway speed or no divergence.
+    diverged_cause: str = ""
 
     def settled(self, window_s: float = 10.0) -> np.ndarray:
         """Mask of samples in the last ``window_s`` seconds."""

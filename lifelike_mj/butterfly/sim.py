@@ -53,6 +53,30 @@ def _is_numba(fn: object) -> bool:
     return isinstance(fn, Dispatcher)
 
 
+#: The fewest time steps per wing beat a flight accepts (the paper's coarsest step, 1/120 s, gives 12).
+MIN_STEPS_PER_BEAT = 8
+
+
+def likely_cause_sentence(params: ButterflyParams, dt_s: float) -> str:
+    """The likely cause of a diverging flight: the physical constants furthest from the paper's
+    (Oe 2010 Table 1) and the time step, as one clause."""
+    from dataclasses import fields
+
+    from lifelike_mj.physics.stability import likely_cause
+
+    names = [f.name for f in fields(ButterflyParams)]
+    raised = likely_cause(params, ButterflyParams(), names)
+    text = f"{raised}, " if raised else ""
+    return (f"the likely cause is {text}the time step ({dt_s:.3g} s) or the controller: try a smaller --dt or the "
+            "paper's constants.")
+
+
+def runaway_message(step: int, dt_s: float, params: ButterflyParams) -> str:
+    """The sentence for a flight whose speed ran away (above 10^4 m/s) at ``step``."""
+    return (f"the flight diverged at step {step} (t = {step * dt_s:.4f} s): its speed ran away above 10^4 m/s; "
+            + likely_cause_sentence(params, dt_s))
+
+
 class Flight(StepCounter):
     """One butterfly flight (Oe 2010), stepped on the ``paper`` or ``mujoco`` backend.
 
@@ -87,6 +111,11 @@ class Flight(StepCounter):
         self._kind = int(kind)
         self._cp = np.ascontiguousarray(cp, dtype=float)
         self._flap = self.controller.flap.as_array()
+        period = 1.0 / self.controller.flap.frequency_hz
+        if self.dt > period / MIN_STEPS_PER_BEAT:
+            raise UserError(f"time step {self.dt:g} s does not resolve the wing beat: it must be at most "
+                            f"1/{MIN_STEPS_PER_BEAT} of the {period:g} s beat ({period / MIN_STEPS_PER_BEAT:g} s; "
+                            "the paper's coarsest is 1/120 s, 12 steps per beat).")
         self._air_z, self._air_y = self.condition.air_velocity()
         self._model = _model
         self._view = None
@@ -112,6 +141,7 @@ class Flight(StepCounter):
         The flight has no randomness; ``seed`` is accepted for the common shape and ignored."""
         self._k = 0
         self.diverged_step = -1
+        self._cause = ""
         if self.backend == "paper":
             from lifelike_mj.butterfly.backends import paper
 
@@ -173,7 +203,8 @@ class Flight(StepCounter):
             theta = out[:, 5]
         return Trajectory(t=t, y=out[:, 0], z=out[:, 1], vy=out[:, 2], vz=out[:, 3], phi=out[:, 4], theta=theta,
                           y0=self.condition.y0_m, flap_period_s=1.0 / self.controller.flap.frequency_hz,
-                          backend=self.backend, diverged_step=self.diverged_step, fitness=self.fitness)
+                          backend=self.backend, diverged_step=self.diverged_step, fitness=self.fitness,
+                          diverged_cause=self._cause)
 
     def state(self) -> dict[str, np.ndarray]:
         """The current state as named arrays (:data:`STATE_UNITS`)."""
@@ -237,8 +268,7 @@ class Flight(StepCounter):
 
     def _check_alive(self) -> None:
         if self.diverged_step >= 0:
-            raise Diverged(f"the flight diverged (runaway speed) at step {self.diverged_step} "
-                           f"(t = {self.diverged_step * self.dt:.4f} s).", self.diverged_step)
+            raise Diverged(self._cause or runaway_message(self.diverged_step, self.dt, self.params), self.diverged_step)
 
     def _row(self) -> tuple[float, ...]:
         q, v, lay = self._data.qpos, self._data.qvel, self._lay
@@ -257,9 +287,19 @@ class Flight(StepCounter):
             return
         from lifelike_mj.butterfly.backends.mj import COMPILED_PASSIVE
         from lifelike_mj.physics.callbacks import passive_callback
+        from lifelike_mj.physics.stability import Watch, describe, reset_time, watching
 
-        with passive_callback(COMPILED_PASSIVE):
+        k0, watch = self._k, Watch([self._data])
+        with passive_callback(COMPILED_PASSIVE), watching():
             self._steps(self._mujoco, n, every, out, r0)
+            if watch.new():  # MuJoCo reset the simulation: from its reported time on, nothing is valid
+                t = reset_time()
+                t = self._k * self.dt if t is None else t
+                self._cause = (describe(self._data, "the flight") + " " + likely_cause_sentence(self.params, self.dt))
+                bad = min(max(k0 + 1, int(round(t / self.dt)) + 1), k0 + n)
+                self.diverged_step = self._k = bad
+                if every:
+                    out[r0 + max(0, -(-(bad - k0) // every) - 1):] = np.nan
 
     def _steps(self, kernel, n: int, every: int, out: np.ndarray, r0: int) -> None:
         if not self._python_law:

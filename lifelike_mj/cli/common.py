@@ -4,7 +4,6 @@ output as text or ``--json``, and checks of numbers given on the command line.""
 from __future__ import annotations
 
 import argparse
-import json
 
 from lifelike_mj.errors import UserError
 
@@ -17,8 +16,11 @@ class Parser(argparse.ArgumentParser):
 
 
 def emit(args: argparse.Namespace, data: dict, human: str) -> None:
-    """Print ``data`` as strict-ish indented JSON with ``--json``, else the sentence ``human``."""
-    print(json.dumps(data, indent=2) if getattr(args, "json", False) else human)
+    """Print ``data`` as strict indented JSON with ``--json`` (NaN as ``null``, named under ``"undefined"``),
+    else the sentence ``human``."""
+    from lifelike_mj.io import dumps
+
+    print(dumps(data) if getattr(args, "json", False) else human)
 
 
 def add_json(p: argparse.ArgumentParser) -> None:

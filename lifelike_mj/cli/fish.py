@@ -68,7 +68,7 @@ def cmd_swim(args) -> None:
 
         summary["video"] = render_fish(args.video, params, n, min(args.duration, args.video_duration), args.seed,
                                        _tank(args), camera=args.camera)
-    emit(args, summary, (f"{n} fish, {summary['duration_s']:.0f} s ({params.name}): a burst every "
+    emit(args, summary, (f"{n} fish, {summary['duration_s']:g} s ({params.name}): a burst every "
                          f"{summary['burst_interval_mean_s']:.2f} s, burstiness {summary['burstiness']:.3f}, "
                          f"acceleration kurtosis {summary['accel_kurtosis']:.2f}, turning entropy "
                          f"{summary['turn_entropy']:.2f} bits, mean speed {summary['mean_speed_body_lengths_s']:.2f} "

@@ -127,9 +127,36 @@ class SerialEvaluator(Evaluator):
 _WORKER_PROBLEM: Any = None
 
 
-def _process_init(problem: Any) -> None:
-    """Pool initializer: keep the problem, ignore SIGINT (Ctrl-C is the parent's business), one numba thread."""
+def die_with_parent(parent_pid: int) -> None:
+    """Make this (worker) process end when ``parent_pid`` does, even if the parent is SIGKILLed and cannot
+    shut its pool down: on Linux the kernel sends SIGKILL at the parent's death (``PR_SET_PDEATHSIG``);
+    elsewhere, and as a second guard, a daemon thread exits once the parent is gone (checked every 0.5 s)."""
+    import threading
+
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG = 1
+        except (OSError, AttributeError):
+            pass
+    if os.getppid() != parent_pid:  # the parent died before we got here
+        os._exit(1)
+
+    def watch() -> None:
+        while os.getppid() == parent_pid:
+            time.sleep(0.5)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="lifelike-mj-parent-watch", daemon=True).start()
+
+
+def _process_init(problem: Any, parent_pid: int) -> None:
+    """Pool initializer: die with the parent, ignore SIGINT (Ctrl-C is the parent's business), one numba
+    thread, keep the problem."""
     global _WORKER_PROBLEM
+    die_with_parent(parent_pid)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _limit_threads()
     _WORKER_PROBLEM = problem
@@ -144,7 +171,8 @@ class ProcessEvaluator(Evaluator):
 
     The problem is sent once to each worker (pool initializer); each batch is split into one contiguous
     chunk per worker. Workers ignore SIGINT, so a Ctrl-C in a terminal interrupts only the parent,
-    which then cancels the outstanding chunks. As with any ``spawn`` pool, a script that uses it needs the
+    which then cancels the outstanding chunks; they die with the parent, even a SIGKILLed one
+    (:func:`die_with_parent`). As with any ``spawn`` pool, a script that uses it needs the
     usual ``if __name__ == "__main__":`` guard, and the problem's class must be importable by the workers.
     """
 
@@ -155,7 +183,7 @@ class ProcessEvaluator(Evaluator):
         self._abandoned = False
         self._pool = concurrent.futures.ProcessPoolExecutor(
             max_workers=self.workers, mp_context=multiprocessing.get_context("spawn"),
-            initializer=_process_init, initargs=(problem,))
+            initializer=_process_init, initargs=(problem, os.getpid()))
 
     def _evaluate(self, X: np.ndarray) -> np.ndarray:
         futures = [self._pool.submit(_process_chunk, c) for c in self._chunks(X)]
@@ -216,7 +244,14 @@ class RayEvaluator(Evaluator):
         self._ray = ray
         self._owns_ray = False
         if not ray.is_initialized():
-            ray.init(address=ray_address)
+            check_ray_address(ray_address)
+            if ray_address not in (None, "local"):  # give up on a silent address after a stated time
+                os.environ.setdefault("RAY_gcs_rpc_server_reconnect_timeout_s", str(int(RAY_CONNECT_TIMEOUT_S)))
+            try:
+                ray.init(address=ray_address, log_to_driver=False)
+            except Exception as exc:  # noqa: BLE001 - ray raises many kinds; the user gets one sentence
+                raise UserError(f"could not start or join Ray at {ray_address or 'a new local cluster'} "
+                                f"({type(exc).__name__}: {str(exc).splitlines()[0][:160] if str(exc) else ''}).") from None
             self._owns_ray = True
         if workers is None:
             workers = max(1, int(ray.cluster_resources().get("CPU", 1)))
@@ -243,6 +278,29 @@ class RayEvaluator(Evaluator):
             self._problem_ref = None
             if self._owns_ray and self._ray.is_initialized():
                 self._ray.shutdown()
+
+
+#: Seconds to wait for a Ray cluster's address to answer before giving up.
+RAY_CONNECT_TIMEOUT_S = 10.0
+
+
+def check_ray_address(address: str | None, timeout_s: float = RAY_CONNECT_TIMEOUT_S) -> None:
+    """:class:`UserError` unless ``address`` is ``None`` (start a local cluster), ``"auto"``/``"local"``, or
+    ``HOST:PORT`` / ``ray://HOST:PORT`` that accepts a connection within ``timeout_s`` seconds (Ray itself
+    would retry for minutes without a word)."""
+    import socket
+
+    if address is None or address in ("auto", "local"):
+        return
+    text = address[len("ray://"):] if address.startswith("ray://") else address
+    host, _, port = text.rpartition(":")
+    if not host or not port.isdigit() or not 0 < int(port) < 65536 or any(c.isspace() for c in host):
+        raise UserError(f"--ray-address must look like HOST:PORT or ray://HOST:PORT (or auto), got {address!r}.")
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), timeout=timeout_s).close()
+    except OSError as exc:
+        raise UserError(f"cannot reach the Ray cluster at {address} within {timeout_s:g} s "
+                        f"({exc.strerror or type(exc).__name__}).") from None
 
 
 def pool_problem_error(problem: Any) -> str | None:

@@ -36,7 +36,7 @@ seed gives the same tracks in any chunking.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import mujoco
 import numpy as np
@@ -49,6 +49,7 @@ from lifelike_mj.fish.scene import BODY_LENGTH_M, FishScene, box_areas, build_sc
 from lifelike_mj.physics import mjabi
 from lifelike_mj.physics.callbacks import passive_callback
 from lifelike_mj.physics.fluid import normal_drag_scalar
+from lifelike_mj.physics.stability import Watch, watching
 from lifelike_mj.stepper import StepCounter
 
 # ---- userdata layout (per model; the callback is process-global) ----------------------------------
@@ -569,7 +570,8 @@ class Tank(StepCounter):
         quat = np.zeros((*shape, 4))
         mu = np.zeros(shape, dtype=np.int8)
         err = np.zeros(4)
-        with passive_callback(COMPILED_PASSIVE):
+        watch = Watch([self.data])
+        with passive_callback(COMPILED_PASSIVE), watching():
             _run_chunk(sc.model._address, self.data._address, sc.vision_model._address, self.vision_data._address,
                        self.data.qpos, self.data.qvel, self.data.userdata, self.state_array, self.cum, self.cum_avoid,
                        U, self.c, n, int(self.params.substeps), pos, quat, mu, record, err, forced_mu, forced_push)
@@ -577,6 +579,7 @@ class Tank(StepCounter):
             t = (self._k + err[1] + 1) * self.params.control_dt_s
             self._k += int(err[1]) + 1
             raise Diverged(self._runaway_message(int(err[0]), int(err[2]), err[3], t), self._k)
+        watch.check(self._k + k, self._unstable_cause(), where="the tank")
         self._k += k
         return pos, quat, mu
 
@@ -633,6 +636,18 @@ class Tank(StepCounter):
         mujoco.mj_comPos(self.scene.model, self.data)
         mujoco.mj_camlight(self.scene.model, self.data)
 
+    def _unstable_cause(self) -> str:
+        """The likely cause of a MuJoCo instability: the parameters raised most above the default preset."""
+        from lifelike_mj.physics.stability import likely_cause
+
+        names = [f.name for f in fields(FishParams) if f.name not in ("name", "description", "transition")]
+        raised = likely_cause(self.params, FishParams(), names)
+        dt_ms = 1000 * self.params.timestep_s
+        if raised:
+            return (f"the likely cause is the parameters furthest from the calibrated default: {raised}; bring them "
+                    f"back, or take smaller time steps (substeps; now {dt_ms:.3g} ms).")
+        return f"take smaller time steps (raise substeps; now {dt_ms:.3g} ms)."
+
     def _runaway_message(self, kind: int, fish: int, speed: float, t: float) -> str:
         p = self.params
         T = p.transition_matrix(False)
@@ -642,6 +657,13 @@ class Tank(StepCounter):
                     f"accelerate are too high (from accelerate: {T[0, 0]:.2f}, from coast: {T[1, 0]:.2f} per step).")
         what = "became NaN" if kind == 2 else (f"kept up {speed:.2f} m/s ({speed / BODY_LENGTH_M:.1f} body lengths/s over "
                                                 f"{RUNAWAY_TAU_S:g} s, above runaway_speed_bl_s = {p.runaway_speed_bl_s:g})")
+        from lifelike_mj.physics.stability import likely_cause
+
+        names = [f.name for f in fields(FishParams) if f.name not in ("name", "description", "transition")]
+        top = likely_cause(p, FishParams(), names, top=1)
+        if top and not top.startswith(("P_a ", "P_b ")):
+            return (f"the speed ran away: fish {fish} {what} at t = {t:.2f} s; the likely cause is the parameters "
+                    f"furthest from the calibrated default: {likely_cause(p, FishParams(), names)}: bring them back.")
         return (f"the speed ran away: fish {fish} {what} at t = {t:.2f} s; {name} = {val:g} is too high "
                 f"(the chance to accelerate again is {prob:.2f} per step): lower {name}.")
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -12,6 +13,7 @@ from lifelike_mj import butterfly
 from lifelike_mj.butterfly import ann, controllers
 from lifelike_mj.butterfly.backends import mj, paper
 from lifelike_mj.butterfly.flight import Condition
+from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.butterfly.sim import STATE_UNITS, Flight
 from lifelike_mj.errors import Diverged, UserError
 
@@ -93,8 +95,9 @@ def test_bad_laws_are_one_sentence():
 
 @pytest.mark.parametrize("backend", ["paper", "mujoco"])
 def test_a_runaway_is_an_error_naming_the_step(backend):
-    f = Flight(RULE, condition=Condition(0.0, (1e4, 0.0)), backend=backend)
-    with pytest.raises(Diverged, match="diverged") as info:
+    light = ButterflyParams().with_overrides(mass_g=0.001)  # a 1 mg butterfly: the wing forces fling it away
+    f = Flight(RULE, light, backend=backend)
+    with pytest.raises(Diverged, match=r"diverged at step \d+ .*ran away.*likely cause is mass_kg = 1e-06") as info:
         f.step(100)
     assert 1 <= info.value.step <= 100
     with pytest.raises(Diverged):
@@ -163,3 +166,34 @@ def test_network_files_are_checked():
         controllers.from_dict(c)
     with pytest.raises(UserError, match="--hidden"):
         butterfly.make_problem("paper", hidden="8,x")
+
+
+@pytest.mark.parametrize("record", [False, True])
+def test_a_mujoco_reset_is_an_error_not_a_fresh_start(record, tmp_path, monkeypatch):
+    """MuJoCo resets a simulation whose state is NaN or huge (here: an altitude of 1e11 m) inside mj_step;
+    the flight must stop with the cause, not fly on from the start, and MuJoCo must not litter the folder."""
+    monkeypatch.chdir(tmp_path)
+    f = Flight(RULE, backend="mujoco")
+    f.step(12)
+    f.data.qpos[f._lay.q_height] = 1e11
+    if record:
+        tr = f.record(24, every=4)
+        assert tr.diverged_step == 13 and "became unstable" in tr.diverged_cause
+        assert np.all(np.isfinite(tr.y[:1])) and np.all(np.isnan(tr.y[1:]))
+    else:
+        with pytest.raises(Diverged, match="became unstable.*huge positions.*reset it") as info:
+            f.step(24)
+        assert info.value.step == 13
+    with pytest.raises(Diverged, match="became unstable"):
+        f.step(1)
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+
+
+def test_conditions_are_checked():
+    for bad in (math.nan, math.inf, 1e6):
+        with pytest.raises(UserError, match="start altitude"):
+            Condition(bad)
+    with pytest.raises(UserError, match="wind component a"):
+        Condition(0.0, (math.nan, 0.0))
+    with pytest.raises(UserError, match="does not resolve the wing beat"):
+        Flight(RULE, dt_s=0.05)

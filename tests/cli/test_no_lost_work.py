@@ -90,3 +90,49 @@ def test_two_concurrent_processes_one_wins(tmp_path):
     finally:
         if first.poll() is None:
             first.kill()
+
+
+def _alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    try:  # a zombie (dead, not yet reaped) counts as gone
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().split(") ", 1)[1][0] != "Z"
+    except OSError:
+        return False
+
+
+def _children(pid):
+    try:
+        with open(f"/proc/{pid}/task/{pid}/children") as fh:
+            return [int(c) for c in fh.read().split()]
+    except OSError:
+        return []
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_killing_the_main_process_leaves_no_worker_alive(tmp_path):
+    """SIGKILL the main process of a pooled evolve run: within 5 s no worker is left, and the reader of its
+    stdout sees the end of the stream (so `$(lifelike-mj ...)` does not hang)."""
+    argv = [sys.executable, "-m", "lifelike_mj", "butterfly", "evolve", "--optimizer", "rcga", "--population", "8",
+            "--generations", "400", "--executor", "process", "--workers", "2", "--quiet", "--out",
+            str(tmp_path / "c.json")]
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.time() + 120
+        while not (tmp_path / "c.json.ckpt").exists() and time.time() < deadline:
+            time.sleep(0.1)
+        workers = _children(proc.pid)
+        assert len(workers) >= 2  # the pool's workers (and the resource tracker)
+        proc.kill()
+        proc.wait(timeout=10)
+        t0 = time.time()
+        while any(_alive(w) for w in workers) and time.time() - t0 < 5:
+            time.sleep(0.1)
+        assert not any(_alive(w) for w in workers), [w for w in workers if _alive(w)]
+        assert proc.stdout.read() == b""  # EOF: nobody holds the pipe any more
+    finally:
+        if proc.poll() is None:
+            proc.kill()

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from lifelike_mj.cli import main
-from lifelike_mj.errors import UserError
+from lifelike_mj.errors import Diverged, UserError
 from lifelike_mj.fish import sim
 from lifelike_mj.fish.experiments import drag_check, pattern_table, swim_summary, write_tracks
 from lifelike_mj.fish.params import ACCELERATE, PRESETS, FishParams, load_preset
@@ -187,6 +187,27 @@ def test_runaway_speed_is_an_error_naming_the_parameter():
         sim.swim(replace(BD, P_a=1000.0), 5, 60.0, seed=0)
     with pytest.raises(UserError, match="P_b"):
         sim.swim(replace(BD, P_b=1000.0), 5, 60.0, seed=0)
+
+
+def test_strong_forces_make_mujoco_reset_and_that_is_an_error_naming_them(tmp_path, monkeypatch):
+    """r = 10-20 N on a 3 g fish: MuJoCo finds huge accelerations and resets the tank inside mj_step; the
+    run must stop with the cause (not swim on from the start), and MuJoCo must not litter the folder."""
+    monkeypatch.chdir(tmp_path)
+    strong = replace(BD, r_min_N=10.0, r_max_N=20.0)
+    with pytest.raises(Diverged, match=r"became unstable.*huge accelerations.*r_min_N = 10 \(default 0.01\)") as info:
+        sim.swim(strong, 10, 2.0, seed=0)
+    assert info.value.step > 0
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+    tank = sim.Tank(BD, 3, seed=0)
+    tank.step(5)
+    tank.data.qpos[0] = 1e11  # a fish flung a hundred million km away: MuJoCo resets
+    with pytest.raises(Diverged, match="huge positions"):
+        tank.step(5)
+
+
+def test_a_runaway_after_raised_forces_names_the_forces():
+    with pytest.raises(Diverged, match=r"ran away.*r_max_N = 0.3 \(default 0.03\)"):
+        sim.swim(replace(BD, r_max_N=0.3), 5, 60.0, seed=0)
 
 
 @pytest.mark.parametrize("name", PRESETS)

@@ -58,6 +58,7 @@ from lifelike_mj.physics import mjabi
 from lifelike_mj.physics.callbacks import passive_callback
 from lifelike_mj.physics.fluid import normal_drag_scalar
 from lifelike_mj.physics.jit import njit_with
+from lifelike_mj.physics.stability import Watch, watching
 
 # ---- userdata layout (float64 slots) -------------------------------------------------------
 U_MODE, U_RICH = 0, 1
@@ -524,10 +525,12 @@ def fitness_batch(cparams: np.ndarray, flap, params: ButterflyParams | None, con
     n = len(datas)
     diverged = np.full(n, -1, dtype=np.int64)
     fitness = np.zeros(n)
-    with passive_callback(COMPILED_PASSIVE):
+    watch = Watch(datas)
+    with passive_callback(COMPILED_PASSIVE), watching():
         kinds = np.full(n, KIND_ANN if kind is None else kind, dtype=np.int64)
         _fitness_batch(m._address, dptrs, kinds, np.ascontiguousarray(cparams),
                        flap.as_array(), layout(m).as_array(), float(dt_s), int(n_steps), diverged, fitness, _OFFSETS)
+    fitness[watch.new()] = np.nan  # MuJoCo reset these flights: no valid fitness (the optimiser counts it worst)
     del datas
     return fitness
 

@@ -1,0 +1,115 @@
+"""MuJoCo's own instability warnings, read after every chunk of steps.
+
+When an acceleration, position or velocity becomes NaN, infinite or huge, ``mj_step`` prints a
+warning, writes ``MUJOCO_LOG.TXT`` into the working directory and *resets* the simulation to its
+initial state, so that a NaN check after the step sees nothing wrong. :func:`watching` catches those
+warnings instead (no print, no log file) and :class:`Watch` turns a new one into a
+:class:`~lifelike_mj.errors.Diverged` error whose message the caller completes with the likely cause.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import threading
+from collections.abc import Iterator, Sequence
+
+import mujoco
+
+from lifelike_mj.errors import Diverged
+
+_BAD = {
+    int(mujoco.mjtWarning.mjWARN_BADQACC): "accelerations",
+    int(mujoco.mjtWarning.mjWARN_BADQPOS): "positions",
+    int(mujoco.mjtWarning.mjWARN_BADQVEL): "velocities",
+}
+_lock = threading.Lock()
+_depth = 0
+_saved: object = None
+_messages: list[str] = []
+
+
+def bad_counts(data: mujoco.MjData) -> tuple[int, ...]:
+    """How often ``data`` has had NaN/huge accelerations, positions, velocities (MuJoCo's counters)."""
+    return tuple(int(data.warning[w].number) for w in _BAD)
+
+
+@contextlib.contextmanager
+def watching() -> Iterator[list[str]]:
+    """While active, MuJoCo's warnings are collected (the yielded list) instead of printed and logged to
+    ``MUJOCO_LOG.TXT``; the previous handler comes back at the end. Re-entrant."""
+    global _depth, _saved
+    with _lock:
+        if _depth == 0:
+            _saved = mujoco.get_mju_user_warning()
+            _messages.clear()
+            mujoco.set_mju_user_warning(_messages.append)
+        _depth += 1
+    try:
+        yield _messages
+    finally:
+        with _lock:
+            _depth -= 1
+            if _depth == 0:
+                mujoco.set_mju_user_warning(_saved)
+
+
+class Watch:
+    """Counts of MuJoCo's instability warnings on some ``mjData``, to compare after each chunk."""
+
+    def __init__(self, datas: Sequence[mujoco.MjData]) -> None:
+        self.datas = list(datas)
+        self.before = [bad_counts(d) for d in self.datas]
+
+    def new(self) -> list[int]:
+        """Indices of the datas with a new instability warning since the last call."""
+        hit = []
+        for i, d in enumerate(self.datas):
+            now = bad_counts(d)
+            if now != self.before[i]:
+                hit.append(i)
+            self.before[i] = now
+        return hit
+
+    def check(self, step: int, cause: str, where: str = "the simulation") -> None:
+        """Raise :class:`Diverged` (at ``step``) if a new warning came: the sentence says what MuJoCo found,
+        when, and ``cause`` (the likely cause, in the caller's words)."""
+        hit = self.new()
+        if hit:
+            raise Diverged(describe(self.datas[hit[0]], where) + " " + cause, step)
+
+
+def describe(data: mujoco.MjData, where: str = "the simulation") -> str:
+    """One clause: what MuJoCo found unstable in ``data``, and when (from its warning record)."""
+    kinds = [name for w, name in _BAD.items() if data.warning[w].number > 0]
+    last = [int(data.warning[w].lastinfo) for w in _BAD if data.warning[w].number > 0]
+    dof = f" (degree of freedom {last[0]})" if last else ""
+    t = reset_time()
+    when = f" at t = {t:.4g} s" if t is not None else ""
+    return (f"{where} became unstable{when}: MuJoCo found NaN, infinite or huge {' and '.join(kinds) or 'values'}"
+            f"{dof} and reset it, so no result from it is valid;")
+
+
+def reset_time() -> float | None:
+    """The simulation time (s) MuJoCo reported with its last warning inside :func:`watching`, if any."""
+    for m in reversed(_messages):
+        if "Time = " in m:
+            try:
+                t = float(m.rsplit("Time = ", 1)[1].rstrip(". "))
+                return t if math.isfinite(t) else None
+            except ValueError:
+                return None
+    return None
+
+
+def likely_cause(current: object, default: object, names: Sequence[str], top: int = 2) -> str:
+    """The parameters of ``current`` that differ most from ``default`` (by ratio), as
+    ``"r_max_N = 20 (default 0.03)"`` phrases, for the "likely cause" part of a divergence message."""
+    scored = []
+    for n in names:
+        a, b = getattr(current, n), getattr(default, n)
+        if isinstance(a, (int, float)) and isinstance(b, (int, float)) and a != b:
+            ratio = abs(math.log(abs(a) / abs(b))) if a and b else math.inf
+            scored.append((ratio, f"{n} = {a:g} (default {b:g})"))
+    scored.sort(key=lambda s: -s[0])
+    return ", ".join(s for _, s in scored[:top])
