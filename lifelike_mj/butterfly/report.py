@@ -11,7 +11,6 @@ Every file is written atomically.
 
 from __future__ import annotations
 
-import json
 import math
 import sys
 import time
@@ -22,7 +21,7 @@ from lifelike_mj.butterfly import controllers, experiments, figures
 from lifelike_mj.butterfly.compare import compare
 from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.errors import UserError
-from lifelike_mj.io import write_json, write_text
+from lifelike_mj.io import dumps, write_json, write_text
 
 FIGURES = {
     "fig3": "fig3_forces.png",
@@ -191,7 +190,7 @@ def report_e1_e5(
         "figures": dict(FIGURES),
         "elapsed_s": time.perf_counter() - t0,
     }
-    write_text(out / "results.json", json.dumps(results, indent=1, allow_nan=True) + "\n")
+    write_text(out / "results.json", dumps(results, indent=1) + "\n")
     write_text(out / "report.md", _markdown(results, extra_sections))
     say(f"wrote {out / 'report.md'} in {results['elapsed_s']:.1f} s")
     return results

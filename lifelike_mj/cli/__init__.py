@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
-from lifelike_mj.cli.common import Parser, add_json, emit
+from lifelike_mj.cli.common import Parser, add_json, add_overwrite, check_outputs, count, emit, join_negative_values
 from lifelike_mj.errors import UserError
 
 #: The creatures, in the order of ``reproduce all``.
@@ -44,18 +44,21 @@ def _verb(sub, name: str, helptext: str, add: str, extra=None) -> None:
 
 def _render_options(p) -> None:
     p.add_argument("--out", required=True, help="FILE.mp4 or FILE.gif")
-    p.add_argument("--fps", type=int, default=30)
-    p.add_argument("--width", type=int, default=640)
-    p.add_argument("--height", type=int, default=480)
+    p.add_argument("--fps", type=count(1, 240), default=30, help="frames per second of video, 1 to 240")
+    p.add_argument("--width", type=count(16, 4096), default=640, help="frame width, pixels, 16 to 4096")
+    p.add_argument("--height", type=count(16, 4096), default=480, help="frame height, pixels, 16 to 4096")
+    add_overwrite(p)
     add_json(p)
 
 
 def _reproduce_options(p) -> None:
     p.add_argument("--out", default=None, help="output folder (default reports/CREATURE; with all: OUT/CREATURE)")
+    add_overwrite(p)
 
 
 def _bench_options(p) -> None:
-    p.add_argument("--out", help="also write the JSON here")
+    p.add_argument("--out", help="also write the JSON here (.json)")
+    add_overwrite(p)
     add_json(p)
 
 
@@ -88,13 +91,13 @@ def cmd_view(args) -> None:
 
 
 def cmd_render(args) -> None:
-    if Path(args.out).suffix.lower() not in (".mp4", ".gif"):
-        raise UserError(f"--out must end in .mp4 or .gif, got {args.out!r}.")
+    check_outputs(args, files={"--out": (".mp4", ".gif")})
     info = creature(args.what).render(args)
     emit(args, info, f"wrote {info['frames']} frames to {args.out}")
 
 
 def cmd_bench(args) -> None:
+    check_outputs(args, files={"--out": (".json",)})
     r, human = creature(args.what).bench(args)
     if args.out:
         from lifelike_mj.io import write_json
@@ -105,6 +108,11 @@ def cmd_bench(args) -> None:
 
 def cmd_reproduce(args) -> None:
     whats = CREATURES if args.what == "all" else (args.what,)
+    from lifelike_mj.paths import check_output_dir
+
+    for what in whats:  # every folder checked before the first stage starts
+        out = Path(args.out or "reports") / what if (args.what == "all" or not args.out) else Path(args.out)
+        check_output_dir(out, "--out", ("report.md", "results.json"), overwrite=args.overwrite)
     for what in whats:
         out = Path(args.out or "reports") / what if (args.what == "all" or not args.out) else Path(args.out)
         creature(what).reproduce(out, args)
@@ -118,7 +126,7 @@ def main(argv: list[str] | None = None) -> int:
 
         ensure_gl_backend()  # before anything imports mujoco
     try:
-        args = build_parser().parse_args(argv)
+        args = build_parser().parse_args(join_negative_values(argv))
         args.func(args)
     except UserError as exc:
         print(f"lifelike-mj: error: {exc}", file=sys.stderr)

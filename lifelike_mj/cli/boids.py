@@ -5,10 +5,25 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from lifelike_mj.cli.common import add_json, emit, seeds
+from lifelike_mj.cli.common import (
+    add_executor,
+    add_json,
+    add_overwrite,
+    add_seed,
+    check_executor,
+    check_outputs,
+    count,
+    emit,
+    seeds,
+)
 from lifelike_mj.errors import UserError
 
 NAME = "boids"
+#: Bounds of the command line: agents, steps, and agents x steps of one run (about an hour here).
+MAX_AGENTS = 1_000_000
+MAX_STEPS = 1_000_000
+MAX_AGENT_STEPS = 2_000_000_000
+RUN_FILES = ("trajectories.npz", "trajectories.csv", "measures.json")
 HELP = "the heterogeneous boids of Nakamura 2013"
 
 
@@ -16,9 +31,18 @@ def _add_boids(p) -> None:
     p.add_argument("--preset", default=None, help="pattern preset 4a ... 5d (default 5a), or a JSON file")
     p.add_argument("--wa", help="alignment matrix 'a,b;c,d' (rows: own type), with --wc instead of a preset")
     p.add_argument("--wc", help="cohesion matrix 'a,b;c,d'")
-    p.add_argument("--n", type=int, default=300, help="number of agents")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--dims", type=int, default=3, help="3 or 2 (section 4.3)")
+    p.add_argument("--n", type=count(2, MAX_AGENTS), default=300, help=f"number of agents, 2 to {MAX_AGENTS:,}")
+    add_seed(p)
+    p.add_argument("--dims", type=int, default=3, choices=(3, 2), help="3 or 2 (section 4.3)")
+
+
+def _check_size(n: int, steps: int | None) -> None:
+    from lifelike_mj.boids.metrics import RUN_STEPS
+
+    total = n * (steps or RUN_STEPS)
+    if total > MAX_AGENT_STEPS:
+        raise UserError(f"--n {n:,} for {steps or RUN_STEPS:,} steps is {total:,} agent-steps; at most "
+                        f"{MAX_AGENT_STEPS:,} per run (fewer agents or steps).")
 
 
 def _params(args):
@@ -54,11 +78,9 @@ def _axis(spec: str) -> tuple[str, list[float]]:
 def cmd_run(args) -> None:
     from lifelike_mj.boids.experiments import measured_run, write_run
 
+    check_outputs(args, files={"--plot": (".png",)}, folders={"--out": RUN_FILES})
+    _check_size(args.n, args.steps)
     params = _params(args)
-    if args.n < 2:
-        raise UserError(f"--n must be at least 2, got {args.n}.")
-    if args.steps is not None and args.steps < 10:
-        raise UserError(f"--steps must be at least 10, got {args.steps}.")
     run, out = measured_run(params, args.n, args.seed, args.steps, progress=not args.json)
     if args.plot:
         from lifelike_mj.boids.figures import pattern_figure
@@ -76,6 +98,9 @@ def cmd_sweep(args) -> None:
     from lifelike_mj.boids.experiments import Sweep, run_sweep, write_sweep
     from lifelike_mj.boids.presets import homogeneous, load_grid
 
+    check_outputs(args, folders={"--out": ("sweep.json", "phase_diagram.png")})
+    check_executor(args)
+    _check_size(args.n, args.steps)
     seed_list = seeds(args.seeds)
     if args.grid:
         g = load_grid(args.grid)
@@ -107,10 +132,12 @@ def add_commands(sub) -> None:
     boids = sub.add_parser(NAME, help=HELP).add_subparsers(dest="sub", required=True, parser_class=Parser)
     p = boids.add_parser("run", help="one run: classified pattern and its measures")
     _add_boids(p)
-    p.add_argument("--steps", type=int, default=None, help="steps (default: the classifier's run length)")
+    p.add_argument("--steps", type=count(10, MAX_STEPS), default=None,
+                   help=f"steps, 10 to {MAX_STEPS:,} (default: the classifier's run length)")
     add_json(p)
     p.add_argument("--plot", help="PNG of the last 5 steps in the paper's style")
     p.add_argument("--out", help="folder for trajectories (npz, CSV) and measures")
+    add_overwrite(p)
     p.set_defaults(func=cmd_run)
     p = boids.add_parser("sweep", help="a grid of runs, classified: the phase diagram")
     _add_boids(p)
@@ -118,18 +145,18 @@ def add_commands(sub) -> None:
     p.add_argument("--x", help="axis NAME=START:STOP:COUNT: wa_cross, wc_cross, wa_IJ, wc_IJ, wa, wc")
     p.add_argument("--y", help="second axis, same form")
     p.add_argument("--seeds", default="0-2", help="seeds, e.g. 0-4 or 0,3,7")
-    p.add_argument("--steps", type=int, default=None)
-    p.add_argument("--executor", default="process", help="serial, process (default) or ray")
-    p.add_argument("--workers", type=int, default=None)
-    p.add_argument("--ray-address", default=None)
+    p.add_argument("--steps", type=count(10, MAX_STEPS), default=None,
+                   help="steps of each run (default: the classifier's run length)")
+    add_executor(p)
     p.add_argument("--out", help="folder for sweep.json and phase_diagram.png")
+    add_overwrite(p)
     add_json(p)
     p.set_defaults(func=cmd_sweep)
 
 
 def add_view_args(p: argparse.ArgumentParser) -> None:
     _add_boids(p)
-    p.add_argument("--camera", default="overview", help="overview (default) or top")
+    p.add_argument("--camera", default="overview", choices=("overview", "top"), help="viewer camera")
 
 
 def view(args) -> None:
@@ -140,8 +167,8 @@ def view(args) -> None:
 
 def add_render_args(p: argparse.ArgumentParser) -> None:
     _add_boids(p)
-    p.add_argument("--steps", type=int, default=None, help="steps to render (default 3000)")
-    p.add_argument("--camera", default="overview", help="overview (default), top or side")
+    p.add_argument("--steps", type=count(1, 100_000), default=None, help="steps to render (default 3000)")
+    p.add_argument("--camera", default="overview", choices=("overview", "top", "side"), help="video camera")
 
 
 def render(args) -> dict:
@@ -162,8 +189,8 @@ def reproduce(out: Path, args) -> None:
 
 
 def add_bench_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--repeats", type=int, default=3)
-    p.add_argument("--max-n", type=int, default=1_000_000, help="largest n of the scaling run")
+    p.add_argument("--repeats", type=count(1, 3), default=3, help="timed repeats, at most 3 (the median is reported)")
+    p.add_argument("--max-n", type=count(1000, 10_000_000), default=1_000_000, help="largest n of the scaling run")
     p.add_argument("--mesa-python", default=None, help="a Python interpreter that has Mesa (for the peer)")
 
 

@@ -8,10 +8,26 @@ import sys
 from pathlib import Path
 
 from lifelike_mj.checks import positive
-from lifelike_mj.cli.common import add_json, emit
+from lifelike_mj.cli.common import (
+    add_executor,
+    add_json,
+    add_overwrite,
+    add_seed,
+    check_executor,
+    check_outputs,
+    count,
+    emit,
+    num,
+)
 from lifelike_mj.errors import UserError
 
 NAME = "butterfly"
+#: Longest flight (s) of fly and compare; longest video (s) of render.
+MAX_DURATION_S = 3600.0
+MAX_VIDEO_S = 600.0
+#: Largest wind map (cells), and the files of ``fly --out``.
+MAX_WIND_CELLS = 40_000
+FLY_FILES = ("trajectory.npz", "trajectory.csv", "flight.png", "summary.json")
 HELP = "the butterfly of Oe et al. 2010"
 
 
@@ -28,12 +44,14 @@ def _wind(text: str) -> tuple[float, float]:
 
 def add_physics(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("physical constants (defaults: Oe 2010, A_b = 1.0 cm^2)")
-    g.add_argument("--body-area-cm2", type=float, help="body projected area A_b (eq. 10), cm^2")
-    g.add_argument("--mass-g", type=float, help="butterfly mass m, g (paper: 0.319)")
-    g.add_argument("--span-cm", type=float, help="wing length L, cm (paper: 5.5)")
-    g.add_argument("--width-cm", type=float, help="wing width W, cm (paper: 5.0)")
-    g.add_argument("--rho", type=float, help="air density, kg/m^3 (paper: 1.28)")
-    g.add_argument("--cd", type=float, help="drag coefficient C_d (paper: 2.2)")
+    g.add_argument("--body-area-cm2", type=num(0, 100, lo_open=True, unit="cm^2"),
+                   help="body projected area A_b (eq. 10), cm^2, in (0, 100] (default 1.0)")
+    g.add_argument("--mass-g", type=num(0, 100, lo_open=True, unit="g"), help="butterfly mass m, g, in (0, 100] (paper: 0.319)")
+    g.add_argument("--span-cm", type=num(0, 100, lo_open=True, unit="cm"), help="wing length L, cm, in (0, 100] (paper: 5.5)")
+    g.add_argument("--width-cm", type=num(0, 100, lo_open=True, unit="cm"), help="wing width W, cm, in (0, 100] (paper: 5.0)")
+    g.add_argument("--rho", type=num(0, 2000, lo_open=True, unit="kg/m^3"),
+                   help="air density, kg/m^3, in (0, 2000] (paper: 1.28)")
+    g.add_argument("--cd", type=num(0, 10, lo_open=True), help="drag coefficient C_d, in (0, 10] (paper: 2.2)")
 
 
 def params(args):
@@ -47,10 +65,10 @@ def params(args):
 def _add_controller(p: argparse.ArgumentParser, required: bool = True) -> None:
     p.add_argument("--controller", required=required, default=None if required else "simple_rule",
                    help="shipped controller name (e.g. simple_rule) or path to a controller JSON file")
-    p.add_argument("--phi-up-deg", type=float, help="override simple_rule's upstroke pitch, deg")
-    p.add_argument("--phi-down-deg", type=float, help="override simple_rule's downstroke pitch, deg")
-    p.add_argument("--phi-deg", type=float, help="override a constant controller's pitch, deg")
-    p.add_argument("--inputs", choices=None, default=None,
+    p.add_argument("--phi-up-deg", type=num(-90, 90, unit="deg"), help="override simple_rule's upstroke pitch, deg")
+    p.add_argument("--phi-down-deg", type=num(-90, 90, unit="deg"), help="override simple_rule's downstroke pitch, deg")
+    p.add_argument("--phi-deg", type=num(-90, 90, unit="deg"), help="override a constant controller's pitch, deg")
+    p.add_argument("--inputs", choices=("relative", "ground"), default=None,
                    help="network controllers: feed relative (air) or ground velocities (section 7.2)")
 
 
@@ -66,9 +84,13 @@ def _controller(args):
 
 
 def _add_backend(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--backend", default="paper", help="paper (eq. 7-11, compiled) or mujoco (models/butterfly/)")
-    p.add_argument("--config", default="paper", help="MuJoCo configuration: paper (equivalent) or rich")
-    p.add_argument("--force-mode", default=None, help="MuJoCo wing force: tip (paper formula) or strip")
+    p.add_argument("--backend", default="paper", choices=("paper", "mujoco"),
+                   help="paper (eq. 7-11, compiled) or mujoco (models/butterfly/)")
+    p.add_argument("--config", default=None, choices=("paper", "rich"),
+                   help="MuJoCo configuration: paper (equivalent, the default) or rich; only with --backend mujoco")
+    p.add_argument("--force-mode", default=None, choices=("tip", "strip"),
+                   help="MuJoCo wing force: tip (paper formula) or strip (default: the configuration's); "
+                        "only with --backend mujoco")
 
 
 def _backend_options(args) -> dict:
@@ -76,8 +98,11 @@ def _backend_options(args) -> dict:
 
     check_backend(args.backend)
     if args.backend != "mujoco":
+        given = [o for o, v in (("--config", args.config), ("--force-mode", args.force_mode)) if v is not None]
+        if given:
+            raise UserError(f"{' and '.join(given)} only apply to --backend mujoco.")
         return {}
-    return mujoco_options(args.config, args.force_mode)
+    return mujoco_options(args.config or "paper", args.force_mode)
 
 
 def _condition(args):
@@ -131,6 +156,7 @@ def cmd_timestep(args) -> None:
 def cmd_fly(args) -> None:
     from lifelike_mj.butterfly.experiments import fly
 
+    check_outputs(args, folders={"--out": FLY_FILES})
     ctrl = _controller(args)
     opts = _backend_options(args)
     r = fly(ctrl, params(args), _condition(args), args.duration, args.dt, args.backend, **opts, name=args.controller)
@@ -149,6 +175,7 @@ def cmd_evolve(args) -> None:
 
     if args.generations is not None and args.evaluations is not None:
         raise UserError("give either --generations or --evaluations, not both.")
+    check_executor(args)
     gens = args.generations
     if gens is None and args.evaluations is None:
         gens = 1000  # the paper's budget (section 6.3)
@@ -172,6 +199,11 @@ def cmd_evolve(args) -> None:
 def cmd_windmap(args) -> None:
     from lifelike_mj.butterfly.ann_experiments import e11_windmap
 
+    check_outputs(args, files={"--plot": (".png",)})
+    cells = (2 * math.floor(args.max / args.step + 1e-9) + 1) ** 2
+    if cells > MAX_WIND_CELLS:
+        raise UserError(f"--max {args.max:g} with --step {args.step:g} makes {cells:,} wind cells; at most "
+                        f"{MAX_WIND_CELLS:,} (a larger --step or a smaller --max).")
     ctrl = _controller(args)
     if ctrl.type != "ann":
         raise UserError(f"the wind map needs a network (ann) controller; {args.controller!r} is {ctrl.type!r}.")
@@ -230,7 +262,8 @@ def add_commands(sub) -> None:
     p = bf.add_parser("trim", help="E4: level-flight upstroke pitch of the simple rule (section 5.1)")
     add_physics(p)
     _add_backend(p)
-    p.add_argument("--dt", type=float, default=1.0 / 12000.0, help="time step, s (paper: 1/12000)")
+    p.add_argument("--dt", type=num(0, 0.01, lo_open=True, unit="s"), default=1.0 / 12000.0,
+                   help="time step, s, in (0, 0.01] (paper: 1/12000)")
     add_json(p)
     p.set_defaults(func=cmd_trim)
     p = bf.add_parser("timestep", help="E5: time-step study at phi_up = 14 deg (section 5.2)")
@@ -242,33 +275,39 @@ def add_commands(sub) -> None:
     _add_controller(p)
     add_physics(p)
     _add_backend(p)
-    p.add_argument("--y0", type=float, default=0.0, help="start altitude, m")
-    p.add_argument("--wind", type=_wind, default=(0.0, 0.0), help="wind A,B in m/s: where it comes from (forward, up)")
-    p.add_argument("--duration", type=float, default=20.0, help="seconds")
-    p.add_argument("--dt", type=float, default=1.0 / 1200.0, help="time step, s")
+    p.add_argument("--y0", type=num(-1000, 1000, unit="m"), default=0.0, help="start altitude, m, within +-1000")
+    p.add_argument("--wind", type=_wind, default=(0.0, 0.0),
+                   help="wind A,B in m/s, each within +-50: where it comes from (forward, up); e.g. --wind -2,0")
+    p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=20.0,
+                   help=f"seconds of flight, at most {MAX_DURATION_S:g}")
+    p.add_argument("--dt", type=num(0, 0.0125, lo_open=True, unit="s"), default=1.0 / 1200.0,
+                   help="time step, s, at most 1/8 of the wing beat")
     p.add_argument("--out", help="folder for trajectory.npz/.csv, flight.png, summary.json")
+    add_overwrite(p)
     add_json(p)
     p.set_defaults(func=cmd_fly)
     p = bf.add_parser("evolve", help="evolve the network pitch controller (section 6) with an optimiser")
-    p.add_argument("--optimizer", required=True, help="rcga (the paper's GA), cmaes, crs2, esch or isres")
+    p.add_argument("--optimizer", required=True, choices=("rcga", "cmaes", "crs2", "esch", "isres"),
+                   help="rcga (the paper's GA), cmaes, crs2, esch or isres")
     p.add_argument("--task", default="paper",
                    help="paper (still air from 0 m, section 6.3); robust, robust_wide or robust_map (varied starts and winds)")
     p.add_argument("--hidden", default=None,
                    help="hidden layer sizes of the network, e.g. 8,8 (default 6: the paper's 6-6-1 network)")
-    p.add_argument("--population", type=int, default=None, help="population size (rcga default 40)")
-    p.add_argument("--generations", type=int, default=None, help="generations (default 1000)")
-    p.add_argument("--evaluations", type=int, default=None, help="budget in evaluations instead of generations")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--backend", default="paper", help="paper (compiled eq. 7-11) or mujoco")
-    p.add_argument("--inputs", default=None,
+    p.add_argument("--population", type=count(1, 100_000), default=None,
+                   help="population size, up to 100,000 (default: rcga 40, cmaes 4 + 3 ln(genes), nlopt's own)")
+    p.add_argument("--generations", type=count(1, 1_000_000), default=None,
+                   help="generations, up to 1,000,000 (default 1000, the paper's)")
+    p.add_argument("--evaluations", type=count(1, 10**9), default=None,
+                   help="budget in evaluations instead of generations, up to 10^9")
+    add_seed(p)
+    p.add_argument("--backend", default="paper", choices=("paper", "mujoco"), help="paper (compiled eq. 7-11) or mujoco")
+    p.add_argument("--inputs", default=None, choices=("relative", "ground", "both"),
                    help="velocity inputs: relative (air), ground, or both (default: relative; robust task: both)")
-    p.add_argument("--executor", default="process", help="serial, process (default: all cores) or ray")
-    p.add_argument("--workers", type=int, default=None, help="worker processes (default: all cores)")
-    p.add_argument("--ray-address", default=None, help="Ray cluster address (default: start a local one)")
+    add_executor(p)
     p.add_argument("--checkpoint", default=None, help="checkpoint file (default: OUT.ckpt), written every generation")
     p.add_argument("--resume", action="store_true", help="continue from the checkpoint")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out and checkpoint (a new run)")
-    p.add_argument("--out", default=None, help="controller file to write (.json)")
+    p.add_argument("--out", default=None, help="controller file to write (.json; default butterfly_OPT_TASK_sSEED.json)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_json(p)
     add_physics(p)
@@ -276,9 +315,11 @@ def add_commands(sub) -> None:
     p = bf.add_parser("windmap", help="E11: pass/fail map over uniform winds (section 7.2)")
     _add_controller(p)
     add_physics(p)
-    p.add_argument("--step", type=float, default=0.1, help="grid step, m/s")
-    p.add_argument("--max", type=float, default=3.0, help="largest wind component, m/s")
+    p.add_argument("--step", type=num(0.01, 10, unit="m/s"), default=0.1, help="grid step, m/s, at least 0.01")
+    p.add_argument("--max", type=num(0, 10, lo_open=True, unit="m/s"), default=3.0,
+                   help="largest wind component, m/s, at most 10")
     p.add_argument("--plot", default=None, help="write the map as a PNG")
+    add_overwrite(p)
     add_json(p)
     p.set_defaults(func=cmd_windmap)
     p = bf.add_parser("assess", help="a network controller's acceptance numbers (E6, E7, E9, tail wind, E11)")
@@ -289,10 +330,13 @@ def add_commands(sub) -> None:
     p = bf.add_parser("compare", help="the same flight on both backends")
     _add_controller(p)
     add_physics(p)
-    p.add_argument("--config", default="paper", help="paper (equivalent) or rich (free body, heavy wings, strips)")
-    p.add_argument("--force-mode", default=None, help="tip or strip (default: tip for paper, strip for rich)")
-    p.add_argument("--duration", type=float, default=20.0)
-    p.add_argument("--dt", type=float, default=1.0 / 1200.0)
+    p.add_argument("--config", default="paper", choices=("paper", "rich"),
+                   help="paper (equivalent) or rich (free body, heavy wings, strips)")
+    p.add_argument("--force-mode", default=None, choices=("tip", "strip"),
+                   help="tip or strip (default: tip for paper, strip for rich)")
+    p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=20.0,
+                   help="seconds of flight")
+    p.add_argument("--dt", type=num(0, 0.0125, lo_open=True, unit="s"), default=1.0 / 1200.0, help="time step, s")
     add_json(p)
     p.set_defaults(func=cmd_compare)
 
@@ -303,15 +347,16 @@ def add_commands(sub) -> None:
 def _add_scene(p: argparse.ArgumentParser) -> None:
     _add_controller(p, required=False)
     add_physics(p)
-    p.add_argument("--config", default="paper", help="MuJoCo configuration: paper or rich")
-    p.add_argument("--force-mode", default=None, help="tip or strip (default: the configuration's)")
-    p.add_argument("--y0", type=float, default=0.0, help="start altitude, m")
-    p.add_argument("--wind", type=_wind, default=(0.0, 0.0), help="wind A,B in m/s: where it comes from")
+    p.add_argument("--config", default="paper", choices=("paper", "rich"), help="MuJoCo configuration: paper or rich")
+    p.add_argument("--force-mode", default=None, choices=("tip", "strip"), help="tip or strip (default: the configuration's)")
+    p.add_argument("--y0", type=num(-1000, 1000, unit="m"), default=0.0, help="start altitude, m")
+    p.add_argument("--wind", type=_wind, default=(0.0, 0.0), help="wind A,B in m/s: where it comes from, e.g. -2,0")
 
 
 def add_view_args(p: argparse.ArgumentParser) -> None:
     _add_scene(p)
-    p.add_argument("--duration", type=float, default=None, help="stop after this many seconds")
+    p.add_argument("--duration", type=num(0, None, lo_open=True, unit="s"), default=None,
+                   help="stop after this many seconds (default: run until the window is closed)")
 
 
 def view(args) -> None:
@@ -323,8 +368,9 @@ def view(args) -> None:
 
 def add_render_args(p: argparse.ArgumentParser) -> None:
     _add_scene(p)
-    p.add_argument("--duration", type=float, default=3.0, help="seconds of flight")
-    p.add_argument("--camera", default="follow", help="follow (default), side or chase")
+    p.add_argument("--duration", type=num(0, MAX_VIDEO_S, lo_open=True, unit="s"), default=3.0,
+                   help=f"seconds of flight, at most {MAX_VIDEO_S:g}")
+    p.add_argument("--camera", default="follow", choices=("follow", "side", "chase"), help="follow, side or chase")
 
 
 def render(args) -> dict:
@@ -346,7 +392,7 @@ def reproduce(out: Path, args) -> None:
 
 
 def add_bench_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--repeats", type=count(1, 100), default=5, help="timed repeats (the median is reported)")
 
 
 def bench(args) -> tuple[dict, str]:

@@ -8,11 +8,75 @@ import argparse
 from lifelike_mj.errors import UserError
 
 
+class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Help that shows every option's default (argparse's ``%(default)s``), except empty ones."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        if "%(default)" in text or action.default in (None, False, argparse.SUPPRESS) or not action.option_strings:
+            return text
+        return f"{text} (default: %(default)s)"
+
+
 class Parser(argparse.ArgumentParser):
-    """An argument parser whose errors are one sentence (exit status 2, no usage block)."""
+    """An argument parser whose errors are one sentence (exit status 2, no usage block) and whose help
+    shows the defaults."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        kwargs.setdefault("formatter_class", HelpFormatter)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str):  # one sentence, exit 2 (argparse prints usage otherwise)
         raise UserError(f"{message} (see '{self.prog} --help').")
+
+
+def num(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False, unit: str = ""):
+    """An argparse ``type``: a finite number in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``); the range
+    is in the error sentence. Numbers like ``1e3`` and negative values (``-2``) are accepted."""
+    from lifelike_mj import checks
+
+    def parse(text: str) -> float:
+        try:
+            v = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+        try:
+            return checks.number("the value", v, lo, hi, lo_open=lo_open, unit=unit)
+        except UserError as exc:
+            raise argparse.ArgumentTypeError(str(exc).removeprefix("the value ").rstrip(".")) from None
+
+    parse.__name__ = "number"
+    return parse
+
+
+def count(lo: int = 0, hi: int | None = None):
+    """An argparse ``type``: a whole number in ``[lo, hi]`` (``1e6`` is accepted when it is whole)."""
+    def parse(text: str) -> int:
+        try:
+            v = float(text) if any(c in text for c in ".eE") else int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+        if v != v or v in (float("inf"), float("-inf")) or int(v) != v or v < lo or (hi is not None and v > hi):
+            rng = f"from {lo:,} to {hi:,}" if hi is not None else f"of at least {lo:,}"
+            raise argparse.ArgumentTypeError(f"must be a whole number {rng}, got {text!r}")
+        return int(v)
+
+    parse.__name__ = "whole number"
+    return parse
+
+
+def join_negative_values(argv: list[str]) -> list[str]:
+    """``--wind -2,0`` as ``--wind=-2,0``: argparse would read a value that starts with ``-`` as an
+    option unless it is a plain negative number."""
+    import re
+
+    out: list[str] = []
+    for tok in argv:
+        if out and re.match(r"^-[0-9.]", tok) and out[-1].startswith("--") and "=" not in out[-1]:
+            out[-1] = f"{out[-1]}={tok}"
+        else:
+            out.append(tok)
+    return out
 
 
 def emit(args: argparse.Namespace, data: dict, human: str) -> None:
@@ -24,7 +88,17 @@ def emit(args: argparse.Namespace, data: dict, human: str) -> None:
 
 
 def add_json(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--json", action="store_true", help="print the results as JSON")
+    p.add_argument("--json", action="store_true",
+                   help="print the results as JSON on stdout (progress bars stay on stderr)")
+
+
+def add_overwrite(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--overwrite", action="store_true", help="replace output files that already exist")
+
+
+def add_seed(p: argparse.ArgumentParser, default: int = 0) -> None:
+    p.add_argument("--seed", type=count(0, 2**32 - 1), default=default,
+                   help="random seed, 0 to 2^32-1: the same seed gives the same result")
 
 
 def seeds(text: str) -> list[int]:
@@ -40,3 +114,44 @@ def seeds(text: str) -> list[int]:
     if not out or min(out) < 0:
         raise UserError(f"--seeds must name non-negative seeds, got {text!r}.")
     return out
+
+
+def add_executor(p: argparse.ArgumentParser) -> None:
+    """``--executor``, ``--workers``, ``--ray-address`` (checked together by :func:`check_executor`)."""
+    p.add_argument("--executor", default="process", choices=("serial", "process", "ray"),
+                   help="where candidates are evaluated: serial (this process), process (a pool on this machine) or ray")
+    p.add_argument("--workers", type=count(1, 1024), default=None,
+                   help="worker processes (process) or chunks per batch (ray), 1 to 1024 (default: all cores)")
+    p.add_argument("--ray-address", default=None,
+                   help="Ray cluster to join, HOST:PORT or ray://HOST:PORT (default: start a local one); only with "
+                        "--executor ray")
+
+
+def check_executor(args: argparse.Namespace) -> None:
+    """Refuse executor options that would be ignored; check a Ray address before any work."""
+    if args.executor == "serial" and args.workers is not None:
+        raise UserError("--workers does not apply to --executor serial.")
+    if args.ray_address is not None:
+        if args.executor != "ray":
+            raise UserError("--ray-address only applies to --executor ray.")
+        from lifelike_mj.evolve.evaluators import check_ray_address
+
+        check_ray_address(args.ray_address)
+
+
+def check_outputs(args: argparse.Namespace, files: dict[str, tuple[str, ...]] | None = None,
+                  folders: dict[str, tuple[str, ...]] | None = None) -> None:
+    """Before any work: each option in ``files`` (name -> allowed suffixes) names a file that can be written
+    and does not exist unless ``--overwrite``; each option in ``folders`` (name -> the files it will hold)
+    names a folder whose files do not exist yet unless ``--overwrite``."""
+    from lifelike_mj.paths import check_output_dir, check_output_file
+
+    overwrite = bool(getattr(args, "overwrite", False))
+    for opt, suffixes in (files or {}).items():
+        value = getattr(args, opt.lstrip("-").replace("-", "_"), None)
+        if value:
+            check_output_file(value, opt, suffixes=suffixes, overwrite=overwrite)
+    for opt, names in (folders or {}).items():
+        value = getattr(args, opt.lstrip("-").replace("-", "_"), None)
+        if value:
+            check_output_dir(value, opt, names, overwrite=overwrite)

@@ -6,10 +6,15 @@ import argparse
 from pathlib import Path
 
 from lifelike_mj.checks import positive
-from lifelike_mj.cli.common import add_json, emit
+from lifelike_mj.cli.common import add_json, add_overwrite, add_seed, check_outputs, count, emit, num
 from lifelike_mj.errors import UserError
 
 NAME = "fish"
+#: Bounds of the command line: fish in a tank, simulated seconds, the smallest tank (2.5 body lengths a side).
+MAX_FISH = 5000
+MAX_DURATION_S = 3600.0
+MIN_TANK_SCALE = 0.35
+SWIM_FILES = ("tracks.npz", "tracks.csv", "tracks.png", "accel_histogram.png", "measures.json")
 HELP = "the tropical fish of Satoi et al. 2015"
 
 
@@ -20,8 +25,6 @@ def _preset(args):
 
 
 def _count(n) -> int:
-    if n is None or n < 1:
-        raise UserError(f"--fish must be at least 1, got {n}.")
     return int(n)
 
 
@@ -34,10 +37,11 @@ def _tank(args):
 def _add_fish(p) -> None:
     p.add_argument("--preset", default="default",
                    help="fish motion preset: NB-ND, NB-D, B-ND, B-D, default (= B-D), or a JSON file")
-    p.add_argument("--fish", type=int, default=10, help="number of fish")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--tank-scale", type=float, default=1.0,
-                   help="tank size as a fraction of the filmed 5 m x 0.5 m x 1 m tank")
+    p.add_argument("--fish", type=count(1, MAX_FISH), default=10, help=f"number of fish, 1 to {MAX_FISH:,}")
+    add_seed(p)
+    p.add_argument("--tank-scale", type=num(MIN_TANK_SCALE, 10.0), default=1.0,
+                   help=f"tank size as a fraction of the filmed 5 m x 0.5 m x 1 m tank, {MIN_TANK_SCALE} to 10 "
+                        "(every side at least 2.5 body lengths)")
 
 
 def _check_camera(camera: str) -> None:
@@ -51,14 +55,11 @@ def cmd_swim(args) -> None:
     from lifelike_mj.fish.experiments import swim_summary, write_swim
     from lifelike_mj.fish.sim import swim
 
+    check_outputs(args, files={"--video": (".mp4", ".gif")}, folders={"--out": SWIM_FILES})
+    if args.video_duration != 10.0 and not args.video:
+        raise UserError("--video-duration only applies with --video.")
     params = _preset(args)
     n = _count(args.fish)
-    if args.seed < 0:
-        raise UserError(f"--seed must be a non-negative whole number, got {args.seed}.")
-    if args.video and Path(args.video).suffix.lower() not in (".mp4", ".gif"):
-        raise UserError(f"--video must end in .mp4 or .gif, got {args.video!r}.")
-    if args.video:
-        _check_camera(args.camera)
     r = swim(params, n, positive("--duration", args.duration), args.seed, _tank(args), progress=not args.json)
     summary = swim_summary(r)
     if args.out:
@@ -90,11 +91,14 @@ def add_commands(sub) -> None:
     fish = sub.add_parser(NAME, help=HELP).add_subparsers(dest="sub", required=True, parser_class=Parser)
     p = fish.add_parser("swim", help="a tank of fish: tracks and life-likeness measures")
     _add_fish(p)
-    p.add_argument("--duration", type=float, default=30.0, help="simulated seconds")
+    p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=30.0,
+                   help=f"simulated seconds, at most {MAX_DURATION_S:g}")
     p.add_argument("--out", help="folder for tracks (npz, CSV), measures and figures")
     p.add_argument("--video", help="also render FILE.mp4 or FILE.gif (same seed, same swim)")
-    p.add_argument("--video-duration", type=float, default=10.0, help="seconds of video (at most --duration)")
-    p.add_argument("--camera", default="side", help="video camera: side, oblique or follow")
+    p.add_argument("--video-duration", type=num(0, 600, lo_open=True, unit="s"), default=10.0,
+                   help="seconds of video (at most --duration); only with --video")
+    p.add_argument("--camera", default="side", choices=("side", "oblique", "follow"), help="video camera")
+    add_overwrite(p)
     add_json(p)
     p.set_defaults(func=cmd_swim)
     p = fish.add_parser("drag-check", help="custom drag (C_D = 1) against MuJoCo's inertia-box fluid model")
@@ -104,8 +108,9 @@ def add_commands(sub) -> None:
 
 def add_view_args(p: argparse.ArgumentParser) -> None:
     _add_fish(p)
-    p.add_argument("--duration", type=float, default=None, help="stop after this many seconds")
-    p.add_argument("--camera", default="side", help="side (default) or follow")
+    p.add_argument("--duration", type=num(0, None, lo_open=True, unit="s"), default=None,
+                   help="stop after this many seconds (default: run until the window is closed)")
+    p.add_argument("--camera", default="side", choices=("side", "follow"), help="viewer camera")
 
 
 def view(args) -> None:
@@ -116,8 +121,8 @@ def view(args) -> None:
 
 def add_render_args(p: argparse.ArgumentParser) -> None:
     _add_fish(p)
-    p.add_argument("--duration", type=float, default=3.0, help="seconds of swim")
-    p.add_argument("--camera", default="side", help="side (default), oblique or follow")
+    p.add_argument("--duration", type=num(0, 600, lo_open=True, unit="s"), default=3.0, help="seconds of swim, at most 600")
+    p.add_argument("--camera", default="side", choices=("side", "oblique", "follow"), help="video camera")
 
 
 def render(args) -> dict:
@@ -138,8 +143,9 @@ def reproduce(out: Path, args) -> None:
 
 
 def add_bench_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--repeats", type=int, default=5)
-    p.add_argument("--long-minutes", type=float, default=10.0, help="simulated minutes of the no-escape run")
+    p.add_argument("--repeats", type=count(1, 100), default=5, help="timed repeats (the median is reported)")
+    p.add_argument("--long-minutes", type=num(0, 600, lo_open=True, unit="min"), default=10.0,
+                   help="simulated minutes of the no-escape run")
 
 
 def bench(args) -> tuple[dict, str]:

@@ -127,7 +127,7 @@ def test_controller_file_round_trip_and_bad_weight_count(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv, needle", [
-    (["butterfly", "evolve", "--optimizer", "nonsense", "--generations", "1"], "unknown optimizer"),
+    (["butterfly", "evolve", "--optimizer", "nonsense", "--generations", "1"], "invalid choice: 'nonsense'"),
     (["butterfly", "evolve", "--optimizer", "rcga", "--population", "2", "--generations", "1"], "minimum"),
     (["butterfly", "evolve", "--optimizer", "rcga", "--task", "elsewhere", "--generations", "1"], "unknown task"),
     (["butterfly", "windmap", "--controller", "simple_rule"], "network"),
@@ -208,8 +208,9 @@ def test_cli_evolve_writes_a_controller_with_provenance_same_on_serial_and_proce
     outs = {}
     for ex in ("serial", "process"):
         out = tmp_path / f"{ex}.json"
+        workers = ["--workers", "2"] if ex == "process" else []
         assert main(["butterfly", "evolve", "--optimizer", "rcga", "--population", "6", "--generations", "3", "--seed",
-                     "5", "--executor", ex, "--workers", "2", "--quiet", "--out", str(out)]) == 0
+                     "5", "--executor", ex, *workers, "--quiet", "--out", str(out)]) == 0
         outs[ex] = json.loads(out.read_text())
         assert (tmp_path / f"{ex}.json.ckpt").exists()
     a, b = outs["serial"], outs["process"]
