@@ -9,7 +9,6 @@ Both hold one folder per creature: ``models/butterfly/butterfly.xml``,
 from __future__ import annotations
 
 import json
-import os
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -93,9 +92,20 @@ def check_writable(path: str | Path, what: str = "output") -> Path:
     parent = _existing_parent(p)
     if not parent.is_dir():
         raise UserError(f"{what} {p} cannot be written: {parent} is a file, not a folder.")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise UserError(f"{what} {p} cannot be written: no permission to write in {parent}.")
+    _probe(parent, p, what)
     return p
+
+
+def _probe(folder: Path, target: Path, what: str) -> None:
+    """Whether a file can be made in ``folder`` (an anonymous temporary file, gone at once: ``os.access``
+    says yes to root everywhere, even in /proc)."""
+    import tempfile
+
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as exc:
+        raise UserError(f"{what} {target} cannot be written in {folder} ({exc.strerror or type(exc).__name__}).") from None
 
 
 def check_output_file(path: str | Path, what: str, *, suffixes: Iterable[str] = (), overwrite: bool = False) -> Path:
@@ -120,8 +130,7 @@ def check_output_dir(path: str | Path, what: str, names: Iterable[str] = (), *, 
     parent = p if p.exists() else _existing_parent(p)
     if not parent.is_dir():
         raise UserError(f"{what} {p} cannot be made: {parent} is a file, not a folder.")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise UserError(f"{what} {p} cannot be written: no permission to write in {parent}.")
+    _probe(parent, p, what)
     if not overwrite:
         there = [n for n in names if (p / n).exists()]
         if there:

@@ -41,6 +41,8 @@ from lifelike_mj.errors import UserError
 R_S, R_A, R_C = 1.0, 2.5, 4.5
 W_S = 0.05
 BOX = 20.0
+#: Widest box, in multiples of R_c (the neighbour grid holds (box / R_c)^3 cells: 200^3 = 8 million).
+MAX_BOX_ZONES = 200
 N_AGENTS = 300
 #: A run has diverged (section 2.2: w_a >= 10 or w_c >= 1) when an agent moves farther than the box
 #: side in one step (box units per step, as a multiple of the box side): the walls and zones no
@@ -82,6 +84,9 @@ class BoidParams:
                             f"R_c = {self.r_c}.")
         if self.box <= 2 * self.r_c:
             raise UserError(f"the box ({self.box}) must be wider than 2 R_c ({2 * self.r_c}).")
+        if self.box > MAX_BOX_ZONES * self.r_c:
+            raise UserError(f"the box ({self.box:g}) may be at most {MAX_BOX_ZONES} R_c ({MAX_BOX_ZONES * self.r_c:g}) "
+                            "wide: the neighbour grid has (box / R_c)^3 cells.")
         if self.dims not in (2, 3):
             raise UserError(f"dims must be 2 or 3, got {self.dims!r}.")
         if self.dt <= 0 or self.mass <= 0:

@@ -17,11 +17,15 @@ from pathlib import Path
 from lifelike_mj.boids.engine import BoidParams
 from lifelike_mj.errors import UserError
 from lifelike_mj.paths import controllers_dir, load_named_json
+from lifelike_mj.schema import check_header, check_keys, finite, number_list
 
 FORMAT = "lifelike-mj/boids-preset"
 GRID_FORMAT = "lifelike-mj/boids-grid"
 PATTERNS = ("4a", "4b", "4c", "4d", "5a", "5b", "5c", "5d")
 _SETTINGS = ("r_s", "r_a", "r_c", "w_s", "box")
+#: Largest homogeneous weight and grid of :func:`load_grid`.
+MAX_WEIGHT = 100.0
+MAX_GRID_CELLS = 10_000
 
 
 def preset_path(name: str) -> Path:
@@ -35,15 +39,16 @@ def _read(ref: str | Path) -> tuple[dict, Path]:
 def load_preset(ref: str | Path, dims: int = 3) -> BoidParams:
     """A pattern preset by name (``4a`` ... ``5d``) or path, as :class:`BoidParams` in ``dims`` D."""
     data, p = _read(ref)
-    if not isinstance(data, dict) or data.get("format") != FORMAT:
-        raise UserError(f"{p} is not a boids preset (format {FORMAT!r} expected).")
-    if "W_a" not in data or "W_c" not in data:
-        raise UserError(f"boids preset {p} needs both W_a and W_c.")
-    settings = data.get("settings", {}) or {}
-    unknown = sorted(set(settings) - set(_SETTINGS))
-    if unknown:
-        raise UserError(f"boids preset {p} has unknown setting(s): {', '.join(unknown)}.")
-    return BoidParams(wa=data["W_a"], wc=data["W_c"], dims=dims, name=str(data.get("name", p.stem)), **settings)
+    where = f"boids preset {p}"
+    check_header(data, FORMAT, where, kind="boids preset")
+    check_keys(data, ("format", "version", "name", "figure", "description", "W_a", "W_c", "settings"), where,
+               required=("W_a", "W_c"))
+    settings = data.get("settings", {})
+    if not isinstance(settings, dict):
+        raise UserError(f"{where}: 'settings' must be an object like {{\"r_s\": 1.0}}, got {settings!r}.")
+    check_keys(settings, _SETTINGS, f"{where} 'settings'")
+    values = {k: finite(v, k, where) for k, v in settings.items()}
+    return BoidParams(wa=data["W_a"], wc=data["W_c"], dims=dims, name=str(data.get("name", p.stem)), **values)
 
 
 def preset_info(ref: str | Path) -> dict:
@@ -54,9 +59,16 @@ def preset_info(ref: str | Path) -> dict:
 def load_grid(ref: str | Path = "fig2_grid") -> dict:
     """The homogeneous grid of Fig. 2: ``{"w_a": [...], "w_c": [...]}``."""
     data, p = _read(ref)
-    if not isinstance(data, dict) or data.get("format") != GRID_FORMAT:
-        raise UserError(f"{p} is not a boids grid (format {GRID_FORMAT!r} expected).")
-    return {"w_a": [float(x) for x in data["w_a"]], "w_c": [float(x) for x in data["w_c"]], "name": p.stem}
+    where = f"boids grid {p}"
+    check_header(data, GRID_FORMAT, where, kind="boids grid")
+    check_keys(data, ("format", "version", "name", "description", "w_a", "w_c"), where, required=("w_a", "w_c"))
+    axes = {k: number_list(data[k], k, where) for k in ("w_a", "w_c")}
+    for k, vals in axes.items():
+        if any(v < 0 or v > MAX_WEIGHT for v in vals):
+            raise UserError(f"{where}: every {k} must be in [0, {MAX_WEIGHT:g}], got {vals}.")
+    if len(axes["w_a"]) * len(axes["w_c"]) > MAX_GRID_CELLS:
+        raise UserError(f"{where} has {len(axes['w_a']) * len(axes['w_c'])} cells; at most {MAX_GRID_CELLS}.")
+    return {**axes, "name": p.stem}
 
 
 def homogeneous(w_a: float, w_c: float, dims: int = 3) -> BoidParams:

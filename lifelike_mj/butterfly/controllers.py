@@ -33,6 +33,7 @@ from lifelike_mj.butterfly import ann
 from lifelike_mj.butterfly.params import FlapPattern
 from lifelike_mj.errors import UserError
 from lifelike_mj.paths import load_named_json, shipped_names
+from lifelike_mj.schema import check_header, check_keys
 
 FORMAT = "lifelike-mj/butterfly-controller"
 
@@ -52,6 +53,10 @@ PITCH_LAWS: dict[str, tuple[int, tuple[str, ...]]] = {
     "simple_rule": (KIND_SIMPLE_RULE, ("phi_up_deg", "phi_down_deg")),
     "ann": (KIND_ANN, ("weights",)),
 }
+
+
+#: Optional parameters of an ann controller file besides its weights.
+ANN_OPTIONAL = ("inputs", "input_scale", "layers", "max_dphi_deg", "phi_limit_deg")
 
 
 @dataclass(frozen=True)
@@ -144,13 +149,16 @@ class ButterflyController:
 def from_dict(data: object, name: str = "") -> ButterflyController:
     """Validate plain data and build a controller; malformed data raises :class:`UserError`."""
     where = f"controller {name}" if name else "controller"
-    if not isinstance(data, dict):
-        raise UserError(f"{where} is not a JSON object.")
-    if data.get("format") != FORMAT:
-        raise UserError(f"{where} is not a butterfly controller file (format must be {FORMAT!r}).")
+    check_header(data, FORMAT, where, kind="butterfly controller file")
+    check_keys(data, ("format", "version", "name", "description", "type", "flap", "parameters", "provenance"), where,
+               required=("type", "flap", "parameters"))
     for key, kind in (("type", str), ("flap", dict), ("parameters", dict)):
         if not isinstance(data.get(key), kind):
             raise UserError(f"{where} needs a {key!r} entry of type {kind.__name__}.")
+    if data["type"] in PITCH_LAWS:
+        allowed = PITCH_LAWS[data["type"]][1] + (ANN_OPTIONAL if data["type"] == "ann" else ())
+        check_keys(data["parameters"], allowed, f"{where} 'parameters'")
+    check_keys(data["flap"], ("frequency_hz", "theta_min_deg", "theta_max_deg"), f"{where} 'flap'")
     flap = data["flap"]
     try:
         pattern = FlapPattern(

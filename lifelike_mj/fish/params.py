@@ -55,6 +55,7 @@ import numpy as np
 from lifelike_mj import checks
 from lifelike_mj.errors import UserError
 from lifelike_mj.paths import controllers_dir, load_named_json
+from lifelike_mj.schema import check_header, check_keys, finite, number_list
 
 FORMAT = "lifelike-mj/fish-preset"
 #: The paper's four patterns (section 5.1.1) and the calibrated default.
@@ -150,8 +151,10 @@ class FishParams:
                             f"got {self.avoid_force_scale}.")
         if not (0 < self.vision_angle_deg < 90):
             raise UserError(f"vision_angle_deg must lie in (0, 90), got {self.vision_angle_deg}.")
-        if int(self.substeps) != self.substeps or self.substeps < 1:
-            raise UserError(f"substeps must be a positive whole number, got {self.substeps}.")
+        if int(self.substeps) != self.substeps or not 1 <= self.substeps <= 100:
+            raise UserError(f"substeps must be a whole number from 1 to 100, got {self.substeps}.")
+        if not 1.0 <= self.control_hz <= 10_000.0:
+            raise UserError(f"control_hz must be in [1, 10000] Hz (the paper's is 60), got {self.control_hz}.")
 
     # ---- the Markov chain (section 3.3) ----
     def transition_matrix(self, avoiding: bool = False) -> np.ndarray:
@@ -203,15 +206,21 @@ _FIELDS = {f.name for f in fields(FishParams)} - {"name", "description"}
 
 def params_from_dict(data: dict, name: str = "") -> FishParams:
     """Build :class:`FishParams` from a preset file's content (unknown keys are an error)."""
-    if not isinstance(data, dict) or data.get("format") != FORMAT:
-        raise UserError(f"{name or 'the file'} is not a fish preset (format {FORMAT!r} expected).")
-    params = data.get("parameters")
+    where = f"fish preset {name}".strip()
+    check_header(data, FORMAT, where, kind="fish preset")
+    check_keys(data, ("format", "version", "name", "description", "parameters"), where, required=("parameters",))
+    params = data["parameters"]
     if not isinstance(params, dict):
-        raise UserError(f"fish preset {name} has no 'parameters' object.")
-    unknown = sorted(set(params) - _FIELDS)
-    if unknown:
-        raise UserError(f"fish preset {name} has unknown parameter(s): {', '.join(unknown)}.")
-    kw = {k: (tuple(v) if isinstance(v, list) else v) for k, v in params.items()}
+        raise UserError(f"{where}: 'parameters' must be an object, got {params!r}.")
+    check_keys(params, sorted(_FIELDS), f"{where} 'parameters'")
+    kw = {}
+    for k, v in params.items():
+        if k in ("brake_dS_v_m2", "brake_dS_w_m5"):
+            kw[k] = tuple(number_list(v, k, where, length=3))
+        elif k == "transition":
+            kw[k] = v
+        else:
+            kw[k] = finite(v, k, where)
     return FishParams(**kw, name=str(data.get("name", name)), description=str(data.get("description", "")))
 
 
@@ -224,6 +233,9 @@ def load_preset(name_or_path: str | Path | None = None, _seen: tuple[str, ...] =
     ref = "default" if name_or_path is None else str(name_or_path)
     data, p = load_named_json("fish", ref, "fish preset")
     if isinstance(data, dict) and "same_as" in data:
+        where = f"fish preset {p.stem}"
+        check_header(data, FORMAT, where, kind="fish preset")
+        check_keys(data, ("format", "version", "name", "description", "same_as"), where)
         target = str(data["same_as"])
         if target in _seen:
             raise UserError(f"fish preset {ref} refers back to itself through 'same_as'.")

@@ -136,3 +136,17 @@ def test_killing_the_main_process_leaves_no_worker_alive(tmp_path):
     finally:
         if proc.poll() is None:
             proc.kill()
+
+
+def test_ctrl_c_before_the_first_generation_exits_130_and_writes_nothing(tmp_path, capsys, small_problem,
+                                                                          monkeypatch):
+    from lifelike_mj.evolve import rcga
+
+    def interrupted(run):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(rcga, "run_rcga", interrupted)
+    assert main(_evolve(tmp_path)) == 130
+    err = capsys.readouterr().err
+    assert "interrupted: stopped before the first generation was evaluated; nothing was written." in err
+    assert not (tmp_path / "ctrl.json").exists() and not (tmp_path / "ctrl.json.ckpt").exists()
