@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lifelike_mj import checks
 from lifelike_mj.boids.engine import N_AGENTS, BoidParams, BoidRun, simulate
 from lifelike_mj.boids.presets import PATTERNS
 from lifelike_mj.errors import UserError
@@ -36,18 +37,32 @@ def run_settings() -> dict:
 
 
 def classified_run(params: BoidParams, n: int = N_AGENTS, seed: int = 0, n_steps: int | None = None,
-                   trail_steps: int = 5, progress: bool = False) -> tuple[BoidRun, dict, str, object]:
-    """Run, measure over the late window and classify. The run records every ``record_every`` steps
-    over the window and every step over the last ``trail_steps`` (for the paper-style figure).
-    Returns ``(run, measures, label, reasons)``."""
+                   trail_steps: int = 5, progress: bool = False,
+                   record_every: int | None = None) -> tuple[BoidRun, dict, str, object]:
+    """Run, measure over the late window and classify. The run records every ``record_every`` steps of
+    the classifier (:func:`run_settings`) over the window and every step over the last ``trail_steps``
+    (for the paper-style figure). Returns ``(run, measures, label, reasons)``.
+
+    ``record_every=K`` keeps the whole run instead: every ``K``-th step from step 0, as well as the
+    classifier's frames, which alone are measured (so the measures and the label do not depend on ``K``).
+    """
     from lifelike_mj.boids import metrics
 
     s = run_settings()
     steps = int(n_steps or s["n_steps"])
     window = min(s["window"], steps)
-    run = simulate(params, n, steps, seed, record_every=s["record_every"], record_from=steps - window, progress=progress,
-                   extra_steps=range(steps - trail_steps, steps + 1))
-    m = metrics.measures(run, window=window)
+    trail = range(steps - trail_steps, steps + 1)
+    if record_every is None:
+        run = simulate(params, n, steps, seed, record_every=s["record_every"], record_from=steps - window,
+                       progress=progress, extra_steps=trail)
+        measured = run
+    else:
+        classifier = sorted(set(range(steps - window, steps + 1, s["record_every"])) | set(trail))
+        run = simulate(params, n, steps, seed, record_every=checks.whole("record_every", record_every, 1),
+                       record_from=0, progress=progress, extra_steps=classifier)
+        keep = np.isin(run.steps, classifier)
+        measured = replace(run, steps=run.steps[keep], positions=run.positions[keep], velocities=run.velocities[keep])
+    m = metrics.measures(measured, window=window)
     label, reasons = metrics.classify(m)
     return run, m, label, reasons
 
@@ -188,7 +203,14 @@ def write_sweep(result: dict, sweep: Sweep, values: list[list[float]], out_dir: 
     from lifelike_mj.io import write_json
 
     out = Path(out_dir)
-    files = [write_json(out / "sweep.json", result)]
+    from dataclasses import asdict
+
+    from lifelike_mj.provenance import provenance
+
+    base = {("W_a" if k == "wa" else "W_c" if k == "wc" else k): v for k, v in asdict(sweep.base).items()}
+    prov = provenance(base=base, axes=list(sweep.axes), values=[list(map(float, v)) for v in values], n=sweep.n,
+                      steps=sweep.n_steps)
+    files = [write_json(out / "sweep.json", {**result, "provenance": prov})]
     if len(values) == 2:
         from lifelike_mj.boids.figures import phase_diagram_figure
 
@@ -199,13 +221,26 @@ def write_sweep(result: dict, sweep: Sweep, values: list[list[float]], out_dir: 
 
 
 def measured_run(params: BoidParams, n: int = N_AGENTS, seed: int = 0, n_steps: int | None = None,
-                 progress: bool = False) -> tuple[BoidRun, dict]:
+                 progress: bool = False, record_every: int | None = None) -> tuple[BoidRun, dict]:
     """:func:`classified_run` as ``boids run`` reports it: ``(run, result)`` with ``result`` holding the
     label, the classifier's reasons, every measure, and the run's settings and wall time."""
-    run, m, label, reasons = classified_run(params, n, seed, n_steps, progress=progress)
+    run, m, label, reasons = classified_run(params, n, seed, n_steps, progress=progress, record_every=record_every)
     result = {"label": label, "reasons": reasons, **m, "preset": params.name, "n": n, "seed": seed,
               "steps": int(run.steps[-1]), "dims": params.dims, "wall_time_s": run.wall_time_s}
     return run, result
+
+
+def run_provenance(run: BoidRun) -> dict:
+    """Everything that made ``run``: the matrices (Nakamura 2013 eq. 1-3), zones, weights, box, agents,
+    seed and steps recorded, with the package version and the command."""
+    from dataclasses import asdict
+
+    from lifelike_mj.provenance import provenance
+
+    p = asdict(run.params)
+    return provenance(**{("W_a" if k == "wa" else "W_c" if k == "wc" else k): v for k, v in p.items()},
+                      n=int(run.positions.shape[1]), seed=int(run.seed), steps=int(run.steps[-1]),
+                      recorded_steps=int(len(run.steps)))
 
 
 def write_run(run: BoidRun, result: dict, out_dir: str | Path) -> list[str]:
@@ -214,5 +249,5 @@ def write_run(run: BoidRun, result: dict, out_dir: str | Path) -> list[str]:
     from lifelike_mj.io import write_json
 
     files = write_trajectories(run, out_dir)
-    write_json(Path(out_dir) / "measures.json", result)
+    write_json(Path(out_dir) / "measures.json", {**result, "provenance": run_provenance(run)})
     return [str(f) for f in files.values()]

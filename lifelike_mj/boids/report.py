@@ -19,6 +19,7 @@ from lifelike_mj.boids.experiments import LABELS, Sweep, classified_run, run_set
 from lifelike_mj.boids.presets import PATTERNS, homogeneous, load_grid, load_preset
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import write_json, write_text
+from lifelike_mj.progress import Stages
 
 SEEDS = (0, 1, 2, 3, 4)
 ROBUST = ("4a", "4b", "4c", "5a", "5c", "5d")
@@ -32,29 +33,38 @@ def _perturbed(name: str, which: str, factor: float):
     return replace(p, **{which: tuple(map(tuple, m.tolist()))}, name=f"{name} {which}x{factor:g}")
 
 
-def _runs(params_list, seeds, executor, workers):
+def _runs(params_list, seeds, executor, workers, bar=None):
     """Rows (label, paper_picture, measures) of each (params, seed), one Sweep per parameter set."""
-    return [run_sweep(Sweep(p, ()), [], seeds, executor=executor, workers=workers)["rows"] for p in params_list]
+    rows = []
+    for p in params_list:
+        rows.append(run_sweep(Sweep(p, ()), [], seeds, executor=executor, workers=workers)["rows"])
+        if bar is not None:
+            bar.update(1)
+    return rows
 
 
 def reproduce_boids(out: str | Path, seeds=SEEDS, executor: str = "process", workers: int | None = None,
-                    phase_steps: int = 7) -> dict:
+                    phase_steps: int = 7, progress: bool = True) -> dict:
     from lifelike_mj.boids.figures import homogeneous_grid_figure, patterns_grid_figure, phase_diagram_figure
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     settings = run_settings()
     results: dict = {"settings": settings, "seeds": list(seeds)}
+    st = Stages("reproduce boids", 6, progress)
 
     # Fig. 4-5: one classified run per pattern (seed 0), drawn in the paper's style
     runs = {}
-    for name in PATTERNS:
-        run, m, label, _ = classified_run(load_preset(name), N_AGENTS, 0)
-        runs[f"{name} (classified {label})"] = run
-    patterns_grid_figure(runs, out / "fig4_5_patterns.png")
+    with st.next("Fig. 4-5: the eight patterns, seed 0", total=len(PATTERNS), unit="run") as b:
+        for name in PATTERNS:
+            run, m, label, _ = classified_run(load_preset(name), N_AGENTS, 0)
+            runs[f"{name} (classified {label})"] = run
+            b.update(1)
+        patterns_grid_figure(runs, out / "fig4_5_patterns.png")
 
     # confusion table over seeds
-    rows = _runs([load_preset(n) for n in PATTERNS], seeds, executor, workers)
+    with st.next(f"confusion table: eight patterns x {len(seeds)} seeds", total=len(PATTERNS), unit="pattern") as b:
+        rows = _runs([load_preset(n) for n in PATTERNS], seeds, executor, workers, b)
     confusion, pictures = {}, {}
     for name, rr in zip(PATTERNS, rows):
         labs = [r["label"] for r in rr]
@@ -65,21 +75,25 @@ def reproduce_boids(out: str | Path, seeds=SEEDS, executor: str = "process", wor
 
     # robustness of the robust patterns
     pert = [(name, which, f) for name in ROBUST for which in ("wa", "wc") for f in PERTURBATIONS]
-    prows = _runs([_perturbed(*x) for x in pert], seeds[:2], executor, workers)
+    with st.next(f"robust patterns under perturbed matrices x {len(seeds[:2])} seeds", total=len(pert),
+                 unit="matrix") as b:
+        prows = _runs([_perturbed(*x) for x in pert], seeds[:2], executor, workers, b)
     results["perturbations"] = [{"preset": n, "matrix": w, "factor": f, "labels": [r["label"] for r in rr]}
                                 for (n, w, f), rr in zip(pert, prows)]
 
     # Fig. 2: the homogeneous grid, and divergence
     g = load_grid()
     grid_runs = {}
-    for wa in g["w_a"]:
-        for wc in g["w_c"]:
-            try:
-                run, m, _, _ = classified_run(homogeneous(wa, wc), N_AGENTS, 0)
-                grid_runs[(wa, wc)] = run
-            except UserError:
-                grid_runs[(wa, wc)] = None
-    homogeneous_grid_figure(grid_runs, out / "fig2_homogeneous.png")
+    with st.next("Fig. 2: the homogeneous grid", total=len(g["w_a"]) * len(g["w_c"]), unit="run") as b:
+        for wa in g["w_a"]:
+            for wc in g["w_c"]:
+                try:
+                    run, m, _, _ = classified_run(homogeneous(wa, wc), N_AGENTS, 0)
+                    grid_runs[(wa, wc)] = run
+                except UserError:
+                    grid_runs[(wa, wc)] = None
+                b.update(1)
+        homogeneous_grid_figure(grid_runs, out / "fig2_homogeneous.png")
     from lifelike_mj.boids import metrics
 
     hom = []
@@ -92,18 +106,22 @@ def reproduce_boids(out: str | Path, seeds=SEEDS, executor: str = "process", wor
             "polarisation", "speed", "n_groups", "nn_distance", "radius_of_gyration") if k in m}})
     results["homogeneous"] = hom
     div = []
-    for wa, wc in ((10.0, 0.01), (0.1, 1.0), (1.0, 1.0), (0.001, 1.0)):
-        try:
-            classified_run(homogeneous(wa, wc), N_AGENTS, 0)
-            div.append({"w_a": wa, "w_c": wc, "diverged": False})
-        except UserError as exc:
-            div.append({"w_a": wa, "w_c": wc, "diverged": True, "message": str(exc)})
+    with st.next("divergence (section 2.2)", total=4, unit="run") as b:
+        for wa, wc in ((10.0, 0.01), (0.1, 1.0), (1.0, 1.0), (0.001, 1.0)):
+            try:
+                classified_run(homogeneous(wa, wc), N_AGENTS, 0)
+                div.append({"w_a": wa, "w_c": wc, "diverged": False})
+            except UserError as exc:
+                div.append({"w_a": wa, "w_c": wc, "diverged": True, "message": str(exc)})
+            b.update(1)
     results["divergence"] = div
 
     # phase diagram over the cross-type weights, diagonal of 5a (W_a = 0.5, W_c = 0.01)
     xa = [float(x) for x in np.linspace(-0.3, 0.5, phase_steps)]
     yc = [float(x) for x in np.linspace(-0.01, 0.01, phase_steps)]
-    ph = run_sweep(Sweep(load_preset("5a"), ("wa_cross", "wc_cross")), [xa, yc], [0], executor=executor, workers=workers)
+    with st.next(f"phase diagram over the cross-type weights ({phase_steps} x {phase_steps} runs)"):
+        ph = run_sweep(Sweep(load_preset("5a"), ("wa_cross", "wc_cross")), [xa, yc], [0], executor=executor,
+                       workers=workers)
     lab = np.array([[ph["majority"][f"{a:g},{b:g}"] for a in xa] for b in yc])
     phase_diagram_figure(lab, xa, yc, "cross-type alignment w_aAB = w_aBA", "cross-type cohesion w_cAB = w_cBA",
                          out / "phase_diagram.png")
@@ -140,7 +158,11 @@ def reproduce_boids(out: str | Path, seeds=SEEDS, executor: str = "process", wor
         L.append(f"* w_a = {d['w_a']:g}, w_c = {d['w_c']:g}: {'diverged: ' + d['message'] if d['diverged'] else 'no'}")
     L += ["", "## Phase diagram over the cross-type weights (diagonal of 5a)", "", "![phase](phase_diagram.png)", ""]
     write_text(out / "report.md", "\n".join(L))
+    from lifelike_mj.provenance import provenance
+
+    results["provenance"] = provenance(seeds=list(seeds), executor=executor, workers=workers, phase_steps=phase_steps)
     write_json(out / "results.json", results)
+    st.done(f"wrote {out / 'report.md'}")
     return results
 
 

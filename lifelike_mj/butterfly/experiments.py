@@ -461,6 +461,8 @@ class FlyResult:
 
     trajectory: Trajectory
     summary: dict
+    #: What made the flight (:func:`lifelike_mj.provenance.provenance`): controller, constants, conditions.
+    provenance: dict = field(default_factory=dict)
 
     def write(self, out_dir: str, title: str = "") -> list[str]:
         """``trajectory.npz``, ``trajectory.csv``, ``flight.png`` and ``summary.json`` into ``out_dir``
@@ -474,7 +476,7 @@ class FlyResult:
         files = [write_npz(out / "trajectory.npz", **self.trajectory.to_npz_dict()),
                  write_text(out / "trajectory.csv", self.trajectory.to_csv())]
         fig_flight(self.trajectory, out / "flight.png", title)
-        files += [out / "flight.png", write_json(out / "summary.json", self.summary)]
+        files += [out / "flight.png", write_json(out / "summary.json", {**self.summary, "provenance": self.provenance})]
         return [str(f) for f in files]
 
 
@@ -498,4 +500,11 @@ def fly(controller: controllers.ButterflyController, params: ButterflyParams | N
 
         raise Diverged(traj.diverged_cause or runaway_message(traj.diverged_step, dt_s, params or ButterflyParams()),
                        traj.diverged_step)
-    return FlyResult(traj, summary)
+    from dataclasses import asdict
+
+    from lifelike_mj.provenance import provenance
+
+    cond = condition or Condition()
+    prov = provenance(controller=controller.to_dict(), params=asdict(params or ButterflyParams()), y0_m=cond.y0_m,
+                      wind_m_s=list(cond.wind_m_s), duration_s=duration_s, dt_s=dt_s, backend=backend, **opts)
+    return FlyResult(traj, summary, prov)

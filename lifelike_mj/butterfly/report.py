@@ -12,7 +12,6 @@ Every file is written atomically.
 from __future__ import annotations
 
 import math
-import sys
 import time
 from dataclasses import asdict
 from pathlib import Path
@@ -22,6 +21,7 @@ from lifelike_mj.butterfly.compare import compare
 from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import dumps, write_json, write_text
+from lifelike_mj.progress import Stages
 
 FIGURES = {
     "fig3": "fig3_forces.png",
@@ -143,40 +143,36 @@ def report_e1_e5(
     backend: str = "paper",
     extra_sections: list[tuple[str, str]] | None = None,
     progress: bool = True,
+    stages: Stages | None = None,
 ) -> dict:
     """Run E1-E5 (Oe 2010 eq. 4-11, Fig. 3-5), write the figures, ``results.json`` and
     ``report.md`` into ``out_dir``, and return the results (the JSON data).
 
     E1-E3 are analytic (no backend); E4 and E5 fly on ``backend`` at the paper's settings
     (RK4, 20 s; dt = 1/12000 s for E4, four steps for E5). ``extra_sections`` are appended to
-    the Markdown as ``## title`` and body. Progress lines go to stderr when ``progress``.
+    the Markdown as ``## title`` and body. Progress (a bar per stage, then its duration) goes to stderr
+    when ``progress``; ``stages`` continues the numbering of a larger job.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     p = params or ButterflyParams()
 
-    def say(msg: str) -> None:
-        if progress:
-            print(f"[reproduce] {msg}", file=sys.stderr, flush=True)
-
+    st = stages if stages is not None else Stages("reproduce butterfly", 4, progress)
     t0 = time.perf_counter()
-    say("E1 closed forms (eq. 4, 6) vs strip integration")
-    e1 = experiments.e1_closed_forms(p)
-    say("E2 Fig. 3 forces")
-    e2 = experiments.e2_fig3(p)
-    say("E3 speed limit (section 4.3)")
-    e3 = experiments.e3_speed_limit(p)
-    sweep = experiments.e3_speed_limit_vs_area(params=p)
-    say(f"E4 level-flight trim on the {backend} backend (dt = 1/12000 s, 20 s)")
-    e4 = experiments.e4_trim(p, backend=backend)
-    say(f"E4 level angle {e4.phi_up_level_deg:.4f} deg after {e4.n_flights} flights")
-    say(f"E5 time-step study on the {backend} backend")
-    e5 = experiments.e5_timestep(p, backend=backend)
-    say("figures")
-    figures.fig3_forces(e2, out / FIGURES["fig3"])
-    figures.fig_speed_limit(sweep, out / FIGURES["speed_limit"])
-    figures.fig4_trim(e4, out / FIGURES["fig4"])
-    figures.fig5_timestep(e5, out / FIGURES["fig5"])
+    with st.next("E1-E3: closed forms, Fig. 3 forces, speed limit"):
+        e1 = experiments.e1_closed_forms(p)
+        e2 = experiments.e2_fig3(p)
+        e3 = experiments.e3_speed_limit(p)
+        sweep = experiments.e3_speed_limit_vs_area(params=p)
+    with st.next(f"E4 level-flight trim on the {backend} backend (dt = 1/12000 s, 20 s flights)"):
+        e4 = experiments.e4_trim(p, backend=backend)
+    with st.next(f"E5 time-step study on the {backend} backend"):
+        e5 = experiments.e5_timestep(p, backend=backend)
+    with st.next("figures 3-5"):
+        figures.fig3_forces(e2, out / FIGURES["fig3"])
+        figures.fig_speed_limit(sweep, out / FIGURES["speed_limit"])
+        figures.fig4_trim(e4, out / FIGURES["fig4"])
+        figures.fig5_timestep(e5, out / FIGURES["fig5"])
     results = {
         "paper": "Oe, Suzuki, Yamamoto, Furukawa 2010, a butterfly model for CG",
         "backend": backend,
@@ -192,7 +188,8 @@ def report_e1_e5(
     }
     write_text(out / "results.json", dumps(results, indent=1) + "\n")
     write_text(out / "report.md", _markdown(results, extra_sections))
-    say(f"wrote {out / 'report.md'} in {results['elapsed_s']:.1f} s")
+    if stages is None:
+        st.done(f"wrote {out / 'report.md'}")
     return results
 
 
@@ -336,21 +333,22 @@ def reproduce(out: str | Path, params: ButterflyParams | None = None, progress: 
     out = Path(out)
     p = params or ButterflyParams()
     out.mkdir(parents=True, exist_ok=True)
-    def say(msg: str) -> None:
-        if progress:
-            print(msg, file=sys.stderr, flush=True)
-
-    say("comparison runs (paper backend vs MuJoCo) ...")
-    cmp_body, cmp_data = _compare_section(out, p)
-    say("snapshots ...")
-    snap_body = _snapshot_section(out, p)
-    say("E6-E11 with the evolved controllers ...")
-    ann_body, ann_data = _ann_section(out, p)
+    st = Stages("reproduce butterfly", 7, progress)
+    with st.next("comparison runs (paper backend vs MuJoCo)"):
+        cmp_body, cmp_data = _compare_section(out, p)
+    with st.next("snapshots (Fig. 10 style)"):
+        snap_body = _snapshot_section(out, p)
+    with st.next("E6-E11 with the evolved controllers (flights, wind maps)"):
+        ann_body, ann_data = _ann_section(out, p)
     results = report_e1_e5(out, p, extra_sections=[("Comparison of the two backends", cmp_body),
                                                        ("Snapshots (Fig. 10 style)", snap_body),
                                                        ("The evolved network: E6-E11 (Oe 2010 sections 6-7)", ann_body)],
-                           progress=progress)
+                           progress=progress, stages=st)
     results["compare"] = cmp_data
     results["ann"] = ann_data
+    from lifelike_mj.provenance import provenance
+
+    results["provenance"] = provenance(params=asdict(p))
     write_json(out / "results.json", results)
+    st.done(f"wrote {out / 'report.md'}")
     return results

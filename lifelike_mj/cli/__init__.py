@@ -101,8 +101,9 @@ def cmd_bench(args) -> None:
     r, human = creature(args.what).bench(args)
     if args.out:
         from lifelike_mj.io import write_json
+        from lifelike_mj.provenance import provenance
 
-        write_json(args.out, r)
+        write_json(args.out, {**r, "provenance": provenance(**{k: v for k, v in vars(args).items() if k != "func"})})
     emit(args, r, human)
 
 
@@ -113,10 +114,17 @@ def cmd_reproduce(args) -> None:
     for what in whats:  # every folder checked before the first stage starts
         out = Path(args.out or "reports") / what if (args.what == "all" or not args.out) else Path(args.out)
         check_output_dir(out, "--out", ("report.md", "results.json"), overwrite=args.overwrite)
+    import time
+
+    from lifelike_mj.progress import duration_text
+
+    t0 = time.perf_counter()
     for what in whats:
         out = Path(args.out or "reports") / what if (args.what == "all" or not args.out) else Path(args.out)
         creature(what).reproduce(out, args)
         print(f"report written to {out / 'report.md'}")
+    if len(whats) > 1:
+        print(f"all reports written in {duration_text(time.perf_counter() - t0)}")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -125,6 +133,9 @@ def main(argv: list[str] | None = None) -> int:
         from lifelike_mj.render.gl import ensure_gl_backend
 
         ensure_gl_backend()  # before anything imports mujoco
+    from lifelike_mj.provenance import set_command
+
+    set_command(argv)
     try:
         args = build_parser().parse_args(join_negative_values(argv))
         args.func(args)

@@ -81,7 +81,9 @@ def cmd_run(args) -> None:
     check_outputs(args, files={"--plot": (".png",)}, folders={"--out": RUN_FILES})
     _check_size(args.n, args.steps)
     params = _params(args)
-    run, out = measured_run(params, args.n, args.seed, args.steps, progress=not args.json)
+    if args.record_every is not None and not args.out:
+        raise UserError("--record-every only applies with --out (it chooses what the trajectory files keep).")
+    run, out = measured_run(params, args.n, args.seed, args.steps, progress=True, record_every=args.record_every)
     if args.plot:
         from lifelike_mj.boids.figures import pattern_figure
 
@@ -95,6 +97,8 @@ def cmd_run(args) -> None:
 
 
 def cmd_sweep(args) -> None:
+    import numpy as np
+
     from lifelike_mj.boids.experiments import Sweep, run_sweep, write_sweep
     from lifelike_mj.boids.presets import homogeneous, load_grid
 
@@ -115,8 +119,12 @@ def cmd_sweep(args) -> None:
             axes.append(name)
             values.append(rng)
         sweep = Sweep(_params(args), tuple(axes), args.n, args.steps)
-    res = run_sweep(sweep, values, seed_list, executor=args.executor, workers=args.workers,
-                    ray_address=args.ray_address)
+    from lifelike_mj.progress import stage
+
+    n_runs = len(seed_list) * int(np.prod([len(v) for v in values]))
+    with stage(f"sweep: {n_runs} runs on {args.executor}"):
+        res = run_sweep(sweep, values, seed_list, executor=args.executor, workers=args.workers,
+                        ray_address=args.ray_address)
     if args.out:
         write_sweep(res, sweep, values, args.out)
     counts: dict[str, int] = {}
@@ -137,6 +145,9 @@ def add_commands(sub) -> None:
     add_json(p)
     p.add_argument("--plot", help="PNG of the last 5 steps in the paper's style")
     p.add_argument("--out", help="folder for trajectories (npz, CSV) and measures")
+    p.add_argument("--record-every", type=count(1, 100_000), default=None,
+                   help="keep every K-th step of the whole run in --out (default: the classifier's frames, every "
+                        "20th step of the last 2,000, and the last 5 steps)")
     add_overwrite(p)
     p.set_defaults(func=cmd_run)
     p = boids.add_parser("sweep", help="a grid of runs, classified: the phase diagram")
@@ -175,7 +186,7 @@ def render(args) -> dict:
     from lifelike_mj.boids.render import render_boids
 
     return render_boids(args.out, _params(args), n=args.n, n_steps=args.steps or 3000, seed=args.seed, fps=args.fps,
-                        width=args.width, height=args.height, camera=args.camera)
+                        width=args.width, height=args.height, camera=args.camera, progress=True)
 
 
 def add_reproduce_args(p: argparse.ArgumentParser) -> None:

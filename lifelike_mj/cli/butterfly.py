@@ -20,6 +20,7 @@ from lifelike_mj.cli.common import (
     num,
 )
 from lifelike_mj.errors import UserError
+from lifelike_mj.progress import stage
 
 NAME = "butterfly"
 #: Longest flight (s) of fly and compare; longest video (s) of render.
@@ -135,7 +136,8 @@ def cmd_trim(args) -> None:
     from lifelike_mj.butterfly import experiments
 
     opts = _backend_options(args)
-    r = experiments.e4_trim(params(args), backend=args.backend, dt_s=positive("--dt", args.dt), **opts)
+    with stage("E4: bisection on phi_up for level flight (20 s flights)"):
+        r = experiments.e4_trim(params(args), backend=args.backend, dt_s=positive("--dt", args.dt), **opts)
     d = r.to_dict()
     emit(args, d, f"level flight at phi_up = {d['phi_up_level_deg']:.3f} deg (paper 12.77); settled forward speed "
          f"{d['mean_forward_speed_cm_s']:.1f} cm/s (paper 340); ripple {d['ripple_cm']:.2f} cm (paper 5.3); "
@@ -146,7 +148,8 @@ def cmd_timestep(args) -> None:
     from lifelike_mj.butterfly import experiments
 
     opts = _backend_options(args)
-    r = experiments.e5_timestep(params(args), backend=args.backend, **opts)
+    with stage("E5: 20 s flights at four time steps"):
+        r = experiments.e5_timestep(params(args), backend=args.backend, **opts)
     d = r.to_dict()
     rows = [f"dt {k:>8s}: altitude at 20 s {d['altitude_20s_m'][k]:8.3f} m, rel. error {d['rel_error'][k]:.2e}"
             for k in d["altitude_20s_m"]]
@@ -208,7 +211,7 @@ def cmd_windmap(args) -> None:
     if ctrl.type != "ann":
         raise UserError(f"the wind map needs a network (ann) controller; {args.controller!r} is {ctrl.type!r}.")
     m = e11_windmap(ctrl, args.inputs, positive("--step", args.step), positive("--max", args.max), params(args),
-                    progress=not args.json)
+                    progress=True)
     d = {"controller": ctrl.name or args.controller, **m.to_dict()}
     if args.plot:
         from lifelike_mj.butterfly.ann_figures import fig_windmap
@@ -224,7 +227,8 @@ def cmd_assess(args) -> None:
     ctrl = _controller(args)
     if ctrl.type != "ann":
         raise UserError(f"assess needs a network (ann) controller; {args.controller!r} is {ctrl.type!r}.")
-    d = {"controller": ctrl.name or args.controller, **assess(ctrl, params(args))}
+    with stage("assess: still air, from +10 m and from below, tail wind, the wind map"):
+        d = {"controller": ctrl.name or args.controller, **assess(ctrl, params(args))}
     s = d["still_air"]
     human = (f"still air: drop {s['initial_drop_m']:.2f} m, settled [{s['settled_altitude_min_m']:+.3f}, "
              f"{s['settled_altitude_max_m']:+.3f}] m at {s['settled_forward_speed_cm_s']:.0f} cm/s; from +10 m holds: "
@@ -238,8 +242,9 @@ def cmd_compare(args) -> None:
     from lifelike_mj.butterfly.compare import compare
 
     ctrl = _controller(args)
-    r = compare(ctrl, args.config, params(args), duration_s=positive("--duration", args.duration),
-                dt_s=positive("--dt", args.dt), force_mode=args.force_mode)
+    with stage("the same flight on both backends"):
+        r = compare(ctrl, args.config, params(args), duration_s=positive("--duration", args.duration),
+                    dt_s=positive("--dt", args.dt), force_mode=args.force_mode)
     d = r.to_dict()
     emit(args, d, f"{args.config} configuration ({r.force_mode} force): largest altitude difference "
          f"{r.max_altitude_diff_m * 100:.2f} cm ({100 * r.altitude_diff_fraction:.2f} % of the "
@@ -378,7 +383,7 @@ def render(args) -> dict:
 
     return render_butterfly(args.out, _controller(args), params(args), _condition(args), config=args.config,
                             force_mode=args.force_mode, duration_s=positive("--duration", args.duration), fps=args.fps,
-                            width=args.width, height=args.height, camera=args.camera)
+                            width=args.width, height=args.height, camera=args.camera, progress=True)
 
 
 def add_reproduce_args(p: argparse.ArgumentParser) -> None:

@@ -60,7 +60,7 @@ def cmd_swim(args) -> None:
         raise UserError("--video-duration only applies with --video.")
     params = _preset(args)
     n = _count(args.fish)
-    r = swim(params, n, positive("--duration", args.duration), args.seed, _tank(args), progress=not args.json)
+    r = swim(params, n, positive("--duration", args.duration), args.seed, _tank(args), progress=True)
     summary = swim_summary(r)
     if args.out:
         summary["files"] = write_swim(r, args.out, dict(summary))
@@ -68,7 +68,7 @@ def cmd_swim(args) -> None:
         from lifelike_mj.fish.render import render_fish
 
         summary["video"] = render_fish(args.video, params, n, min(args.duration, args.video_duration), args.seed,
-                                       _tank(args), camera=args.camera)
+                                       _tank(args), camera=args.camera, progress=True)
     emit(args, summary, (f"{n} fish, {summary['duration_s']:g} s ({params.name}): a burst every "
                          f"{summary['burst_interval_mean_s']:.2f} s, burstiness {summary['burstiness']:.3f}, "
                          f"acceleration kurtosis {summary['accel_kurtosis']:.2f}, turning entropy "
@@ -129,7 +129,8 @@ def render(args) -> dict:
     from lifelike_mj.fish.render import render_fish
 
     return render_fish(args.out, _preset(args), _count(args.fish), positive("--duration", args.duration), args.seed,
-                       _tank(args), fps=args.fps, width=args.width, height=args.height, camera=args.camera)
+                       _tank(args), fps=args.fps, width=args.width, height=args.height, camera=args.camera,
+                       progress=True)
 
 
 def add_reproduce_args(p: argparse.ArgumentParser) -> None:

@@ -213,5 +213,9 @@ def write_swim(result: SwimResult, out_dir: str | Path, summary: dict | None = N
     files = write_tracks(result, out)
     tracks_figure(result, out / "tracks.png")
     accel_histogram_figure(result, out / "accel_histogram.png")
-    write_json(out / "measures.json", summary if summary is not None else swim_summary(result))
+    from lifelike_mj.provenance import provenance
+
+    prov = provenance(preset=result.params.to_file_dict(), n_fish=result.n_fish, seed=int(result.seed),
+                      tank_m=list(result.tank_m), duration_s=float(result.times_s[-1] - result.times_s[0]))
+    write_json(out / "measures.json", {**(summary if summary is not None else swim_summary(result)), "provenance": prov})
     return [str(f) for f in (*files.values(), out / "tracks.png", out / "accel_histogram.png", out / "measures.json")]

@@ -17,6 +17,7 @@ from lifelike_mj.fish.params import load_preset
 from lifelike_mj.fish.scene import BODY_LENGTH_M
 from lifelike_mj.fish.sim import swim
 from lifelike_mj.io import write_json, write_text
+from lifelike_mj.progress import Stages
 
 #: Settings of the report (the paper: ten fish, 30 s tracks).
 N_FISH = 10
@@ -38,22 +39,27 @@ def reproduce_fish(out: str | Path, seeds=PATTERN_SEEDS, pattern_s: float = PATT
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     bd = load_preset("B-D")
-    r = swim(bd, N_FISH, swim_s, 0, progress=progress)
-    write_tracks(r, out)
-    tracks_figure(r, out / "fig7_tracks.png")
-    accel_histogram_figure(r, out / "fig8_accel_histogram.png")
-    summ = swim_summary(r)
-    _, p = resample(r.times_s, side_view(r.positions))
-    _, acc = speed_and_accel(p, 24.0)
-    hist = histogram_summary(acc / BODY_LENGTH_M)
-    drag = drag_check()
-    table = pattern_table(seeds, pattern_s, N_FISH, progress=progress)
-    patterns_figure(table.rows, out / "fig11_patterns.png")
-    try:
-        frame_png(out / "tank.png", bd, n_fish=N_FISH, seed=0, t_s=5.0, camera="follow")
-        snap = "![tank](tank.png)\n"
-    except (UserError, ImportError, RuntimeError) as exc:
-        snap = f"(no rendered frame on this machine: {exc})\n"
+    st = Stages("reproduce fish", 4, progress)
+    with st.next(f"F1-F3: {N_FISH} B-D fish, {swim_s:g} s"):
+        r = swim(bd, N_FISH, swim_s, 0, progress=progress)
+        write_tracks(r, out)
+        tracks_figure(r, out / "fig7_tracks.png")
+        accel_histogram_figure(r, out / "fig8_accel_histogram.png")
+        summ = swim_summary(r)
+        _, p = resample(r.times_s, side_view(r.positions))
+        _, acc = speed_and_accel(p, 24.0)
+        hist = histogram_summary(acc / BODY_LENGTH_M)
+    with st.next("drag cross-check against MuJoCo's fluid model"):
+        drag = drag_check()
+    with st.next(f"F4: four patterns x {len(seeds)} seeds x {pattern_s:g} s"):
+        table = pattern_table(seeds, pattern_s, N_FISH, progress=progress)
+        patterns_figure(table.rows, out / "fig11_patterns.png")
+    with st.next("a rendered frame of the tank"):
+        try:
+            frame_png(out / "tank.png", bd, n_fish=N_FISH, seed=0, t_s=5.0, camera="follow")
+            snap = "![tank](tank.png)\n"
+        except (UserError, ImportError, RuntimeError) as exc:
+            snap = f"(no rendered frame on this machine: {exc})\n"
 
     lines = ["# Tropical fish (Satoi, Nakadai, Hoshino 2015): reproduction report", ""]
     lines += ["## F1-F3: ten `B-D` fish, 30 s (seed 0)", "",
@@ -86,7 +92,11 @@ def reproduce_fish(out: str | Path, seeds=PATTERN_SEEDS, pattern_s: float = PATT
               f"{drag['trials']} random states: max relative error {drag['max_rel_error']:.1e}.", ""]
     write_text(out / "report.md", "\n".join(lines))
     results = {"swim": summ, "accel_histogram": hist, "drag_check": drag, "patterns": table.to_dict()}
+    from lifelike_mj.provenance import provenance
+
+    results["provenance"] = provenance(seeds=list(seeds), pattern_s=pattern_s, swim_s=swim_s, n_fish=N_FISH)
     write_json(out / "results.json", results)
+    st.done(f"wrote {out / 'report.md'}")
     return results
 
 

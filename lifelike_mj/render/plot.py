@@ -35,10 +35,13 @@ def png_path(path: str | os.PathLike, what: str) -> Path:
 
 
 def save(fig: Figure, path: str | os.PathLike, dpi: int = DPI) -> Path:
-    """Write ``fig`` as a PNG to ``path`` atomically; return the path."""
+    """Write ``fig`` as a PNG to ``path`` atomically, with the package version and the command in its
+    text chunks (:func:`lifelike_mj.provenance.png_metadata`); return the path."""
+    from lifelike_mj.provenance import png_metadata
+
     path = Path(path)
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=dpi)
+        fig.savefig(tmp, format="png", dpi=dpi, metadata=png_metadata())
     return path
 
 
