@@ -37,7 +37,8 @@ def _tank(args):
 def _add_fish(p) -> None:
     p.add_argument("--preset", default="default",
                    help="fish motion preset: NB-ND, NB-D, B-ND, B-D, default (= B-D), or a JSON file")
-    p.add_argument("--fish", type=count(1, MAX_FISH), default=10, help=f"number of fish, 1 to {MAX_FISH:,}")
+    p.add_argument("--n", "--fish", dest="fish", type=count(1, MAX_FISH), default=10,
+                   help=f"number of fish, 1 to {MAX_FISH:,} (--n as for boids; --fish is the older spelling)")
     add_seed(p)
     p.add_argument("--tank-scale", type=num(MIN_TANK_SCALE, 10.0), default=1.0,
                    help=f"tank size as a fraction of the filmed 5 m x 0.5 m x 1 m tank, {MIN_TANK_SCALE} to 10 "

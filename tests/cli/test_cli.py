@@ -103,3 +103,32 @@ def test_console_script_exit_code_without_traceback():
     proc = subprocess.run([sys.executable, "-m", "lifelike_mj.cli", "butterfly", "fly", "--controller", "nope"],
                           capture_output=True, text=True)
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
+
+
+def _options(parser, path=()):
+    import argparse
+
+    for a in parser._actions:
+        if isinstance(a, argparse._SubParsersAction):
+            for name, sub in a.choices.items():
+                yield from _options(sub, (*path, name))
+        elif a.option_strings and a.dest != "help":
+            yield " ".join(path), a
+
+
+def test_every_option_has_help_and_shows_its_default():
+    from lifelike_mj.cli import build_parser
+
+    opts = list(_options(build_parser()))
+    assert len(opts) > 150
+    for where, a in opts:
+        assert a.help, f"{where} {a.option_strings[0]} has no help"
+    text = build_parser()._subparsers._group_actions[0].choices["fish"]._subparsers._group_actions[0] \
+        .choices["swim"].format_help()
+    assert "--n FISH, --fish FISH" in text and "(default: 30.0)" in text
+
+
+def test_negative_values_are_values(capsys):
+    code, out, _ = run(capsys, "butterfly", "fly", "--controller", "simple_rule", "--duration", "1", "--wind", "-2,0",
+                       "--y0", "-1", "--json")
+    assert code == 0 and json.loads(out)["start_altitude_m"] == -1.0
