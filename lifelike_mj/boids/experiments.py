@@ -18,12 +18,15 @@ import numpy as np
 
 from lifelike_mj import checks
 from lifelike_mj.boids.engine import N_AGENTS, BoidParams, BoidRun, simulate
+from lifelike_mj.boids.metrics import HOMOGENEOUS_LABELS
 from lifelike_mj.boids.presets import PATTERNS
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import atomic_path, write_npz
 
 #: Labels a run can get: the eight patterns, ``other``, and ``diverged``.
-LABELS = (*PATTERNS, "other", "diverged")
+#: Labels of two-type runs (the eight patterns), then of one-type runs (Fig. 2's regimes).
+TWO_TYPE_LABELS = (*PATTERNS, "other", "diverged")
+LABELS = (*TWO_TYPE_LABELS, *HOMOGENEOUS_LABELS)
 #: What a sweep row returns, in this order.
 OUTPUTS = ("label", "paper_picture", "segregation_index", "centroid_distance", "radius_ratio",
            "radial_sorting_error", "plane_split", "n_groups", "polarisation", "speed")
@@ -63,7 +66,7 @@ def classified_run(params: BoidParams, n: int = N_AGENTS, seed: int = 0, n_steps
         keep = np.isin(run.steps, classifier)
         measured = replace(run, steps=run.steps[keep], positions=run.positions[keep], velocities=run.velocities[keep])
     m = metrics.measures(measured, window=window)
-    label, reasons = metrics.classify(m)
+    label, reasons = metrics.classify(m) if params.n_types > 1 else metrics.classify_homogeneous(m)
     return run, m, label, reasons
 
 
@@ -215,7 +218,12 @@ def write_sweep(result: dict, sweep: Sweep, values: list[list[float]], out_dir: 
         from lifelike_mj.boids.figures import phase_diagram_figure
 
         labels = np.array([[result["majority"][f"{a:g},{b:g}"] for a in values[0]] for b in values[1]])
-        phase_diagram_figure(labels, values[0], values[1], sweep.axes[0], sweep.axes[1], out / "phase_diagram.png")
+        seeds = sorted({int(r["seed"]) for r in result["rows"]})
+        base = "one type" if sweep.base.n_types == 1 else f"base {sweep.base.name}"
+        title = (f"Classified patterns over {sweep.axes[0]} x {sweep.axes[1]}: {base}, n = {sweep.n}, "
+                 f"{sweep.n_steps or run_settings()['n_steps']} steps; majority over seeds {', '.join(map(str, seeds))}")
+        phase_diagram_figure(labels, values[0], values[1], sweep.axes[0], sweep.axes[1], out / "phase_diagram.png",
+                             title=title)
         files.append(out / "phase_diagram.png")
     return [str(f) for f in files]
 

@@ -1,7 +1,8 @@
 """Figures of the boids in the style of Nakamura 2013 (Fig. 2, 4 and 5), and a phase diagram.
 
 The paper's snapshots show each agent's path over its last 5 steps as a short line segment, type A
-in red and type B in yellow-green, in a 2D projection of the 20^3 box. Here:
+in red and type B in yellow-green, in a 2D projection of the 20^3 box. Here (in colour-blind-safe blue
+and orange unless :func:`~lifelike_mj.boids.palette.use_palette` chooses the paper's colours):
 
 * the projection is onto the **x-y plane** by default (the view from above, looking down -z, x to
   the right, y up; the ``top`` camera of :mod:`lifelike_mj.boids.scene`): the same plane for 3D and
@@ -34,6 +35,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch, Rectangle
 
+from lifelike_mj.boids.palette import PALETTES, type_colour, use_palette
 from lifelike_mj.errors import UserError
 from lifelike_mj.render.plot import finish, png_path
 from lifelike_mj.render.plot import new_figure as _figure
@@ -45,8 +47,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 #: Steps of motion in a trail (the paper's figures: 5 steps).
 TRAIL_STEPS = 5
-#: Colours of the types: A red, B yellow-green (the paper's), then more (as the 3D scene's).
-TYPE_COLOURS = ("#dc140f", "#9acd32", "#1f77b4", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf")
+TYPE_COLOURS = PALETTES["colour-blind"]
 #: Short names of the eight patterns (Nakamura 2013 section 3.2).
 PATTERN_NAMES = {
     "4a": "two ellipsoidal groups, small interface",
@@ -65,14 +66,11 @@ _LINE_WIDTH = 1.3
 #: Colours of the labels of :func:`phase_diagram_figure`: the eight patterns, then other labels.
 _LABEL_COLOURS = {"4a": "#1f77b4", "4b": "#ff7f0e", "4c": "#2ca02c", "4d": "#d62728", "5a": "#9467bd", "5b": "#8c564b",
                   "5c": "#e377c2", "5d": "#17becf"}
+_LABEL_COLOURS.update({"aligned lattice": "#0072b2", "compact flock": "#d55e00", "swarm": "#e69f00",
+                       "spread": "#56b4e9"})
 _EXTRA_COLOURS = ("#bcbd22", "#aec7e8", "#ffbb78", "#98df8a", "#ff9896", "#c5b0d5", "#c49c94", "#f7b6d2", "#dbdb8d",
                   "#9edae5", "#393b79", "#637939", "#8c6d31", "#843c39", "#7b4173")
 _NO_LABEL = {"", "none", "nan", "n/a", "diverged", "unclassified", "unknown", "?"}
-
-
-def type_colour(k: int) -> str:
-    """Colour of type ``k`` (0 = A red, 1 = B yellow-green, ...)."""
-    return TYPE_COLOURS[int(k) % len(TYPE_COLOURS)]
 
 
 def _new_figure(width_in: float, height_in: float) -> Figure:
@@ -151,7 +149,7 @@ def _label_title(label: str) -> str:
 def pattern_figure(run: BoidRun, out_path: str | os.PathLike | None = None, title: str | None = None, plane: str = "xy",
                    trail_steps: int = TRAIL_STEPS) -> Figure:
     """One run as in Nakamura 2013 Fig. 4-5: each agent's last ``trail_steps`` (5) steps as a short
-    trail, A red, B yellow-green, in the x-y projection (``plane``: module docstring) of the box.
+    trail, A blue, B orange (or the paper's red and yellow-green), in the x-y projection (``plane``: module docstring) of the box.
 
     The run must hold the last ``trail_steps`` steps recorded every step:
     ``simulate(params, n_steps=N, record_every=1, record_from=N - 5)`` (:class:`UserError` otherwise).
@@ -309,10 +307,11 @@ def _hex(c: str) -> tuple[float, float, float]:
 
 def _fmt(v) -> str:
     try:
-        return f"{float(v):g}"
+        x = round(float(v), 12)
+        return f"{x:.3g}" if x else "0"
     except (TypeError, ValueError):
         return str(v)
 
 
-__all__ = ["PATTERN_NAMES", "TRAIL_STEPS", "TYPE_COLOURS", "homogeneous_grid_figure", "pattern_figure",
-           "patterns_grid_figure", "phase_diagram_figure", "trails", "type_colour"]
+__all__ = ["PALETTES", "PATTERN_NAMES", "TRAIL_STEPS", "TYPE_COLOURS", "homogeneous_grid_figure", "pattern_figure",
+           "patterns_grid_figure", "phase_diagram_figure", "trails", "type_colour", "use_palette"]

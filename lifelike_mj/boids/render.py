@@ -4,7 +4,7 @@ The agents are the real run of a :class:`~lifelike_mj.boids.sim.Flock`, streamed
 between frames, so no trajectory is kept in memory and a rendered run is the run
 :func:`~lifelike_mj.boids.engine.simulate` computes with the same arguments. MuJoCo only draws:
 the agents are mocap bodies of :mod:`lifelike_mj.boids.scene`
-(ellipsoids along their velocities; A red, B yellow-green), placed by
+(ellipsoids along their velocities; A blue, B orange: :mod:`lifelike_mj.boids.palette`), placed by
 :func:`~lifelike_mj.boids.scene.update` before each frame.
 
 Time: the engine's step (``dt = 1``) has no unit of seconds, so a video plays ``steps_per_frame``

@@ -15,11 +15,14 @@ from pathlib import Path
 import numpy as np
 
 from lifelike_mj.boids.engine import N_AGENTS
-from lifelike_mj.boids.experiments import LABELS, Sweep, classified_run, run_settings, run_sweep
+from lifelike_mj.boids.experiments import TWO_TYPE_LABELS as LABELS
+from lifelike_mj.boids.experiments import Sweep, classified_run, run_settings, run_sweep
+from lifelike_mj.boids.figures import PATTERN_NAMES
 from lifelike_mj.boids.presets import PATTERNS, homogeneous, load_grid, load_preset
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import write_json, write_text
 from lifelike_mj.progress import Stages
+from lifelike_mj.render.plot import markdown_figure
 
 SEEDS = (0, 1, 2, 3, 4)
 ROBUST = ("4a", "4b", "4c", "5a", "5c", "5d")
@@ -31,6 +34,22 @@ def _perturbed(name: str, which: str, factor: float):
     p = load_preset(name)
     m = np.array(getattr(p, which)) * factor
     return replace(p, **{which: tuple(map(tuple, m.tolist()))}, name=f"{name} {which}x{factor:g}")
+
+
+CAPTIONS = {
+    "patterns": "cf. Nakamura 2013 Fig. 4 and 5 — the eight presets (seed 0), trails of the last 5 steps, each "
+                "titled with the label the classifier gives it.",
+    "fig2": "cf. Nakamura 2013 Fig. 2 — one type over the alignment weight w_a (rows) and the cohesion weight w_c "
+            "(columns), seed 0.",
+    "phase": "Beyond the paper — the classified pattern over the cross-type weights around 5a (seed 0).",
+}
+
+
+def _paper_fig2(w_a: float, w_c: float) -> str:
+    """What Nakamura 2013 section 2.2 says of one type at ``(w_a, w_c)``."""
+    a = "aligned, lattice-like" if w_a >= 1 else "midge-like swarm" if w_a >= 0.01 else "spread, no alignment"
+    c = "fast compact flock" if w_c >= 0.1 else "no clear flock" if w_c == 0 else "spreads and slows"
+    return f"{a}; {c}"
 
 
 def _runs(params_list, seeds, executor, workers, bar=None):
@@ -102,7 +121,8 @@ def reproduce_boids(out: str | Path, seeds=SEEDS, executor: str = "process", wor
             hom.append({"w_a": wa, "w_c": wc, "diverged": True})
             continue
         m = metrics.measures(run, window=settings["window"])
-        hom.append({"w_a": wa, "w_c": wc, "diverged": False, **{k: m.get(k) for k in (
+        hom.append({"w_a": wa, "w_c": wc, "diverged": False, "regime": metrics.classify_homogeneous(m)[0],
+                    **{k: m.get(k) for k in (
             "polarisation", "speed", "n_groups", "nn_distance", "radius_of_gyration") if k in m}})
     results["homogeneous"] = hom
     div = []
@@ -124,39 +144,45 @@ def reproduce_boids(out: str | Path, seeds=SEEDS, executor: str = "process", wor
                        workers=workers)
     lab = np.array([[ph["majority"][f"{a:g},{b:g}"] for a in xa] for b in yc])
     phase_diagram_figure(lab, xa, yc, "cross-type alignment w_aAB = w_aBA", "cross-type cohesion w_cAB = w_cBA",
-                         out / "phase_diagram.png")
+                         out / "phase_diagram.png",
+                         title=f"Classified patterns around 5a (W_a diagonal 0.5, W_c diagonal 0.01): n = {N_AGENTS}, "
+                               f"{settings['n_steps']} steps, seed 0")
     results["phase_diagram"] = ph
 
     # report
     L = ["# Heterogeneous boids (Nakamura 2013): reproduction report", "",
          f"n = {N_AGENTS}, box 20, R_s = 1, R_a = 2.5, R_c = 4.5, w_s = 0.05, dt = 1; runs of "
          f"{settings['n_steps']} steps, measures averaged over the last {settings['window']} steps.", "",
-         "## Fig. 4-5: the eight patterns (seed 0)", "", "![patterns](fig4_5_patterns.png)", "",
-         f"## Confusion table (seeds {', '.join(map(str, seeds))})", "",
-         "| preset | " + " | ".join(LABELS) + " | own label | own label, paper's picture |",
-         "|---" * (len(LABELS) + 3) + "|"]
+         "## Fig. 4-5: the eight patterns (seed 0)", "", markdown_figure("fig4_5_patterns.png", CAPTIONS["patterns"]),
+         "", f"## Paper vs ours: the classified label of each preset (seeds {', '.join(map(str, seeds))})", "",
+         "| preset | paper (its picture) | ours: own label | ours: own label and the paper's picture | "
+         + " | ".join(LABELS) + " |",
+         "|---" * (len(LABELS) + 4) + "|"]
     for name in PATTERNS:
         c = confusion[name]
-        L.append(f"| {name} | " + " | ".join(str(c.get(lab, 0)) for lab in LABELS)
-                 + f" | {c.get(name, 0)}/{len(seeds)} | {pictures[name]}/{len(seeds)} |")
+        L.append(f"| {name} | {PATTERN_NAMES[name]} | {c.get(name, 0)}/{len(seeds)} | {pictures[name]}/{len(seeds)} | "
+                 + " | ".join(str(c.get(lab, 0)) for lab in LABELS) + " |")
     L += ["", "## Robust patterns under small changes of their matrices (seeds 0, 1)", "",
           "| preset | matrix | factor | labels |", "|---|---|---|---|"]
     for r in results["perturbations"]:
         L.append(f"| {r['preset']} | {r['matrix']} | {r['factor']:g} | {', '.join(r['labels'])} |")
-    L += ["", "## Fig. 2: homogeneous boids", "", "![Fig. 2](fig2_homogeneous.png)", "",
-          "| w_a | w_c | diverged | polarisation | mean speed | groups | nearest-neighbour distance |",
-          "|---|---|---|---|---|---|---|"]
+    L += ["", "## Fig. 2: homogeneous boids", "", markdown_figure("fig2_homogeneous.png", CAPTIONS["fig2"]), "",
+          "| w_a | w_c | paper (section 2.2) | ours: regime | polarisation | mean speed | groups | "
+          "nearest-neighbour distance |", "|---|---|---|---|---|---|---|---|"]
 
     def f3(x):
         return "" if x is None else f"{x:.3g}"
 
     for h in hom:
-        L.append(f"| {h['w_a']:g} | {h['w_c']:g} | {h['diverged']} | {f3(h.get('polarisation'))} | "
-                 f"{f3(h.get('speed'))} | {h.get('n_groups', '')} | {f3(h.get('nn_distance'))} |")
+        ours = "diverged" if h["diverged"] else h.get("regime", "")
+        L.append(f"| {h['w_a']:g} | {h['w_c']:g} | {_paper_fig2(h['w_a'], h['w_c'])} | {ours} | "
+                 f"{f3(h.get('polarisation'))} | {f3(h.get('speed'))} | {h.get('n_groups', '')} | "
+                 f"{f3(h.get('nn_distance'))} |")
     L += ["", "Divergence (section 2.2):", ""]
     for d in div:
         L.append(f"* w_a = {d['w_a']:g}, w_c = {d['w_c']:g}: {'diverged: ' + d['message'] if d['diverged'] else 'no'}")
-    L += ["", "## Phase diagram over the cross-type weights (diagonal of 5a)", "", "![phase](phase_diagram.png)", ""]
+    L += ["", "## Phase diagram over the cross-type weights (diagonal of 5a)", "",
+          markdown_figure("phase_diagram.png", CAPTIONS["phase"]), ""]
     write_text(out / "report.md", "\n".join(L))
     from lifelike_mj.provenance import provenance
 

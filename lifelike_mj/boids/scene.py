@@ -3,8 +3,8 @@
 The boids engine (:mod:`lifelike_mj.boids.engine`) moves the agents; MuJoCo only draws them. Each
 agent is a mocap body carrying one ellipsoid, elongated along its local x axis
 (:data:`BODY_SEMI_AXES`, box units), which :func:`update` points along the agent's velocity, and
-coloured by type (:data:`TYPE_RGBA`: A red, B yellow-green as in the paper's figures; further types
-get further colours). Nothing collides: every geom has ``contype = conaffinity = 0`` and contacts
+coloured by type (:mod:`lifelike_mj.boids.palette`: A blue, B orange by default, or the paper's red
+and yellow-green; further types get further colours). Nothing collides: every geom has ``contype = conaffinity = 0`` and contacts
 are disabled in ``<option>``.
 
 World frame = the engine's frame, in the paper's box units: the box is ``[0, L]^3`` (``L`` =
@@ -35,21 +35,11 @@ import mujoco
 import numpy as np
 
 from lifelike_mj import checks
+from lifelike_mj.boids.palette import type_rgba
 from lifelike_mj.errors import UserError
 
 #: Semi-axes (box units) of an agent's ellipsoid: along its velocity, across, and up.
 BODY_SEMI_AXES = (0.35, 0.12, 0.12)
-#: Colours (RGBA) of the types in order: A red, B yellow-green (the paper's figures), then more.
-TYPE_RGBA = (
-    (0.86, 0.08, 0.06, 1.0),  # A: red
-    (0.60, 0.80, 0.20, 1.0),  # B: yellow-green (CSS yellowgreen)
-    (0.12, 0.47, 0.71, 1.0),  # blue
-    (1.00, 0.50, 0.05, 1.0),  # orange
-    (0.58, 0.40, 0.74, 1.0),  # purple
-    (0.55, 0.34, 0.29, 1.0),  # brown
-    (0.89, 0.47, 0.76, 1.0),  # pink
-    (0.09, 0.75, 0.81, 1.0),  # cyan
-)
 #: Height (box units) of the plane of a 2D run above the floor.
 PLANE_Z_2D = 0.25
 #: The cameras of a 3D scene; a 2D scene has the first two.
@@ -62,11 +52,6 @@ OVERVIEW_FOVY_DEG = 40.0
 MIN_SPEED = 1e-9
 _BASE_MEMORY = 16 * 2**20
 _BROADPHASE_MAX_N = 6000
-
-
-def type_rgba(k: int) -> tuple[float, float, float, float]:
-    """RGBA colour of type ``k`` (0 = A red, 1 = B yellow-green, ...; cycles after 8 types)."""
-    return TYPE_RGBA[int(k) % len(TYPE_RGBA)]
 
 
 def cameras_for(dims: int) -> tuple[str, ...]:
@@ -147,7 +132,7 @@ def build_scene(n: int, types=None, box: float = 20.0, dims: int = 3, semi_axes=
                 type_colors=None) -> tuple[mujoco.MjModel, BoidsLayout]:
     """Compile a scene of ``n`` agents of the given ``types`` (n ints from 0; default all 0) in the box
     ``[0, box]^dims`` (box units; ``dims`` 3 or 2). ``semi_axes``: the ellipsoid's semi-axes (box
-    units; along the velocity first). ``type_colors``: RGBA per type (default :data:`TYPE_RGBA`).
+    units; along the velocity first). ``type_colors``: RGBA per type (default: :func:`~lifelike_mj.boids.palette.type_rgba`).
     Agent ``i`` is body ``boid<i>``, its geom ``boid<i>``; the cameras are named in :data:`CAMERAS`.
     Returns ``(model, layout)``; the agents start at the box's centre, pointing along +x: call
     :func:`update` before drawing."""
@@ -316,5 +301,5 @@ def update(model: mujoco.MjModel, data: mujoco.MjData, layout: BoidsLayout, posi
     mujoco.mj_camlight(model, data)
 
 
-__all__ = ["BODY_SEMI_AXES", "CAMERAS", "EDGE_RADIUS", "PLANE_Z_2D", "TYPE_RGBA", "BoidsLayout", "build_scene",
+__all__ = ["BODY_SEMI_AXES", "CAMERAS", "EDGE_RADIUS", "PLANE_Z_2D", "BoidsLayout", "build_scene",
            "cameras_for", "scene_memory_bytes", "set_edge_radius", "type_rgba", "update", "velocity_quat"]

@@ -66,10 +66,10 @@ _WIND_COLOURS = {"front (2,0)": "tab:blue", "above (0,2)": "tab:green", "behind 
 _BOX = {"boxstyle": "round", "fc": "white", "alpha": 0.85}
 #: Categories of a wind-map cell: (label, colour). Index 0 passes.
 _MAP_CATEGORIES = (
-    ("pass", "#4daf4a"),
-    (f"fail: settled y below −{MAP_BAND_M:g} m", "#377eb8"),
-    (f"fail: settled y above +{MAP_BAND_M:g} m", "#ff7f00"),
-    ("fail: flies backwards (v_z < 0)", "#984ea3"),
+    ("pass", "#009e73"),  # Okabe-Ito colours: told apart by colour-blind readers
+    (f"fail: settled y below −{MAP_BAND_M:g} m", "#0072b2"),
+    (f"fail: settled y above +{MAP_BAND_M:g} m", "#e69f00"),
+    ("fail: flies backwards (v_z < 0)", "#cc79a7"),
     ("fail: diverged (non-finite)", "#252525"),
 )
 
@@ -98,8 +98,10 @@ def _altitude_window(anchors: Sequence[float], curves: Sequence[np.ndarray], min
     return lo - margin, hi + margin
 
 
-def _mark_exits(ax: Axes, x: np.ndarray, y: np.ndarray, colour: str, ylim: tuple[float, float], t_end_s: float) -> None:
-    """Annotate where a curve first leaves the altitude window ``ylim`` (m), with its final altitude."""
+def _mark_exits(ax: Axes, x: np.ndarray, y: np.ndarray, colour: str, ylim: tuple[float, float], t_end_s: float,
+                slot: int = 0) -> None:
+    """Annotate where a curve first leaves the altitude window ``ylim`` (m), with its final altitude;
+    ``slot`` staggers the notes of several curves so that none hides another."""
     lo, hi = ylim
     out = np.flatnonzero(~np.isfinite(y) | (y < lo) | (y > hi))
     if not len(out):
@@ -109,7 +111,8 @@ def _mark_exits(ax: Axes, x: np.ndarray, y: np.ndarray, colour: str, ylim: tuple
     edge = lo if below else hi
     final = y[np.isfinite(y)][-1] if np.isfinite(y).any() else float("nan")
     ax.annotate(f"{'↓' if below else '↑'} leaves the plot; y({t_end_s:g} s) = {final:+.1f} m", (x[i], edge),
-                xytext=(6, 10 if below else -14), textcoords="offset points", fontsize=8, color=colour,
+                xytext=(6, (10 + 16 * slot) if below else -(14 + 16 * slot)), textcoords="offset points", fontsize=8,
+                color=colour,
                 bbox={"boxstyle": "round", "fc": "white", "ec": colour, "alpha": 0.9})
 
 
@@ -359,6 +362,10 @@ def fig12_sink(glide: GlideResult, path: str | os.PathLike | None = None) -> Fig
 # E10: Fig. 14, 15
 
 
+#: Flights in wind that end within this altitude (m) are drawn whole in :func:`fig14_15_winds`.
+LEVEL_SHOWN_M = 10.0
+
+
 def _wind_passes(num: Mapping) -> bool:
     """The wind map's pass test on one flight's numbers: settled y within ±MAP_BAND_M, v_z >= 0."""
     return bool(abs(num.get("settled_altitude_min_m", np.inf)) <= MAP_BAND_M
@@ -377,18 +384,23 @@ def fig14_15_winds(winds: WindsResult, path: str | os.PathLike | None = None) ->
     fig = _new_figure(6.0 * len(kinds), 5.6)
     axes = np.atleast_1d(fig.subplots(1, len(kinds), sharey=True))
     all_y = [tr.y for k in kinds for tr in winds.trajectories[k].values()]
-    ylim = _altitude_window([-MAP_BAND_M, MAP_BAND_M], all_y, min_pad_m=1.5)
+    # every flight that levels off (within +-LEVEL_SHOWN_M) is drawn whole; only falls and climbs leave the plot
+    finals = [float(y[np.isfinite(y)][-1]) for y in all_y if np.isfinite(y).any()]
+    ylim = _altitude_window([-MAP_BAND_M, MAP_BAND_M, *[f for f in finals if abs(f) <= LEVEL_SHOWN_M]], all_y,
+                            min_pad_m=1.0)
     names = {"relative": "air-relative velocity inputs (cf. Fig. 14)", "ground": "ground velocity inputs (cf. Fig. 15)"}
     for j, (ax, kind) in enumerate(zip(axes, kinds)):
         ax.axhspan(-MAP_BAND_M, MAP_BAND_M, color="tab:green", alpha=0.12, label=f"pass band ±{MAP_BAND_M:g} m")
         _target_line(ax)
+        exits = 0
         for i, (label, tr) in enumerate(winds.trajectories[kind].items()):
             colour = _WIND_COLOURS.get(label, _colour(i))
             num = winds.flights.get(kind, {}).get(label, {})
             verdict = "pass" if _wind_passes(num) else "fail"
             ax.plot(tr.z, tr.y, "-", color=colour, lw=1.0,
                     label=f"wind {label}: y({tr.t[-1]:g} s) = {tr.y[-1]:+.2f} m, {verdict}")
-            _mark_exits(ax, tr.z, tr.y, colour, ylim, float(tr.t[-1]))
+            _mark_exits(ax, tr.z, tr.y, colour, ylim, float(tr.t[-1]), slot=exits)
+            exits += int(bool(np.any(~np.isfinite(tr.y) | (tr.y < ylim[0]) | (tr.y > ylim[1]))))
         ax.set_ylim(*ylim)
         ax.set_xlim(left=min(0.0, ax.get_xlim()[0]))
         ax.set_xlabel("forward distance z [m]")

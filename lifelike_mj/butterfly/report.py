@@ -22,6 +22,7 @@ from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import dumps, write_json, write_text
 from lifelike_mj.progress import Stages
+from lifelike_mj.render.plot import markdown_figure
 
 FIGURES = {
     "fig3": "fig3_forces.png",
@@ -112,7 +113,7 @@ def _table(results: dict) -> list[tuple[str, str, str, str]]:
 def _markdown(results: dict, extra_sections: list[tuple[str, str]] | None) -> str:
     p = results["params"]
     lines = [
-        "# Butterfly (Oe, Suzuki, Yamamoto, Furukawa 2010): experiments E1–E5, paper vs ours",
+        "# Butterfly (Oe, Suzuki, Yamamoto, Furukawa 2010): experiments E1–E11, paper vs ours",
         "",
         f"Backend for E4–E5: `{results['backend']}`. Constants: m = {_fmt(1e3 * p['mass_kg'])} g, "
         f"L = {_fmt(1e2 * p['span_m'])} cm, W = {_fmt(1e2 * p['width_m'])} cm, ρ = {_fmt(p['rho'])} kg/m³, "
@@ -123,7 +124,7 @@ def _markdown(results: dict, extra_sections: list[tuple[str, str]] | None) -> st
     ]
     for row in _table(results):
         lines.append("| " + " | ".join(str(c).replace("|", "\\|") for c in row) + " |")
-    lines += ["", "## Figures", ""]
+    lines += ["", "## Figures of E1–E5", ""]
     captions = {
         "fig3": "Oe 2010 Fig. 3 — F_y and F_z against φ for v_z = 0, 2, 4 m/s, upstroke and downstroke (E2).",
         "speed_limit": "Oe 2010 section 4.3 — the forward-speed limit against the body area A_b (E3).",
@@ -131,7 +132,7 @@ def _markdown(results: dict, extra_sections: list[tuple[str, str]] | None) -> st
         "fig5": "Oe 2010 Fig. 5 — flights and altitude differences for four time steps (E5).",
     }
     for key, name in FIGURES.items():
-        lines += [f"![{captions[key]}]({name})", "", f"*{captions[key]}*", ""]
+        lines += [markdown_figure(name, captions[key]), ""]
     for title, body in extra_sections or []:
         lines += [f"## {title}", "", body.rstrip(), ""]
     return "\n".join(lines).rstrip() + "\n"
@@ -211,7 +212,7 @@ def _compare_section(out: Path, params: ButterflyParams) -> tuple[str, list[dict
                     f"({100 * r.altitude_diff_fraction:.2f} %) | {100 * r.max_forward_diff_m:.2f} cm | "
                     f"{r.max_altitude_excursion_m:.2f} m | {notes[r.config]} |")
     body = ("Simple rule at the paper's 12.77 deg, flap [-90, 90] deg, RK4, dt = 1/1200 s, 20 s.\n\n"
-            + "\n".join(rows) + "\n\n![comparison](fig_compare_backends.png)\n")
+            + "\n".join(rows) + "\n\n" + _figure("fig_compare_backends") + "\n")
     return body, [r.to_dict() for r in results]
 
 
@@ -223,11 +224,45 @@ def _snapshot_section(out: Path, params: ButterflyParams) -> str:
     except (UserError, ImportError, RuntimeError) as exc:
         return f"Snapshots not rendered on this machine: {exc}\n"
     return ("The MuJoCo model in settled flight, one frame every 0.025 s (the paper's Fig. 10 shows the "
-            "evolved controller; here the simple rule).\n\n![snapshots](fig10_snapshots.png)\n")
+            "evolved controller; here the simple rule).\n\n" + _figure("fig10_snapshots") + "\n")
 
 
 def _yesno(flag: bool) -> str:
     return "yes" if flag else "no"
+
+
+#: Captions of the figures of E6-E11 and of the extra sections (Oe 2010 figure numbers).
+CAPTIONS = {
+    "fig7_fitness": "Oe 2010 Fig. 7 — best and mean fitness H (eq. 13) per generation of the RCGA run that made ann_paper.",
+    "fig8_flight": "Oe 2010 Fig. 8 — ann_paper from 0 m in still air: altitude against forward distance (E6).",
+    "fig9_phi": "Oe 2010 Fig. 9 — the pitch φ the network chooses and the flap angle θ over the first seconds (E6).",
+    "fig11_from_above": "Oe 2010 Fig. 11 — ann_paper from +10 m and other heights above the target (E7).",
+    "fig12_sink": "Oe 2010 Fig. 12 — sink speed gliding (φ = 0, θ = 75°) against flapping with the network (E8).",
+    "fig13_from_below": "Oe 2010 Fig. 13 — ann_paper from below the target: it does not climb back (E9).",
+    "fig14_15_winds": "Oe 2010 Fig. 14 and 15 — flights in 2 m/s winds from four directions, air-relative (a) "
+                      "and ground-velocity (b) inputs (E10).",
+    "fig15_windmap": "Oe 2010 section 7.2 — pass/fail over uniform winds (a, b), the colour giving why a cell "
+                     "fails (E11).",
+    "fig_windmap_paper_vs_robust": "Beyond the paper — the wind maps of ann_paper and ann_robust side by side.",
+    "fig_robust_from_below": "Beyond the paper — ann_paper and ann_robust from -10 m.",
+    "fig_compare_backends": "The simple rule on the paper backend and on MuJoCo (paper and rich configurations).",
+    "fig10_snapshots": "cf. Oe 2010 Fig. 10 — the MuJoCo model in flight, one frame every 0.025 s.",
+}
+
+
+def _figure(name: str) -> str:
+    """A figure with its caption (Markdown)."""
+    return markdown_figure(f"{name}.png", CAPTIONS[name])
+
+
+def _state(v: dict) -> str:
+    """How a flight ends: level within a band, or still falling or climbing (settled climb rate above
+    5 cm/s over the last 10 s), with its final altitude."""
+    rate = v.get("settled_climb_rate_cm_s")
+    if rate is not None and abs(rate) > 5.0:
+        return (f"{'falls' if rate < 0 else 'climbs'} at {abs(rate):.0f} cm/s over the last 10 s, "
+                f"y(20 s) = {v['final_altitude_m']:+.1f} m")
+    return f"level in {_band(v)}"
 
 
 def _band(v: dict, digits: int = 2) -> str:
@@ -281,7 +316,7 @@ def _ann_section(out: Path, params: ButterflyParams) -> tuple[str, dict]:
     for inputs, flights in e10.flights.items():
         for w, v in flights.items():
             rows.append((f"E10 wind from {w}, {inputs} inputs", paper_e10[w],
-                         f"settled {_band(v)}, {v['settled_forward_speed_cm_s']:.0f} cm/s"))
+                         f"{_state(v)}, {v['settled_forward_speed_cm_s']:.0f} cm/s"))
     for k, m in maps.items():
         q = m.quadrants()
         paper_e11 = {"relative": "weak to tail + from-above wind",
@@ -295,9 +330,10 @@ def _ann_section(out: Path, params: ButterflyParams) -> tuple[str, dict]:
             "Paper backend, RK4, dt = 1/1200 s, flap 10 Hz over [-60, 75]°, 20 s.", "",
             "| experiment | paper | ours |", "|---|---|---|"]
     body += [f"| {a} | {b} | {c} |" for a, b, c in rows]
-    body += [""] + [f"![{n}]({n}.png)" for n in ("fig7_fitness", "fig8_flight", "fig9_phi", "fig11_from_above",
-                                                 "fig12_sink", "fig13_from_below", "fig14_15_winds", "fig15_windmap")
-                    if (out / f"{n}.png").exists()]
+    for n in ("fig7_fitness", "fig8_flight", "fig9_phi", "fig11_from_above", "fig12_sink", "fig13_from_below",
+              "fig14_15_winds", "fig15_windmap"):
+        if (out / f"{n}.png").exists():
+            body += ["", _figure(n)]
     if robust is not None:
         rfb = ax.e9_from_below(robust, params=params, starts=(-10.0,))
         rb = {"from -10 m": rfb.flights["-10 m"],
@@ -321,7 +357,7 @@ def _ann_section(out: Path, params: ButterflyParams) -> tuple[str, dict]:
                  f"| still air: settled altitude | {_band(n6, 3)} | {_band(rb['still air'], 3)} |",
                  f"| wind map cells passing, relative inputs | {maps['relative'].pass_cells} | {rmaps['relative'].pass_cells} |",
                  f"| wind map cells passing, ground inputs | {maps['ground'].pass_cells} | {rmaps['ground'].pass_cells} |",
-                 "", "![windmaps](fig_windmap_paper_vs_robust.png)", "", "![from below](fig_robust_from_below.png)"]
+                 "", _figure("fig_windmap_paper_vs_robust"), "", _figure("fig_robust_from_below")]
         data["robust"] = {"from_-10m": rb["from -10 m"], "still_air": rb["still air"],
                           "tail_wind": tw, "e11": {k: m.to_dict() for k, m in rmaps.items()}}
     return "\n".join(body) + "\n", data

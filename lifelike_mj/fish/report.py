@@ -18,6 +18,7 @@ from lifelike_mj.fish.scene import BODY_LENGTH_M
 from lifelike_mj.fish.sim import swim
 from lifelike_mj.io import write_json, write_text
 from lifelike_mj.progress import Stages
+from lifelike_mj.render.plot import markdown_figure
 
 #: Settings of the report (the paper: ten fish, 30 s tracks).
 N_FISH = 10
@@ -56,8 +57,9 @@ def reproduce_fish(out: str | Path, seeds=PATTERN_SEEDS, pattern_s: float = PATT
         patterns_figure(table.rows, out / "fig11_patterns.png")
     with st.next("a rendered frame of the tank"):
         try:
-            frame_png(out / "tank.png", bd, n_fish=N_FISH, seed=0, t_s=5.0, camera="follow")
-            snap = "![tank](tank.png)\n"
+            frame_png(out / "tank.png", bd, n_fish=N_FISH, seed=0, t_s=5.0, camera="oblique", width=1280, height=720)
+            snap = markdown_figure("tank.png", f"All {N_FISH} B-D fish in the filmed 5 m tank at t = 5 s (seed 0), a "
+                                                "rendered frame of the MuJoCo scene; each fish is 7 cm long.") + "\n"
         except (UserError, ImportError, RuntimeError) as exc:
             snap = f"(no rendered frame on this machine: {exc})\n"
 
@@ -72,7 +74,10 @@ def reproduce_fish(out: str | Path, seeds=PATTERN_SEEDS, pattern_s: float = PATT
               f"| speed | (damselfish, 7 cm) | mean {_f(summ['mean_speed_body_lengths_s'])} BL/s, max "
               f"{_f(summ['max_speed_body_lengths_s'])} BL/s (side view, 24 fps) |",
               f"| fish outside the tank | - | {summ['fish_outside_tank']} |", "",
-              "![tracks](fig7_tracks.png)", "", "![acceleration histogram](fig8_accel_histogram.png)", "", snap]
+              markdown_figure("fig7_tracks.png", "cf. Satoi 2015 Fig. 7 — one fish's speed, the motion unit it is in, "
+                              "and its track seen from the side (F1, F2)."), "",
+              markdown_figure("fig8_accel_histogram.png", "cf. Satoi 2015 Fig. 8 — histogram of the acceleration along "
+                              "the side-view tracks of ten fish, 24 fps (F3)."), "", snap]
     lines += ["## F4: the four patterns on objective measures", "",
               f"{len(seeds)} seeds x {_f(pattern_s, 0)} s x {N_FISH} fish; medians over seeds.", "",
               "| pattern | burstiness B | acceleration kurtosis | turning entropy (bits) | burst interval (s) | "
@@ -86,7 +91,8 @@ def reproduce_fish(out: str | Path, seeds=PATTERN_SEEDS, pattern_s: float = PATT
               "| ordering | holds for every seed | margins per seed |", "|---|---|---|"]
     for k, c in table.checks.items():
         lines.append(f"| {k} | {'yes' if c['holds'] else '**no**'} | {', '.join(_f(m, 3) for m in c['margins'])} |")
-    lines += ["", "![patterns](fig11_patterns.png)", "",
+    lines += ["", markdown_figure("fig11_patterns.png", "cf. Satoi 2015 section 5.1 — the four patterns (bursty or "
+                                  "not, diverse or not) on the objective measures, one point per seed (F4)."), "",
               "## Drag cross-check", "",
               f"Custom drag (C_D = 1, equivalent-inertia-box areas) against MuJoCo's inertia-box fluid model over "
               f"{drag['trials']} random states: max relative error {drag['max_rel_error']:.1e}.", ""]

@@ -50,3 +50,8 @@ def finish(fig: Figure, path: str | os.PathLike | None, what: str = "figure") ->
     if path is not None:
         save(fig, png_path(path, what))
     return fig
+
+
+def markdown_figure(file: str, caption: str) -> str:
+    """A figure in a Markdown report: the image (its caption as alt text) and the caption below it."""
+    return f"![{caption}]({file})\n\n*{caption}*"

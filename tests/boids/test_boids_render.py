@@ -34,8 +34,8 @@ def test_scene_has_one_mocap_body_per_agent_and_no_collisions():
     assert np.all(m.geom_type[geoms] == mujoco.mjtGeom.mjGEOM_ELLIPSOID)
     np.testing.assert_allclose(m.geom_size[geoms[0]], scene.BODY_SEMI_AXES)
     rgba = m.mat_rgba[m.geom_matid[geoms]]
-    np.testing.assert_allclose(rgba[0], scene.TYPE_RGBA[0], atol=1e-6)  # A red
-    np.testing.assert_allclose(rgba[1], scene.TYPE_RGBA[1], atol=1e-6)  # B yellow-green
+    np.testing.assert_allclose(rgba[0], scene.type_rgba(0), atol=1e-6)  # A blue (colour-blind palette)
+    np.testing.assert_allclose(rgba[1], scene.type_rgba(1), atol=1e-6)  # B orange
     assert [m.camera(i).name for i in range(m.ncam)] == list(scene.CAMERAS)
     assert m.narena == scene.scene_memory_bytes(50)
     m2, layout2 = scene.build_scene(10, dims=2)
