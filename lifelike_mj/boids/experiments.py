@@ -182,6 +182,8 @@ def run_sweep(sweep: Sweep, values: list[list[float]], seeds, executor: str = "p
 
     grid = list(itertools.product(*values))
     rows = np.array([[*g, s] for g in grid for s in seeds], dtype=float)
+    for g in grid:  # every cell's parameters are checked before any run starts
+        sweep.params_of([*g, 0])
     with make_evaluator(sweep, executor=executor, workers=workers, ray_address=ray_address) as ev:
         res = ev(rows)
     table = []

@@ -121,6 +121,10 @@ def cmd_sweep(args) -> None:
         sweep = Sweep(_params(args), tuple(axes), args.n, args.steps)
     from lifelike_mj.progress import stage
 
+    import itertools
+
+    for cell in itertools.product(*values):  # bad axes or weights: one sentence before any run
+        sweep.params_of([*cell, 0])
     n_runs = len(seed_list) * int(np.prod([len(v) for v in values]))
     with stage(f"sweep: {n_runs} runs on {args.executor}"):
         res = run_sweep(sweep, values, seed_list, executor=args.executor, workers=args.workers,

@@ -90,12 +90,12 @@ def test_velocity_quat_is_a_unit_quaternion_in_every_direction():
 
 
 def _colour_pixels(img) -> tuple[int, int]:
-    """Pixels of the red (A) and the yellow-green (B) agents."""
+    """Pixels of the blue (A) and the orange (B) agents (the colour-blind palette)."""
     a = np.asarray(img, dtype=float)
     r, g, b = a[..., 0], a[..., 1], a[..., 2]
-    red = (r > 120) & (r > g + 70) & (r > b + 70)
-    green = (g > 100) & (g > r + 15) & (g > b + 60)
-    return int(red.sum()), int(green.sum())
+    blue = (b > 90) & (b > r + 60) & (b > g + 25)
+    orange = (r > 120) & (r > b + 90) & (g > b + 50) & (r > g + 20)
+    return int(blue.sum()), int(orange.sum())
 
 
 def test_render_tiny_gif(tmp_path, gl_backend):

@@ -253,6 +253,11 @@ def test_patterns_order_as_the_paper_ratings_for_every_seed():
     """F4: B-D above NB-ND on burstiness and diversity, B above NB on burstiness, D above ND on
     diversity, seed by seed (3 seeds x 40 s here; the report uses 5 x 60 s)."""
     table = pattern_table(seeds=(0, 1, 2), duration_s=40.0, n_fish=10)
+    # the orderings the paper's ratings imply (Satoi 2015 Fig. 11-12), written out here, not taken from the code
+    expected = {f"{hi} > {lo} on {k}" for k in ("burstiness", "accel_kurtosis")
+                for hi, lo in (("B-D", "NB-ND"), ("B-D", "NB-D"), ("B-ND", "NB-ND"))}
+    expected |= {f"{hi} > {lo} on turn_entropy" for hi, lo in (("B-D", "NB-ND"), ("B-D", "B-ND"), ("NB-D", "NB-ND"))}
+    assert set(table.checks) == expected
     failed = {k: c["margins"] for k, c in table.checks.items() if not c["holds"]}
     assert not failed
 
