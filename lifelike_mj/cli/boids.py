@@ -119,9 +119,9 @@ def cmd_sweep(args) -> None:
             axes.append(name)
             values.append(rng)
         sweep = Sweep(_params(args), tuple(axes), args.n, args.steps)
-    from lifelike_mj.progress import stage
-
     import itertools
+
+    from lifelike_mj.progress import stage
 
     for cell in itertools.product(*values):  # bad axes or weights: one sentence before any run
         sweep.params_of([*cell, 0])
