@@ -17,8 +17,10 @@ imported on first use: ``import lifelike_mj`` does not load MuJoCo.
 """
 
 from lifelike_mj._lazy import attach
+from lifelike_mj._numba_cache import configure as _configure_numba_cache
 
 __version__ = "0.2.0"
+_configure_numba_cache()  # before anything imports numba: a cache that cannot serve stale code
 
 __getattr__, __dir__, __all__ = attach(__name__, {
     "butterfly": ".", "fish": ".", "boids": ".", "evolve": ".", "render": ".", "physics": ".", "stepper": ".",
