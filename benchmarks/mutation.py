@@ -18,13 +18,16 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shutil
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 
+PAPER = "tests/butterfly/test_paper_backend.py tests/butterfly/test_experiments.py"
 # (id, file, old, new, tests): one occurrence of ``old`` is replaced by ``new``.
 MUTANTS = [
     # --- physics: the fluid force (Oe 2010 eq. 1, 10), the butterfly's equations (eq. 7-11), RK4
@@ -33,14 +36,14 @@ MUTANTS = [
     ("fluid_sign", "lifelike_mj/physics/fluid.py", "return -0.5 * np.asarray(area_m2, dtype=float) * rho * cd * v * np.abs(v)",
      "return 0.5 * np.asarray(area_m2, dtype=float) * rho * cd * v * np.abs(v)", "tests/physics tests/butterfly/test_aero.py"),
     ("paper_eq7_sign", "lifelike_mj/butterfly/backends/paper.py", "vp = c[_L] * omega - vzr * sphi  # eq. 7",
-     "vp = c[_L] * omega + vzr * sphi  # eq. 7", "tests/butterfly/test_paper_backend.py tests/butterfly/test_experiments.py"),
+     "vp = c[_L] * omega + vzr * sphi  # eq. 7", PAPER),
     ("paper_gravity", "lifelike_mj/butterfly/backends/paper.py", "/ c[_MASS] - c[_G]  # eq. 11 (+ gravity)",
-     "/ c[_MASS] - 0.9 * c[_G]  # eq. 11 (+ gravity)", "tests/butterfly/test_paper_backend.py tests/butterfly/test_experiments.py"),
+     "/ c[_MASS] - 0.9 * c[_G]  # eq. 11 (+ gravity)", PAPER),
     ("paper_lift_cos", "lifelike_mj/butterfly/backends/paper.py", "ay = (-f * cphi * ctheta + fby)",
-     "ay = (-f * cphi + fby)", "tests/butterfly/test_paper_backend.py tests/butterfly/test_experiments.py"),
+     "ay = (-f * cphi + fby)", PAPER),
     ("paper_rk4_weight", "lifelike_mj/butterfly/backends/paper.py",
      "vy += dt / 6.0 * (a1y + 2.0 * a2y + 2.0 * a3y + a4y)", "vy += dt / 6.0 * (a1y + 2.0 * a2y + 3.0 * a3y + a4y)",
-     "tests/butterfly/test_paper_backend.py tests/butterfly/test_experiments.py"),
+     PAPER),
     ("params_rho", "lifelike_mj/physics/fluid.py", "RHO_AIR: float = 1.28", "RHO_AIR: float = 1.2",
      "tests/test_paper_constants.py tests/butterfly/test_experiments.py"),
     ("fitness_speed", "lifelike_mj/butterfly/flight.py", "return vz / 3.0 * 0.1 / (abs(y_rel) + 0.1)",
@@ -82,11 +85,11 @@ MUTANTS = [
 ]
 
 
-def _env(root: Path) -> dict:
-    """The tests' environment: the mutated checkout first on the path (for subprocesses too); the
-    numba cache chosen by the package (keyed on the mutated source)."""
-    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
-    env["PYTHONPATH"] = str(root)
+def _env(root: Path, cache: str) -> dict:
+    """The tests' environment: the mutated checkout first on the path (for subprocesses too) and an
+    empty numba cache of its own (so that no compiled code of the unmutated source is served, also on
+    checkouts older than the source-keyed cache)."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache, PYTHONPATH=str(root))
     return env
 
 
@@ -98,10 +101,11 @@ def run_mutant(root: Path, mid: str, file: str, old: str, new: str, tests: str, 
     selected = [t for t in tests.split() if (root / t.split("::")[0]).exists()]
     path.write_text(src.replace(old, new))
     t0 = time.perf_counter()
+    cache = tempfile.mkdtemp(prefix="mutant-numba-")
     try:
         proc = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", *selected],
                               cwd=root, capture_output=True, text=True, timeout=timeout_s,
-                              env=_env(root))
+                              env=_env(root, cache))
         failed = proc.returncode != 0
         line = next((ln for ln in proc.stdout.splitlines() if ln.startswith("FAILED")), "")
         status = "killed" if failed else "survived"
@@ -109,6 +113,7 @@ def run_mutant(root: Path, mid: str, file: str, old: str, new: str, tests: str, 
         status, line = "killed", "timeout"
     finally:
         path.write_text(src)
+        shutil.rmtree(cache, ignore_errors=True)
     return {"id": mid, "file": file, "tests": selected, "status": status, "by": line[7:160],
             "seconds": round(time.perf_counter() - t0, 1)}
 
