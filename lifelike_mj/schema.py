@@ -57,3 +57,62 @@ def number_list(value: object, name: str, where: str, length: int | None = None,
         want = f"{length}" if length is not None else f"at least {min_length}"
         raise UserError(f"{where}: {name} must have {want} numbers, got {len(value)}.")
     return [finite(v, f"{name}[{i}]", where) for i, v in enumerate(value)]
+
+
+def document_schema(fmt: str, title: str, properties: dict, required: list[str], description: str = "") -> dict:
+    """A JSON Schema (draft 2020-12) of a file with ``format``/``version`` headers and ``properties``,
+    unknown keys refused (``additionalProperties: false``), as the loaders refuse them."""
+    return {
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "$id": f"https://lifelike-mj.example/schemas/{fmt.split('/')[-1]}.schema.json",
+        "title": title,
+        "description": description,
+        "type": "object",
+        "properties": {"format": {"const": fmt}, "version": {"const": 1, "description": "file format version"},
+                       "name": {"type": "string"}, "description": {"type": "string"}, **properties},
+        "required": ["format", *required],
+        "additionalProperties": False,
+    }
+
+
+_UNITS = {"_N": "N", "_deg": "deg", "_m": "m", "_m2": "m^2", "_m5": "m^5", "_s": "s", "_hz": "Hz",
+          "_kg_m3": "kg/m^3", "_per_deg": "1/deg", "_bl_s": "body lengths/s", "_cm2": "cm^2", "_g": "g"}
+
+
+def unit_of(name: str) -> str:
+    """The unit a key's name ends in (``r_max_N`` -> ``N``), or ``""``."""
+    for suffix, unit in sorted(_UNITS.items(), key=lambda kv: -len(kv[0])):
+        if name.endswith(suffix):
+            return unit
+    return ""
+
+
+def number(description: str = "", minimum: float | None = None, maximum: float | None = None,
+           exclusive_minimum: float | None = None) -> dict:
+    """The JSON Schema of a number."""
+    out: dict = {"type": "number"}
+    if description:
+        out["description"] = description
+    if minimum is not None:
+        out["minimum"] = minimum
+    if exclusive_minimum is not None:
+        out["exclusiveMinimum"] = exclusive_minimum
+    if maximum is not None:
+        out["maximum"] = maximum
+    return out
+
+
+def write_schemas(folder) -> list:
+    """Write every file format's JSON Schema into ``folder`` (for editors); returns the paths."""
+    from pathlib import Path
+
+    from lifelike_mj.boids.presets import grid_json_schema
+    from lifelike_mj.boids.presets import json_schema as boids_schema
+    from lifelike_mj.butterfly.controllers import json_schema as butterfly_schema
+    from lifelike_mj.fish.params import json_schema as fish_schema
+    from lifelike_mj.io import write_json
+
+    out = Path(folder)
+    docs = {"butterfly-controller": butterfly_schema(), "fish-preset": fish_schema(), "boids-preset": boids_schema(),
+            "boids-grid": grid_json_schema()}
+    return [write_json(out / f"{name}.schema.json", schema) for name, schema in docs.items()]

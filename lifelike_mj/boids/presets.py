@@ -74,3 +74,29 @@ def load_grid(ref: str | Path = "fig2_grid") -> dict:
 def homogeneous(w_a: float, w_c: float, dims: int = 3) -> BoidParams:
     """One type with alignment weight ``w_a`` and cohesion weight ``w_c`` (section 2)."""
     return BoidParams(wa=((w_a,),), wc=((w_c,),), dims=dims, name=f"w_a={w_a:g}, w_c={w_c:g}")
+
+
+def json_schema() -> dict:
+    """The JSON Schema of a boids preset file (``docs/schemas/boids-preset.schema.json``)."""
+    from lifelike_mj.schema import document_schema, number
+
+    matrix = {"type": "array", "minItems": 1, "items": {"type": "array", "minItems": 1, "items": {"type": "number"}},
+              "description": "k x k weights, row: own type, column: the neighbour's type"}
+    settings = {"type": "object", "additionalProperties": False, "properties": {
+        "r_s": number("separation zone radius, box units", exclusive_minimum=0),
+        "r_a": number("alignment zone radius, box units", exclusive_minimum=0),
+        "r_c": number("cohesion zone radius, box units", exclusive_minimum=0),
+        "w_s": number("separation weight (the paper: 0.05)"),
+        "box": number("box side, box units (at most 200 R_c)", exclusive_minimum=0)}}
+    return document_schema(FORMAT, "lifelike-mj boids preset", {"figure": {"type": "string"}, "W_a": matrix,
+                           "W_c": matrix, "settings": settings}, ["W_a", "W_c"],
+                           "Nakamura 2013: the alignment and cohesion matrices of a two-type (or k-type) flock.")
+
+
+def grid_json_schema() -> dict:
+    """The JSON Schema of a homogeneous grid file (``docs/schemas/boids-grid.schema.json``)."""
+    from lifelike_mj.schema import document_schema
+
+    axis = {"type": "array", "minItems": 1, "items": {"type": "number", "minimum": 0, "maximum": MAX_WEIGHT}}
+    return document_schema(GRID_FORMAT, "lifelike-mj boids grid", {"w_a": axis, "w_c": axis}, ["w_a", "w_c"],
+                           "Nakamura 2013 Fig. 2: the homogeneous alignment and cohesion weights to sweep.")

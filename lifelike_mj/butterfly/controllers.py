@@ -231,3 +231,33 @@ def load(name_or_path: str | Path) -> ButterflyController:
     """Load a shipped controller by name (``simple_rule``) or any controller file by path."""
     data, path = load_named_json("butterfly", name_or_path, "controller")
     return from_dict(data, path.stem)
+
+
+def json_schema() -> dict:
+    """The JSON Schema of a butterfly controller file (``docs/schemas/butterfly-controller.schema.json``)."""
+    from lifelike_mj.schema import document_schema, number
+
+    angle = number("deg", -90, 90)
+    flap = {"type": "object", "additionalProperties": False, "required": ["theta_min_deg", "theta_max_deg"],
+            "properties": {"frequency_hz": number("flap frequency, Hz (the paper: 10)", exclusive_minimum=0),
+                           "theta_min_deg": number("lowest flap angle, deg", -180, 180),
+                           "theta_max_deg": number("highest flap angle, deg", -180, 180)}}
+    ann_params = {"weights": {"type": "array", "items": {"type": "number"},
+                              "description": "49 weights for the 6-6-1 network, or as many as layers need"},
+                  "inputs": {"enum": list(ann.INPUT_KINDS)},
+                  "input_scale": {"type": "object", "additionalProperties": {"type": "number", "exclusiveMinimum": 0}},
+                  "layers": {"type": "array", "items": {"type": "integer", "minimum": 1}},
+                  "max_dphi_deg": number("largest change of pitch per step, deg", exclusive_minimum=0),
+                  "phi_limit_deg": number("pitch limit, deg", exclusive_minimum=0)}
+    laws = {"simple_rule": {"phi_up_deg": angle, "phi_down_deg": angle}, "constant": {"phi_deg": angle},
+            "ann": ann_params}
+    variants = [{"properties": {"type": {"const": t}, "parameters": {
+        "type": "object", "properties": props, "required": list(PITCH_LAWS[t][1]), "additionalProperties": False}}}
+        for t, props in laws.items()]
+    schema = document_schema(FORMAT, "lifelike-mj butterfly controller",
+                             {"type": {"enum": sorted(PITCH_LAWS)}, "flap": flap, "parameters": {"type": "object"},
+                              "provenance": {"type": "object"}}, ["type", "flap", "parameters"],
+                             "Oe 2010: a flap pattern and a pitch law (section 5.1 rule, a constant, or the "
+                             "section 6 network) with its parameters.")
+    schema["oneOf"] = variants
+    return schema

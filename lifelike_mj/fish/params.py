@@ -250,3 +250,33 @@ def preset_names() -> list[str]:
     from lifelike_mj.paths import shipped_names
 
     return shipped_names("fish")
+
+
+def json_schema() -> dict:
+    """The JSON Schema of a fish preset file (``docs/schemas/fish-preset.schema.json``)."""
+    from lifelike_mj.schema import document_schema, number, unit_of
+
+    props: dict = {}
+    for f in fields(FishParams):
+        if f.name in ("name", "description"):
+            continue
+        if f.name == "transition":
+            props[f.name] = {"type": "array", "minItems": 4, "maxItems": 4, "description": "4 x 4 Markov weights, "
+                             "rows from accelerate, coast, cruise, brake (instead of P_a..P_e)",
+                             "items": {"type": "array", "minItems": 4, "maxItems": 4,
+                                       "items": {"type": "number", "minimum": 0}}}
+        elif f.name.startswith("brake_dS"):
+            props[f.name] = {"type": "array", "minItems": 3, "maxItems": 3, "items": {"type": "number", "minimum": 0},
+                             "description": f"per body axis (x, y, z), {unit_of(f.name)}"}
+        elif f.name == "substeps":
+            props[f.name] = {"type": "integer", "minimum": 1, "maximum": 100, "description": "MuJoCo steps per control step"}
+        elif f.name == "control_hz":
+            props[f.name] = number("control steps per second, Hz (the paper: 60)", 1, 10_000)
+        else:
+            props[f.name] = number(unit_of(f.name) and f"unit: {unit_of(f.name)}", minimum=0)
+    params = {"type": "object", "properties": props, "additionalProperties": False,
+              "description": "every parameter is optional; missing ones take the calibrated default (B-D)"}
+    schema = document_schema(FORMAT, "lifelike-mj fish preset", {"parameters": params, "same_as": {"type": "string"}},
+                             [], "Satoi 2015 motion units: a preset's parameters, or same_as another preset.")
+    schema["oneOf"] = [{"required": ["parameters"]}, {"required": ["same_as"]}]
+    return schema
