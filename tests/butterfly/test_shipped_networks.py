@@ -85,3 +85,39 @@ def test_ann_robust_passes_more_wind_cells(ann_paper, ann_robust, inputs):
     a = ax.e11_windmap(ann_paper, inputs, step_m_s=0.25)
     b = ax.e11_windmap(ann_robust, inputs, step_m_s=0.25)
     assert b.pass_cells > a.pass_cells
+
+
+def test_e8_the_glide_sinks_at_its_closed_form_terminal_speed(ann_paper):
+    """E8: gliding with the wings held at 75 deg and phi = 0, the wings meet the air edge-on (eq. 7:
+    v' = -v_z sin(phi) = 0), so only the body's drag (eq. 10) holds the weight: the sink speed tends to
+    v_t = sqrt(2 m g / (rho C_d A_b)) = 4.712 m/s."""
+    import math
+
+    from lifelike_mj.butterfly.params import ButterflyParams
+
+    p = ButterflyParams()
+    v_t = math.sqrt(2 * p.mass_kg * p.gravity / (p.rho * p.cd * p.body_area_m2))
+    assert v_t == pytest.approx(4.712, abs=5e-4)
+    e8 = ax.e8_glide(ann_paper)
+    assert e8.max_sink_gliding_m_s <= v_t and e8.max_sink_gliding_m_s == pytest.approx(v_t, rel=1e-3)
+    # the paper: the glide sinks about twice as fast as the network's descent; ours computes 0.79
+    # (docs/results.md: our network descends at 5.9 m/s, it dives rather than flaps down)
+    assert e8.ratio == pytest.approx(0.793, abs=0.005)
+
+
+def test_e10_the_winds_as_computed(ann_paper):
+    """E10 (Fig. 14, 15), computed: each flight's end altitude (m) in the four 2 m/s winds, both input
+    readings. Paper: relative inputs hold in a head wind and level at an offset from above and below;
+    a tail wind crashes. Ours, pinned at what the code computes (docs/results.md says where it differs)."""
+    e10 = ax.e10_winds(ann_paper)
+    final = {(k, w): v["final_altitude_m"] for k, d in e10.flights.items() for w, v in d.items()}
+    want = {("relative", "front (2,0)"): 0.0002, ("relative", "above (0,2)"): -3.377,
+            ("relative", "behind (-2,0)"): 0.0002, ("relative", "below (0,-2)"): -51.789,
+            ("ground", "front (2,0)"): -0.584, ("ground", "above (0,2)"): -0.120,
+            ("ground", "behind (-2,0)"): -1.371, ("ground", "below (0,-2)"): 0.081}
+    assert set(final) == set(want)
+    for key, value in want.items():
+        assert final[key] == pytest.approx(value, abs=0.002), key
+    # the levelled flights have settled; the one from below falls all the way
+    rates = {(k, w): v["settled_climb_rate_cm_s"] for k, d in e10.flights.items() for w, v in d.items()}
+    assert abs(rates[("relative", "above (0,2)")]) < 5 and rates[("relative", "below (0,-2)")] < -100
