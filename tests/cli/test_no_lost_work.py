@@ -150,3 +150,21 @@ def test_ctrl_c_before_the_first_generation_exits_130_and_writes_nothing(tmp_pat
     err = capsys.readouterr().err
     assert "interrupted: stopped before the first generation was evaluated; nothing was written." in err
     assert not (tmp_path / "ctrl.json").exists() and not (tmp_path / "ctrl.json.ckpt").exists()
+
+
+def test_an_unstable_fish_tank_exits_2_naming_the_cause_and_writes_no_measures(tmp_path, capsys):
+    strong = tmp_path / "strong.json"
+    strong.write_text(json.dumps({"format": "lifelike-mj/fish-preset", "version": 1, "name": "strong",
+                                  "parameters": {"r_min_N": 10, "r_max_N": 20}}))
+    out = tmp_path / "out"
+    assert main(["fish", "swim", "--preset", str(strong), "--duration", "2", "--out", str(out), "--json"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and "became unstable" in captured.err and "r_min_N = 10 (default 0.01)" in captured.err
+    assert not (out / "measures.json").exists()
+
+
+def test_an_unstable_butterfly_exits_2_naming_the_cause(capsys):
+    assert main(["butterfly", "fly", "--controller", "simple_rule", "--mass-g", "0.001", "--duration", "1",
+                 "--json"]) == 2
+    err = capsys.readouterr().err
+    assert "diverged at step" in err and "mass_kg = 1e-06 (default 0.000319)" in err
