@@ -516,3 +516,45 @@ def test_a_problem_the_pool_cannot_take_runs_serially_with_a_warning():
     with ev:
         assert isinstance(ev, SerialEvaluator)
         assert ev(np.zeros((3, 2))).shape == (3,)
+
+
+# --- the driver's and CMA-ES's documented choices, each checked by its effect --------------------------
+
+
+def test_cmaes_starts_with_a_quarter_of_the_bounds_width():
+    """sigma0 = 0.25 mean(upper - lower): the first generation's spread about the centre of wide bounds."""
+    asked = []
+
+    def record(X):
+        asked.append(np.array(X))
+        return np.sum(X * X, axis=1)
+
+    p = Sphere(dim=50, low=-100.0, high=100.0)
+    optimize(p, "cmaes", seed=3, generations=1, evaluator=record, progress=False)
+    X = asked[0]
+    assert np.std(X) == pytest.approx(0.25 * 200.0, rel=0.08)
+
+
+@pytest.mark.parametrize("maximize", [False, True])
+def test_nan_fitness_counts_as_the_worst(maximize):
+    p = Sphere(dim=3, maximize=maximize)
+
+    def with_nan(X):
+        f = np.sum(X * X, axis=1)
+        f[0] = np.nan
+        return f
+
+    res = optimize(p, "rcga", seed=0, population=9, generations=3, evaluator=with_nan, progress=False)
+    assert np.isfinite(res.best_f)
+    assert all(np.isfinite(h["best"]) for h in res.history)
+
+
+def test_a_tie_keeps_the_older_best():
+    seen = []
+
+    def flat(X):
+        seen.append(np.array(X))
+        return np.ones(len(X))
+
+    res = optimize(Sphere(dim=3), "rcga", seed=0, population=9, generations=4, evaluator=flat, progress=False)
+    np.testing.assert_array_equal(res.best_x, seen[0][0])
