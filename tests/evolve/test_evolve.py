@@ -532,7 +532,8 @@ def test_cmaes_starts_with_a_quarter_of_the_bounds_width():
     p = Sphere(dim=50, low=-100.0, high=100.0)
     optimize(p, "cmaes", seed=3, generations=1, evaluator=record, progress=False)
     X = asked[0]
-    assert np.std(X) == pytest.approx(0.25 * 200.0, rel=0.08)
+    # the median |x| of N(0, sigma) is 0.6745 sigma, measured where pycma's bound handling is the identity
+    assert np.median(np.abs(X)) / 0.6745 == pytest.approx(0.25 * 200.0, rel=0.1)
 
 
 @pytest.mark.parametrize("maximize", [False, True])
