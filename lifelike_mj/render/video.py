@@ -30,8 +30,10 @@ class MP4Writer:
         import imageio.v2 as iio
 
         try:
+            meta = _provenance_text()
             self._w = iio.get_writer(str(path), format="FFMPEG", mode="I", fps=fps, codec="libx264", quality=8,
-                                     pixelformat="yuv420p", macro_block_size=2, ffmpeg_log_level="error")
+                                     pixelformat="yuv420p", macro_block_size=2, ffmpeg_log_level="error",
+                                     output_params=["-metadata", f"comment={meta}"])
         except (ImportError, RuntimeError, ValueError) as exc:
             raise UserError(f"cannot write MP4 ({exc.__class__.__name__}); install imageio-ffmpeg or write a "
                             ".gif.") from None
@@ -58,7 +60,15 @@ class GIFWriter:
         if self.frames:
             ms = max(20, int(round(1000.0 / self.fps)))  # browsers treat < 20 ms as 100 ms
             self.frames[0].save(self.path, format="GIF", save_all=True, append_images=self.frames[1:], duration=ms,
-                                loop=0, disposal=1, optimize=False)
+                                loop=0, disposal=1, optimize=False, comment=_provenance_text().encode()[:255])
+
+
+def _provenance_text() -> str:
+    """``lifelike-mj VERSION; COMMAND``: what a video file records of where it came from."""
+    from lifelike_mj.provenance import png_metadata
+
+    meta = png_metadata()
+    return f"{meta['Software']}; {meta['Description']}"
 
 
 #: Writer class by file suffix.

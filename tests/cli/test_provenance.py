@@ -48,3 +48,10 @@ def test_custom_boids_run_records_its_matrices_and_can_keep_the_whole_run(tmp_pa
         assert ma[k] == mb[k], k
     steps = np.load(b / "trajectories.npz")["steps"]
     assert np.array_equal(steps, np.arange(301))
+
+
+def test_videos_record_the_version_and_command(tmp_path, gl_backend):
+    out = tmp_path / "v.gif"
+    assert main(["render", "fish", "--out", str(out), "--duration", "0.2", "--width", "64", "--height", "48"]) == 0
+    comment = Image.open(out).info["comment"].decode()
+    assert comment.startswith(f"lifelike-mj {__version__}; lifelike-mj render fish --out ")
