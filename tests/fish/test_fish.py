@@ -376,3 +376,13 @@ def test_the_compiled_push_equals_the_papers_equations_by_hand():
         np.testing.assert_allclose(ud[base + 3 : base + 6], want, rtol=1e-12, atol=1e-15)
         checked += 1
     assert checked >= 5
+
+
+def test_the_righting_moment_is_weight_times_the_buoyancy_offset():
+    """Buoyancy (ours, not the paper's): the water carries the weight m g at a point buoyancy_offset_m
+    above the centre of mass, so a fish tilted by an angle a feels m g h sin(a) righting it."""
+    tank = sim.Tank(BD, 2, seed=0)
+    g = float(np.linalg.norm(tank.scene.model.opt.gravity))
+    assert g == pytest.approx(9.81)
+    assert tank.data.userdata[sim.U_RIGHT] == pytest.approx(tank.scene.mass_kg * 9.81 * 0.001, rel=1e-12)
+    assert BD.buoyancy_offset_m == 0.001
