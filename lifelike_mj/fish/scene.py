@@ -45,7 +45,7 @@ def check_tank(size) -> tuple[float, float, float]:
     vals = tuple(float(v) for v in size)
     if len(vals) != 3 or not all(math.isfinite(v) and v > 0 for v in vals):
         raise UserError(f"a tank size is three positive lengths in m (length, depth, height), got {size!r}.")
-    if min(vals) < 2.5 * BODY_LENGTH_M:
+    if min(vals) < 2.5 * BODY_LENGTH_M * (1.0 - 1e-9):  # the bound itself is allowed, whatever its rounding
         raise UserError(f"every side of the tank must be at least {2.5 * BODY_LENGTH_M:.3f} m (2.5 body lengths), got {vals}.")
     return vals  # type: ignore[return-value]
 

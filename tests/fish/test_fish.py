@@ -386,3 +386,12 @@ def test_the_righting_moment_is_weight_times_the_buoyancy_offset():
     assert g == pytest.approx(9.81)
     assert tank.data.userdata[sim.U_RIGHT] == pytest.approx(tank.scene.mass_kg * 9.81 * 0.001, rel=1e-12)
     assert BD.buoyancy_offset_m == 0.001
+
+
+def test_the_smallest_tank_scale_is_accepted(capsys):
+    """--tank-scale's stated lower bound (0.35: every side 2.5 body lengths) is itself accepted."""
+    from lifelike_mj.cli.fish import MIN_TANK_SCALE
+
+    assert MIN_TANK_SCALE * min(0.5, 1.0) == pytest.approx(2.5 * BODY_LENGTH_M)
+    assert main(["fish", "swim", "--n", "1", "--duration", "0.2", "--tank-scale", str(MIN_TANK_SCALE)]) == 0
+    assert main(["fish", "swim", "--n", "1", "--duration", "0.2", "--tank-scale", "0.3499"]) == 2
