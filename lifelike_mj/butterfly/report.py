@@ -316,7 +316,7 @@ def _ann_section(out: Path, params: ButterflyParams) -> tuple[str, dict]:
     for inputs, flights in e10.flights.items():
         for w, v in flights.items():
             rows.append((f"E10 wind from {w}, {inputs} inputs", paper_e10[w],
-                         f"{_state(v)}, {v['settled_forward_speed_cm_s']:.0f} cm/s"))
+                         f"{_state(v)}; forward speed {v['settled_forward_speed_cm_s']:.0f} cm/s"))
     for k, m in maps.items():
         q = m.quadrants()
         paper_e11 = {"relative": "weak to tail + from-above wind",
