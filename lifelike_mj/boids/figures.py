@@ -66,8 +66,8 @@ _LINE_WIDTH = 1.3
 #: Colours of the labels of :func:`phase_diagram_figure`: the eight patterns, then other labels.
 _LABEL_COLOURS = {"4a": "#1f77b4", "4b": "#ff7f0e", "4c": "#2ca02c", "4d": "#d62728", "5a": "#9467bd", "5b": "#8c564b",
                   "5c": "#e377c2", "5d": "#17becf"}
-_LABEL_COLOURS.update({"aligned lattice": "#0072b2", "compact flock": "#d55e00", "swarm": "#e69f00",
-                       "spread": "#56b4e9"})
+_LABEL_COLOURS.update({"aligned lattice": "#0072b2", "lattice": "#009e73", "compact flock": "#d55e00",
+                       "swarm": "#e69f00", "spread": "#56b4e9"})
 _EXTRA_COLOURS = ("#bcbd22", "#aec7e8", "#ffbb78", "#98df8a", "#ff9896", "#c5b0d5", "#c49c94", "#f7b6d2", "#dbdb8d",
                   "#9edae5", "#393b79", "#637939", "#8c6d31", "#843c39", "#7b4173")
 _NO_LABEL = {"", "none", "nan", "n/a", "diverged", "unclassified", "unknown", "?"}

@@ -575,26 +575,30 @@ def classify(m: dict) -> tuple[str, dict]:
 
 
 # One type (the homogeneous boids of Nakamura 2013 Fig. 2). Thresholds set by hand on the 16 cells of
-# Fig. 2's grid, seeds 0 and 1, n = 300 (docs/results.md): every cell got the same label on both seeds.
+# Fig. 2's grid, seeds 0 and 1, n = 300 (docs/results.md): every cell got the same label on both seeds,
+# and every threshold lies in a gap between the cells' values.
 #: Aligned lattice: polarisation at least this (w_c = 0, w_a >= 0.1: 0.85-1.00; every other cell <= 0.59).
 ALIGNED_POLARISATION = 0.8
-#: Compact flock: mean nearest-neighbour distance at most this (w_c = 0.1, w_a >= 0.01: 0.21-0.53).
+#: Compact flock: mean nearest-neighbour distance at most this (w_c = 0.1, w_a >= 0.01: 0.21-0.53; others >= 0.85).
 COMPACT_NN_DISTANCE = 0.6
-#: Swarm (a cohesive, unaligned cloud): nearest-neighbour distance at most this (w_c = 0.01, w_a >= 0.01:
-#: 0.85-0.96); above it the agents spread (w_c <= 0.001 or w_a = 0.001: 1.01-1.70).
-SWARM_NN_DISTANCE = 1.0
-HOMOGENEOUS_LABELS = ("aligned lattice", "compact flock", "swarm", "spread")
+#: Spread: RMS distance from the centroid above this, box units (no flock: 5.0-9.7; one cloud: 1.8-3.6).
+SPREAD_RADIUS = 4.3
+#: Lattice (a slow cloud spaced at about R_s) below this mean speed per step, swarm above it
+#: (w_c = 0.001, w_a >= 0.1: 0.012-0.030; w_c = 0.01, w_a >= 0.01: 0.066-0.153).
+LATTICE_SPEED = 0.05
+HOMOGENEOUS_LABELS = ("aligned lattice", "lattice", "compact flock", "swarm", "spread")
 
 
 def classify_homogeneous(m: dict) -> tuple[str, dict]:
     """The regime of a one-type run (Nakamura 2013 Fig. 2, section 2.2) from its averaged measures ``m``
     (:func:`measures`), and the reasons (as :func:`classify`'s):
 
-    1. ``polarisation >= ALIGNED_POLARISATION`` -> **aligned lattice** (every agent heading the same
-       way, spaced by the separation zone: the paper's "lattice-like" flock).
+    1. ``polarisation >= ALIGNED_POLARISATION`` -> **aligned lattice** (every agent heading the same way).
     2. ``nn_distance <= COMPACT_NN_DISTANCE`` -> **compact flock**.
-    3. ``nn_distance <= SWARM_NN_DISTANCE`` -> **swarm** (cohesive, unaligned: midge-like).
-    4. else **spread** (no flock).
+    3. ``radial_rms_0 > SPREAD_RADIUS`` -> **spread** (no flock: the agents fill much of the box).
+    4. ``speed < LATTICE_SPEED`` -> **lattice** (one slow cloud, agents about R_s apart: the paper's
+       "lattice-like" spacing).
+    5. else **swarm** (one agitated, unaligned cloud: the paper's midge-like swarm).
 
     A run that diverges (w_a >= 10 or w_c >= 1) is labelled ``diverged`` by the caller.
     """
@@ -602,7 +606,8 @@ def classify_homogeneous(m: dict) -> tuple[str, dict]:
 
     def t(key, op, thr):
         val = m.get(key)
-        ok = val is not None and (val >= thr if op == ">=" else val <= thr)
+        ok = val is not None and (val >= thr if op == ">=" else val <= thr if op == "<=" else
+                                  val > thr if op == ">" else val < thr)
         tests.append((key, None if val is None else round(float(val), 4), op, thr, bool(ok)))
         return ok
 
@@ -613,9 +618,11 @@ def classify_homogeneous(m: dict) -> tuple[str, dict]:
         return done("aligned lattice", "1", "every agent heading the same way")
     if t("nn_distance", "<=", COMPACT_NN_DISTANCE):
         return done("compact flock", "2", "a dense flock")
-    if t("nn_distance", "<=", SWARM_NN_DISTANCE):
-        return done("swarm", "3", "a cohesive, unaligned cloud")
-    return done("spread", "4", "agents spread, no flock")
+    if t("radial_rms_0", ">", SPREAD_RADIUS):
+        return done("spread", "3", "agents spread over the box, no flock")
+    if t("speed", "<", LATTICE_SPEED):
+        return done("lattice", "4", "one slow cloud, agents about R_s apart")
+    return done("swarm", "5", "one agitated, unaligned cloud")
 
 
 def simulate_and_measure(params, seed: int, n: int | None = None, n_steps: int = RUN_STEPS,

@@ -47,7 +47,7 @@ def test_fig2_regimes_of_one_type():
     want = {}
     for wa in (1.0, 0.1, 0.01, 0.001):
         want[(wa, 0.0)] = "aligned lattice" if wa >= 0.1 else "spread"
-        want[(wa, 0.001)] = "spread"
+        want[(wa, 0.001)] = "lattice" if wa >= 0.1 else "spread"
         want[(wa, 0.01)] = "swarm" if wa >= 0.01 else "spread"
         want[(wa, 0.1)] = "compact flock" if wa >= 0.01 else "spread"
     assert got == want
