@@ -100,19 +100,3 @@ def number(description: str = "", minimum: float | None = None, maximum: float |
     if maximum is not None:
         out["maximum"] = maximum
     return out
-
-
-def write_schemas(folder) -> list:
-    """Write every file format's JSON Schema into ``folder`` (for editors); returns the paths."""
-    from pathlib import Path
-
-    from lifelike_mj.boids.presets import grid_json_schema
-    from lifelike_mj.boids.presets import json_schema as boids_schema
-    from lifelike_mj.butterfly.controllers import json_schema as butterfly_schema
-    from lifelike_mj.fish.params import json_schema as fish_schema
-    from lifelike_mj.io import write_json
-
-    out = Path(folder)
-    docs = {"butterfly-controller": butterfly_schema(), "fish-preset": fish_schema(), "boids-preset": boids_schema(),
-            "boids-grid": grid_json_schema()}
-    return [write_json(out / f"{name}.schema.json", schema) for name, schema in docs.items()]

@@ -5,8 +5,8 @@ from pathlib import Path
 
 import pytest
 
+from lifelike_mj.cli.schemas import write_schemas
 from lifelike_mj.paths import controllers_dir
-from lifelike_mj.schema import write_schemas
 
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "schemas"
 KINDS = {"butterfly": "butterfly-controller", "fish": "fish-preset", "boids": "boids-preset"}
@@ -15,7 +15,7 @@ KINDS = {"butterfly": "butterfly-controller", "fish": "fish-preset", "boids": "b
 def test_published_schemas_are_current(tmp_path):
     for path in write_schemas(tmp_path):
         assert (DOCS / path.name).read_text() == path.read_text(), f"regenerate {path.name}: python -c " \
-            "\"from lifelike_mj.schema import write_schemas; write_schemas('docs/schemas')\""
+            "\"from lifelike_mj.cli.schemas import write_schemas; write_schemas('docs/schemas')\""
 
 
 def test_schema_keys_are_the_loaders_keys():
