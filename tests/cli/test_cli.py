@@ -132,3 +132,16 @@ def test_negative_values_are_values(capsys):
     code, out, _ = run(capsys, "butterfly", "fly", "--controller", "simple_rule", "--duration", "1", "--wind", "-2,0",
                        "--y0", "-1", "--json")
     assert code == 0 and json.loads(out)["start_altitude_m"] == -1.0
+
+
+def test_json_output_is_strict_with_undefined_values_named(capsys):
+    """One fish for half a second has no burst: its burst measures are undefined, printed as null and named."""
+    code, out, _ = run(capsys, "fish", "swim", "--n", "1", "--duration", "0.5", "--json")
+    assert code == 0
+
+    def no_constant(name):
+        raise AssertionError(f"bare {name} in JSON output")
+
+    d = json.loads(out, parse_constant=no_constant)
+    assert d["burst_interval_mean_s"] is None
+    assert d["undefined"]["burst_interval_mean_s"] == "not defined for this run (NaN)"
