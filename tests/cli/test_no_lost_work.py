@@ -76,13 +76,13 @@ def test_a_second_run_on_the_same_out_stops_at_once(tmp_path, capsys, small_prob
 def test_two_concurrent_processes_one_wins(tmp_path):
     """Two real processes on one --out: the second stops with exit 2 while the first goes on to finish."""
     argv = [sys.executable, "-m", "lifelike_mj", "butterfly", "evolve", "--optimizer", "rcga", "--population", "6",
-            "--generations", "400", "--executor", "serial", "--quiet", "--out", str(tmp_path / "c.json")]
-    first = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            "--generations", "1000000", "--executor", "serial", "--quiet", "--out", str(tmp_path / "c.json")]
+    first = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # runs until stopped
     try:
-        deadline = time.time() + 60
+        deadline = time.time() + 180
         while not (tmp_path / "c.json.ckpt").exists() and time.time() < deadline:
             time.sleep(0.1)
-        second = subprocess.run(argv, capture_output=True, text=True, timeout=60)
+        second = subprocess.run(argv, capture_output=True, text=True, timeout=180)
         assert second.returncode == 2 and "another run is writing" in second.stderr, second.stderr
         first.send_signal(signal.SIGINT)
         out, err = first.communicate(timeout=60)
@@ -117,7 +117,7 @@ def test_killing_the_main_process_leaves_no_worker_alive(tmp_path):
     """SIGKILL the main process of a pooled evolve run: within 5 s no worker is left, and the reader of its
     stdout sees the end of the stream (so `$(lifelike-mj ...)` does not hang)."""
     argv = [sys.executable, "-m", "lifelike_mj", "butterfly", "evolve", "--optimizer", "rcga", "--population", "8",
-            "--generations", "400", "--executor", "process", "--workers", "2", "--quiet", "--out",
+            "--generations", "1000000", "--executor", "process", "--workers", "2", "--quiet", "--out",
             str(tmp_path / "c.json")]
     proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
     try:
