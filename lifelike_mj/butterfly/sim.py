@@ -287,12 +287,12 @@ class Flight(StepCounter):
             return
         from lifelike_mj.butterfly.backends.mj import COMPILED_PASSIVE
         from lifelike_mj.physics.callbacks import passive_callback
-        from lifelike_mj.physics.stability import Watch, describe, reset_time, watching
+        from lifelike_mj.physics.stability import describe, reset_time, was_reset, watching
 
-        k0, watch = self._k, Watch([self._data])
+        k0, t0 = self._k, float(self._data.time)
         with passive_callback(COMPILED_PASSIVE), watching():
             self._steps(self._mujoco, n, every, out, r0)
-            if watch.new():  # MuJoCo reset the simulation: from its reported time on, nothing is valid
+            if was_reset(self._data, t0, self._k - k0, self.dt):  # MuJoCo reset it: nothing from then on is valid
                 t = reset_time()
                 t = self._k * self.dt if t is None else t
                 self._cause = (describe(self._data, "the flight") + " " + likely_cause_sentence(self.params, self.dt))

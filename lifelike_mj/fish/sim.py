@@ -49,7 +49,7 @@ from lifelike_mj.fish.scene import BODY_LENGTH_M, FishScene, box_areas, build_sc
 from lifelike_mj.physics import mjabi
 from lifelike_mj.physics.callbacks import passive_callback
 from lifelike_mj.physics.fluid import normal_drag_scalar
-from lifelike_mj.physics.stability import Watch, watching
+from lifelike_mj.physics.stability import describe, was_reset, watching
 from lifelike_mj.stepper import StepCounter
 
 # ---- userdata layout (per model; the callback is process-global) ----------------------------------
@@ -570,16 +570,18 @@ class Tank(StepCounter):
         quat = np.zeros((*shape, 4))
         mu = np.zeros(shape, dtype=np.int8)
         err = np.zeros(4)
-        watch = Watch([self.data])
+        t0 = float(self.data.time)
         with passive_callback(COMPILED_PASSIVE), watching():
             _run_chunk(sc.model._address, self.data._address, sc.vision_model._address, self.vision_data._address,
                        self.data.qpos, self.data.qvel, self.data.userdata, self.state_array, self.cum, self.cum_avoid,
                        U, self.c, n, int(self.params.substeps), pos, quat, mu, record, err, forced_mu, forced_push)
+            done = (int(err[1]) + 1 if err[0] != 0 else k) * int(self.params.substeps)
+            if was_reset(self.data, t0, done, float(self.scene.model.opt.timestep)):
+                raise Diverged(describe(self.data, "the tank") + " " + self._unstable_cause(), self._k + k)
         if err[0] != 0:
             t = (self._k + err[1] + 1) * self.params.control_dt_s
             self._k += int(err[1]) + 1
             raise Diverged(self._runaway_message(int(err[0]), int(err[2]), err[3], t), self._k)
-        watch.check(self._k + k, self._unstable_cause(), where="the tank")
         self._k += k
         return pos, quat, mu
 

@@ -3,8 +3,10 @@
 When an acceleration, position or velocity becomes NaN, infinite or huge, ``mj_step`` prints a
 warning, writes ``MUJOCO_LOG.TXT`` into the working directory and *resets* the simulation to its
 initial state, so that a NaN check after the step sees nothing wrong. :func:`watching` catches those
-warnings instead (no print, no log file) and :class:`Watch` turns a new one into a
-:class:`~lifelike_mj.errors.Diverged` error whose message the caller completes with the likely cause.
+warnings instead (no print, no log file); :func:`was_reset` (the clock went back) or :class:`Watch`
+(MuJoCo's warning counters, for batches) finds a reset after each chunk, and :func:`describe` says
+what MuJoCo found, for a :class:`~lifelike_mj.errors.Diverged` error that the caller completes with
+the likely cause.
 """
 
 from __future__ import annotations
@@ -52,6 +54,13 @@ def watching() -> Iterator[list[str]]:
             _depth -= 1
             if _depth == 0:
                 mujoco.set_mju_user_warning(_saved)
+
+
+def was_reset(data: mujoco.MjData, time_before: float, n_steps: int, dt: float) -> bool:
+    """Whether MuJoCo reset ``data`` during the last ``n_steps`` steps of ``dt`` seconds begun at
+    ``time_before``: a reset sets the clock back to 0, so the clock then disagrees with the steps taken.
+    (Two float reads: cheap enough to run after every call, where :class:`Watch` costs tens of us.)"""
+    return abs(float(data.time) - (time_before + n_steps * dt)) > 0.5 * dt
 
 
 class Watch:

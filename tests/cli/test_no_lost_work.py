@@ -77,7 +77,9 @@ def test_two_concurrent_processes_one_wins(tmp_path):
     """Two real processes on one --out: the second stops with exit 2 while the first goes on to finish."""
     argv = [sys.executable, "-m", "lifelike_mj", "butterfly", "evolve", "--optimizer", "rcga", "--population", "6",
             "--generations", "1000000", "--executor", "serial", "--quiet", "--out", str(tmp_path / "c.json")]
-    first = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # runs until stopped
+    # runs until stopped; Ctrl-C's default restored (a shell's background job starts with SIGINT ignored)
+    first = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         deadline = time.time() + 180
         while not (tmp_path / "c.json.ckpt").exists() and time.time() < deadline:
