@@ -53,6 +53,21 @@ def _is_numba(fn: object) -> bool:
     return isinstance(fn, Dispatcher)
 
 
+_MUJOCO_PARTS: tuple = ()
+
+
+def _mujoco_parts() -> tuple:
+    """What a MuJoCo step needs, imported once (MuJoCo is loaded only when a MuJoCo flight runs)."""
+    global _MUJOCO_PARTS
+    if not _MUJOCO_PARTS:
+        from lifelike_mj.butterfly.backends.mj import COMPILED_PASSIVE
+        from lifelike_mj.physics.callbacks import passive_callback
+        from lifelike_mj.physics.stability import describe, reset_time, was_reset, watching
+
+        _MUJOCO_PARTS = (COMPILED_PASSIVE, passive_callback, describe, reset_time, was_reset, watching)
+    return _MUJOCO_PARTS
+
+
 #: The fewest time steps per wing beat a flight accepts (the paper's coarsest step, 1/120 s, gives 12).
 MIN_STEPS_PER_BEAT = 8
 
@@ -285,10 +300,7 @@ class Flight(StepCounter):
         if self.backend == "paper":
             self._steps(self._paper, n, every, out, r0)
             return
-        from lifelike_mj.butterfly.backends.mj import COMPILED_PASSIVE
-        from lifelike_mj.physics.callbacks import passive_callback
-        from lifelike_mj.physics.stability import describe, reset_time, was_reset, watching
-
+        COMPILED_PASSIVE, passive_callback, describe, reset_time, was_reset, watching = _mujoco_parts()
         k0, t0 = self._k, float(self._data.time)
         with passive_callback(COMPILED_PASSIVE), watching():
             self._steps(self._mujoco, n, every, out, r0)

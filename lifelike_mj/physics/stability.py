@@ -11,10 +11,9 @@ the likely cause.
 
 from __future__ import annotations
 
-import contextlib
 import math
 import threading
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 
 import mujoco
 
@@ -36,24 +35,37 @@ def bad_counts(data: mujoco.MjData) -> tuple[int, ...]:
     return tuple(int(data.warning[w].number) for w in _BAD)
 
 
-@contextlib.contextmanager
-def watching() -> Iterator[list[str]]:
-    """While active, MuJoCo's warnings are collected (the yielded list) instead of printed and logged to
-    ``MUJOCO_LOG.TXT``; the previous handler comes back at the end. Re-entrant."""
-    global _depth, _saved
-    with _lock:
-        if _depth == 0:
-            _saved = mujoco.get_mju_user_warning()
-            _messages.clear()
-            mujoco.set_mju_user_warning(_messages.append)
-        _depth += 1
-    try:
-        yield _messages
-    finally:
+class _Watching:
+    """The context manager of :func:`watching` (a class: it runs around every chunk of steps)."""
+
+    __slots__ = ()
+
+    def __enter__(self) -> list[str]:
+        global _depth, _saved
+        with _lock:
+            if _depth == 0:
+                _saved = mujoco.get_mju_user_warning()
+                _messages.clear()
+                mujoco.set_mju_user_warning(_messages.append)
+            _depth += 1
+        return _messages
+
+    def __exit__(self, *exc: object) -> None:
+        global _depth
         with _lock:
             _depth -= 1
             if _depth == 0:
                 mujoco.set_mju_user_warning(_saved)
+
+
+_WATCHING = _Watching()
+
+
+def watching() -> _Watching:
+    """While active (``with watching() as messages:``), MuJoCo's warnings are collected in ``messages``
+    instead of printed and logged to ``MUJOCO_LOG.TXT``; the previous handler comes back at the end.
+    Re-entrant."""
+    return _WATCHING
 
 
 def was_reset(data: mujoco.MjData, time_before: float, n_steps: int, dt: float) -> bool:
