@@ -27,7 +27,8 @@ What is here:
   :mod:`~lifelike_mj.butterfly.ann_experiments`), their figures (:mod:`~lifelike_mj.butterfly.figures`,
   :mod:`~lifelike_mj.butterfly.ann_figures`, each returning a matplotlib ``Figure``) and
   :func:`reproduce` (the whole report);
-* evolution of the network: :class:`PitchProblem`, :func:`make_problem`, :func:`evolve_controller`;
+* evolution of the network: :class:`PitchProblem`, :func:`make_problem`, :func:`evolve_controller`,
+  :data:`PAPER_FLAP` (the flap pattern of section 6);
 * on screen: :func:`render_butterfly`, :func:`film_flight`, :func:`playback` (a trajectory you have),
   :func:`render_frame`, :func:`view_butterfly`, :func:`snapshot_figure`.
 """
@@ -41,7 +42,7 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "ButterflyController": "controllers", "ann_controller": "controllers",
     "load_controller": "_api", "controller_names": "_api",
     "simulate": "backends", "fly": "experiments", "compare": "compare",
-    "PitchProblem": "evolution", "make_problem": "evolution", "evolve_controller": "evolution",
+    "PitchProblem": "evolution", "make_problem": "evolution", "evolve_controller": "evolution", "PAPER_FLAP": "evolution",
     "reproduce": "report",
     "render_butterfly": "render", "film_flight": "render", "playback": "render", "render_frame": "render",
     "view_butterfly": "render", "snapshot_figure": "render",

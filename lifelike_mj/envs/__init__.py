@@ -1,0 +1,45 @@
+"""Gymnasium environments over the creatures' steppers (``pip install "lifelike-mj[gym]"``).
+
+Importing this module registers them under the ``lifelike_mj`` namespace: ``import lifelike_mj.envs``
+then ``gymnasium.make("lifelike_mj/ButterflyPitch-v0")``, or in one go (Gymnasium imports the module
+named before the colon) ``gymnasium.make("lifelike_mj.envs:lifelike_mj/ButterflyPitch-v0")``:
+
+* ``lifelike_mj/ButterflyPitch-v0``: :class:`~lifelike_mj.envs.butterfly.ButterflyPitchEnv`, the
+  pitch task of Oe 2010 section 6.
+* ``lifelike_mj/ButterflyPitchWind-v0``: :class:`~lifelike_mj.envs.butterfly.ButterflyPitchWindEnv`,
+  the same with the start altitude and the wind drawn per episode (``butterfly evolve``'s
+  ``robust_map`` task).
+
+Each environment's docstring is its documentation page (spaces with names and units, reward,
+starting state, episode end, arguments, version history).
+"""
+
+from __future__ import annotations
+
+#: The registered ids and their entry points.
+ENVS = {
+    "lifelike_mj/ButterflyPitch-v0": "lifelike_mj.envs.butterfly:ButterflyPitchEnv",
+    "lifelike_mj/ButterflyPitchWind-v0": "lifelike_mj.envs.butterfly:ButterflyPitchWindEnv",
+}
+
+
+def register_envs() -> None:
+    """Register every environment with Gymnasium (idempotent; done on import of this module)."""
+    from gymnasium.envs.registration import register, registry
+
+    for env_id, entry_point in ENVS.items():
+        if env_id not in registry:
+            register(id=env_id, entry_point=entry_point, disable_env_checker=False)
+
+
+def __getattr__(name: str):
+    if name in ("ButterflyPitchEnv", "ButterflyPitchWindEnv"):
+        from lifelike_mj.envs import butterfly
+
+        return getattr(butterfly, name)
+    raise AttributeError(name)
+
+
+__all__ = ["ENVS", "ButterflyPitchEnv", "ButterflyPitchWindEnv", "register_envs"]
+
+register_envs()

@@ -1,0 +1,225 @@
+"""The butterfly's pitch task of Oe 2010 section 6 as a Gymnasium environment."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from lifelike_mj import checks
+from lifelike_mj.butterfly import PAPER_FLAP, ButterflyController, ButterflyParams, Condition, Flight
+from lifelike_mj.errors import Diverged, UserError
+
+#: Names and units of the observation's six entries (the network's inputs, Oe 2010 section 6.1).
+OBSERVATION_NAMES = ("phi_prev_rad", "omega_rad_s", "theta_rad", "v_y_m_s", "y_m", "v_z_m_s")
+ACTION_MODES = ("dphi", "phi")
+#: Speeds beyond this end the flight as a runaway (m/s); altitudes are bounded for the space's sake (m).
+RUNAWAY_M_S = 1.0e4
+MAX_ALTITUDE_M = 1.0e5
+
+
+class ButterflyPitchEnv(gym.Env):
+    """``lifelike_mj/ButterflyPitch-v0``: choose the butterfly's pitch once per step so that it flies
+    level and fast (Oe 2010 section 6).
+
+    The butterfly flaps its wings at 10 Hz over [-60, 75] deg (the paper's section 6 pattern) and
+    flies in a vertical plane (eq. 7-11). Each step the agent sets the body's pitch; the fitness of
+    eq. 13 rewards flying near the target altitude 0 m at a forward speed near 3 m/s.
+
+    ## Action space
+
+    ``action_mode="dphi"`` (default): ``Box(-max_dphi, max_dphi, (1,))``, the change of the pitch this
+    step in rad (the paper's network changes it by at most 3 deg per step). ``action_mode="phi"``:
+    ``Box(-phi_limit, phi_limit, (1,))``, the pitch itself in rad. The pitch is always clipped to
+    ``[-phi_limit, phi_limit]`` (30 deg).
+
+    ## Observation space
+
+    ``Box((6,))``, float64, SI units (the network's six inputs, section 6.1), bounded by the pitch limit,
+    the flap's range and peak rate, the runaway speed (10^4 m/s, where a flight diverges) and 10^5 m:
+
+    | index | name | unit | meaning |
+    |---|---|---|---|
+    | 0 | ``phi_prev_rad`` | rad | the pitch of the previous step |
+    | 1 | ``omega_rad_s`` | rad/s | flap rate (positive on the upstroke) |
+    | 2 | ``theta_rad`` | rad | flap angle |
+    | 3 | ``v_y_m_s`` | m/s | vertical velocity, relative to the air or the ground (``inputs``) |
+    | 4 | ``y_m`` | m | altitude above the target altitude 0 m |
+    | 5 | ``v_z_m_s`` | m/s | forward velocity, relative to the air or the ground (``inputs``) |
+
+    The names are also in ``info["observation_names"]`` at reset.
+
+    ## Reward
+
+    Each step's term of Oe 2010 eq. 13, ``(v_z / 3) 0.1 / (|y| + 0.1)`` (ground forward speed, m/s;
+    altitude, m), summed over the ``frame_skip`` simulation steps the action is held. Summed over an
+    episode it is the fitness ``H`` that ``lifelike-mj butterfly evolve`` maximises.
+
+    ## Starting state
+
+    At rest at ``y0_m`` (default 0 m), wings at the top of the stroke, pitch 0. Nothing is random: the
+    episode depends only on the actions (``reset(seed=...)`` is accepted for the common shape).
+
+    ## Episode end
+
+    Truncated after ``duration_s`` (20 s, the paper's flights). Terminated when the flight diverges
+    (a runaway speed, or MuJoCo finding its state unstable; ``info["diverged"]`` says why) or, if
+    ``ground_m`` is given, when the butterfly sinks below ``-ground_m``. The paper's flights have no
+    ground, so ``ground_m`` is ``None`` by default.
+
+    ## Arguments
+
+    ``backend`` (``"paper"``: eq. 7-11 with RK4, compiled; ``"mujoco"``), ``inputs`` (``"relative"``:
+    velocities relative to the air, the paper's section 6; ``"ground"``: section 7.2), ``action_mode``,
+    ``wind_m_s`` ``(a, b)`` (where the wind comes from: front, above; m/s), ``y0_m``, ``duration_s``,
+    ``dt_s`` (1/1200 s), ``frame_skip``, ``max_dphi_deg`` (3), ``phi_limit_deg`` (30), ``params`` (a
+    :class:`~lifelike_mj.butterfly.ButterflyParams`, or a dict of overrides in the command line's units
+    such as ``{"body_area_cm2": 1.53}``), ``config`` and ``force_mode`` (MuJoCo backend), ``ground_m``.
+
+    ## Version history
+
+    * v0: the first version (lifelike-mj 0.3).
+    """
+
+    metadata = {"render_modes": [], "render_fps": 30}
+
+    def __init__(self, backend: str = "paper", inputs: str = "relative", action_mode: str = "dphi",
+                 wind_m_s: tuple[float, float] = (0.0, 0.0), y0_m: float = 0.0, duration_s: float = 20.0,
+                 dt_s: float = 1.0 / 1200.0, frame_skip: int = 1, max_dphi_deg: float = 3.0,
+                 phi_limit_deg: float = 30.0, params: ButterflyParams | dict | None = None, config: str = "paper",
+                 force_mode: str | None = None, ground_m: float | None = None, render_mode: str | None = None) -> None:
+        if inputs not in ("relative", "ground"):
+            raise UserError(f"inputs must be relative or ground, got {inputs!r}.")
+        if action_mode not in ACTION_MODES:
+            raise UserError(f"action_mode must be dphi or phi, got {action_mode!r}.")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise UserError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}.")
+        if isinstance(params, dict):
+            params = ButterflyParams().with_overrides(**params)
+        self.params = params or ButterflyParams()
+        self.backend, self.inputs, self.action_mode = backend, inputs, action_mode
+        self.condition = Condition(float(y0_m), (float(wind_m_s[0]), float(wind_m_s[1])))
+        self.dt_s = checks.positive("dt_s", dt_s, "s")
+        self.frame_skip = checks.whole("frame_skip", frame_skip, 1, 10_000)
+        self.n_steps = int(round(checks.positive("duration_s", duration_s, "s") / self.dt_s))
+        self.max_dphi = math.radians(checks.number("max_dphi_deg", max_dphi_deg, 0.0, 90.0, lo_open=True, unit="deg"))
+        self.phi_limit = math.radians(checks.number("phi_limit_deg", phi_limit_deg, 0.0, 90.0, lo_open=True,
+                                                    unit="deg"))
+        self.ground_m = None if ground_m is None else checks.positive("ground_m", ground_m, "m")
+        self.render_mode = render_mode
+        self._controller = ButterflyController("constant", PAPER_FLAP, {"phi_deg": 0.0})
+        self._flight_options = {"backend": backend, "config": config, "force_mode": force_mode}
+        bound = self.max_dphi if action_mode == "dphi" else self.phi_limit
+        self.action_space = spaces.Box(-bound, bound, (1,), dtype=np.float64)
+        f = PAPER_FLAP
+        w = f.theta_a * 2.0 * math.pi * f.frequency_hz * (1.0 + 1e-9)
+        lo = np.array([-self.phi_limit, -w, f.theta_c - f.theta_a - 1e-9, -RUNAWAY_M_S, -MAX_ALTITUDE_M, -RUNAWAY_M_S])
+        self.observation_space = spaces.Box(lo, -lo + np.array([0, 0, 2 * f.theta_c, 0, 0, 0]), (6,), dtype=np.float64)
+        self._phi = 0.0
+        self.flight: Flight | None = None
+
+    # ---- the Gymnasium API ----------------------------------------------------------------------
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        super().reset(seed=seed)
+        self.flight = self._new_flight(self.condition)
+        self._phi = 0.0
+        return self._observation(), {"observation_names": OBSERVATION_NAMES}
+
+    def step(self, action):
+        if self.flight is None:
+            raise RuntimeError("call reset() before step()")
+        a = float(np.asarray(action, dtype=np.float64).reshape(-1)[0])
+        if not math.isfinite(a):
+            raise ValueError(f"the action must be a finite number, got {action!r}")
+        target = self._phi + float(np.clip(a, -self.max_dphi, self.max_dphi)) if self.action_mode == "dphi" else a
+        self._phi = min(self.phi_limit, max(-self.phi_limit, target))
+        before = self.flight.fitness
+        n = min(self.frame_skip, self.n_steps - self.flight.steps)
+        info: dict[str, Any] = {}
+        terminated = False
+        try:
+            self.flight.step(n)
+        except Diverged as exc:
+            terminated, info["diverged"] = True, str(exc)
+        reward = self.flight.fitness - before
+        obs = self._observation()
+        if self.ground_m is not None and obs[4] < -self.ground_m:
+            terminated, info["ground"] = True, True
+        truncated = not terminated and self.flight.steps >= self.n_steps
+        return obs, float(reward) if math.isfinite(reward) else 0.0, terminated, truncated, info
+
+    # ---- internals ------------------------------------------------------------------------------
+
+    def _new_flight(self, condition: Condition) -> Flight:
+        return Flight(self._controller, self.params, condition, dt_s=self.dt_s, pitch_law=self._law,
+                      **self._flight_options)
+
+    def _law(self, obs) -> float:
+        return self._phi
+
+    def _observation(self) -> np.ndarray:
+        o = self.flight.observation()
+        vy, vz = o.climb_m_s, o.forward_m_s
+        if self.inputs == "relative":
+            vy, vz = vy - o.air_up_m_s, vz - o.air_forward_m_s
+        out = np.array([o.phi_rad, o.omega_rad_s, o.theta_rad, vy, o.altitude_m, vz], dtype=np.float64)
+        return np.where(np.isfinite(out), out, 0.0)
+
+    # ---- pickling: the settings travel, the simulation is rebuilt by reset() ------------------------
+
+    def __getstate__(self) -> dict:
+        state = dict(self.__dict__)
+        state["flight"] = None
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+
+
+class ButterflyPitchWindEnv(ButterflyPitchEnv):
+    """``lifelike_mj/ButterflyPitchWind-v0``: :class:`ButterflyPitchEnv` with the start altitude and the
+    wind drawn per episode.
+
+    Each ``reset`` draws one flight condition uniformly, with the environment's ``np_random`` (seeded by
+    ``reset(seed=...)``), from the ``robust_map`` task of ``butterfly evolve``: starts at -10, -4, 0, +4,
+    +10 m in still air, and from 0 m twelve winds over the wind map (2 and 3 m/s from each side, 2 m/s
+    along both diagonals). ``conditions`` replaces that list: ``[(y0_m, (a, b)), ...]``.
+
+    Everything else (spaces, reward, episode end, arguments) is as in :class:`ButterflyPitchEnv`. The
+    reward is eq. 13's term, unweighted; ``info["flight_weight"]`` at reset is the weight the
+    ``robust_map`` task gives this flight (its head-wind share of eq. 13's speed term), so that a weighted
+    sum over episodes is that task's fitness.
+
+    ## Version history
+
+    * v0: the first version (lifelike-mj 0.3).
+    """
+
+    def __init__(self, conditions=None, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        from lifelike_mj.butterfly.evolution import robust_map_conditions
+
+        if conditions is None:
+            self.conditions = robust_map_conditions()
+        else:
+            try:
+                self.conditions = tuple(Condition(float(y0), (float(w[0]), float(w[1]))) for y0, w in conditions)
+            except (TypeError, ValueError, IndexError):
+                raise UserError("conditions must be a list of (y0_m, (a, b)) pairs in m and m/s.") from None
+            if not self.conditions:
+                raise UserError("conditions must hold at least one (y0_m, (a, b)) pair.")
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        gym.Env.reset(self, seed=seed)
+        from lifelike_mj.butterfly.evolution import flight_weight
+
+        self.condition = self.conditions[int(self.np_random.integers(len(self.conditions)))]
+        self.flight = self._new_flight(self.condition)
+        self._phi = 0.0
+        return self._observation(), {"observation_names": OBSERVATION_NAMES, "y0_m": self.condition.y0_m,
+                                     "wind_m_s": tuple(self.condition.wind_m_s),
+                                     "flight_weight": flight_weight(self.condition.wind_m_s[0])}

@@ -1,0 +1,100 @@
+"""ButterflyPitch-v0: Gymnasium's checker, determinism, pickling, and the reward against eq. 13."""
+
+import pickle
+
+import numpy as np
+import pytest
+
+gym = pytest.importorskip("gymnasium")
+
+import lifelike_mj.envs  # noqa: E402,F401  (registers the environments)
+from lifelike_mj.envs.butterfly import OBSERVATION_NAMES, ButterflyPitchEnv  # noqa: E402
+
+
+@pytest.mark.parametrize("backend", ["paper", "mujoco"])
+def test_gymnasiums_checker_passes(backend):
+    from gymnasium.utils.env_checker import check_env
+
+    env = gym.make("lifelike_mj/ButterflyPitch-v0", backend=backend, duration_s=0.5).unwrapped
+    check_env(env, skip_render_check=True)
+
+
+def test_make_with_the_module_prefix_and_spaces():
+    env = gym.make("lifelike_mj.envs:lifelike_mj/ButterflyPitch-v0")
+    obs, info = env.reset(seed=0)
+    assert obs.shape == (6,) and info["observation_names"] == OBSERVATION_NAMES
+    assert env.action_space.high[0] == pytest.approx(np.radians(3.0))
+
+
+def _rollout(env, actions):
+    env.reset(seed=1)
+    out = []
+    for a in actions:
+        obs, r, term, trunc, _ = env.step(np.array([a]))
+        out.append((obs.copy(), r, term, trunc))
+    return out
+
+
+def test_same_actions_same_episode_and_pickling():
+    rng = np.random.default_rng(0)
+    actions = rng.uniform(-0.05, 0.05, 300)
+    env = ButterflyPitchEnv(duration_s=0.25)
+    a = _rollout(env, actions)
+    b = _rollout(pickle.loads(pickle.dumps(env)), actions)
+    assert len(a) == len(b) == 300
+    for (oa, ra, ta, ua), (ob, rb, tb, ub) in zip(a, b):
+        np.testing.assert_array_equal(oa, ob)
+        assert (ra, ta, ua) == (rb, tb, ub)
+    assert a[-1][3] and not any(t[3] for t in a[:-1])  # truncated exactly at 0.25 s = 300 steps
+
+
+@pytest.mark.parametrize("backend", ["paper", "mujoco"])
+def test_episode_reward_is_the_evolution_fitness(backend):
+    """The shipped network flown through the env (action = its pitch): the summed reward equals the eq. 13
+    fitness H that `butterfly evolve` computes for the same weights (1e-9 relative)."""
+    from lifelike_mj.butterfly import ann, controllers
+    from lifelike_mj.butterfly.evolution import PitchProblem
+
+    ctrl = controllers.load("ann_paper")
+    weights = np.array(ctrl.parameters["weights"])
+    problem = PitchProblem(backend=backend, duration_s=4.0)
+    h = float(problem.evaluate(weights[None, :])[0])
+    _, cp = problem.controller(weights).compiled()
+    env = ButterflyPitchEnv(backend=backend, action_mode="phi", duration_s=4.0)
+    env.reset()
+    total, done = 0.0, False
+    while not done:
+        o = env.flight.observation()
+        phi = ann.ann_pitch(cp, o.theta_rad, o.omega_rad_s, o.altitude_m, o.climb_m_s, o.forward_m_s, o.air_up_m_s,
+                            o.air_forward_m_s, o.phi_rad)
+        _, r, term, trunc, _ = env.step(np.array([phi]))
+        total += r
+        done = term or trunc
+    assert total == pytest.approx(h, rel=1e-9)
+
+
+def test_bad_arguments_are_one_sentence():
+    from lifelike_mj.errors import UserError
+
+    for kw in ({"inputs": "air"}, {"action_mode": "angle"}, {"frame_skip": 0}, {"duration_s": -1},
+               {"wind_m_s": (100.0, 0.0)}, {"render_mode": "human"}):
+        with pytest.raises(UserError):
+            ButterflyPitchEnv(**kw)
+
+
+def test_the_wind_env_draws_its_condition_from_the_seed():
+    from gymnasium.utils.env_checker import check_env
+
+    from lifelike_mj.butterfly.evolution import robust_map_conditions
+
+    env = gym.make("lifelike_mj/ButterflyPitchWind-v0", duration_s=0.5).unwrapped
+    check_env(env, skip_render_check=True)
+    drawn = [env.reset(seed=s)[1] for s in range(40)]
+    conds = {(c.y0_m, tuple(c.wind_m_s)) for c in robust_map_conditions()}
+    got = {(d["y0_m"], d["wind_m_s"]) for d in drawn}
+    assert got <= conds and len(got) >= 10  # 40 draws over the 17 conditions
+    assert env.reset(seed=7)[1] == env.reset(seed=7)[1]
+    obs, info = env.reset(seed=3)
+    assert obs[4] == info["y0_m"] and info["flight_weight"] > 0
+    fixed = gym.make("lifelike_mj/ButterflyPitchWind-v0", conditions=[(5.0, (0.0, 1.0))]).unwrapped
+    assert fixed.reset(seed=0)[1]["wind_m_s"] == (0.0, 1.0)
