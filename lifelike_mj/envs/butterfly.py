@@ -77,20 +77,23 @@ class ButterflyPitchEnv(gym.Env):
     ``wind_m_s`` ``(a, b)`` (where the wind comes from: front, above; m/s), ``y0_m``, ``duration_s``,
     ``dt_s`` (1/1200 s), ``frame_skip``, ``max_dphi_deg`` (3), ``phi_limit_deg`` (30), ``params`` (a
     :class:`~lifelike_mj.butterfly.ButterflyParams`, or a dict of overrides in the command line's units
-    such as ``{"body_area_cm2": 1.53}``), ``config`` and ``force_mode`` (MuJoCo backend), ``ground_m``.
+    such as ``{"body_area_cm2": 1.53}``), ``config`` and ``force_mode`` (MuJoCo backend), ``ground_m``;
+    rendering: ``render_mode`` (``"rgb_array"``: offscreen frames of ``width`` x ``height`` pixels, EGL or
+    OSMesa, no display needed; ``"human"``: the MuJoCo viewer), ``camera`` (``follow``, ``side``, ``chase``).
 
     ## Version history
 
     * v0: the first version (lifelike-mj 0.3).
     """
 
-    metadata = {"render_modes": [], "render_fps": 30}
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 30}
 
     def __init__(self, backend: str = "paper", inputs: str = "relative", action_mode: str = "dphi",
                  wind_m_s: tuple[float, float] = (0.0, 0.0), y0_m: float = 0.0, duration_s: float = 20.0,
                  dt_s: float = 1.0 / 1200.0, frame_skip: int = 1, max_dphi_deg: float = 3.0,
                  phi_limit_deg: float = 30.0, params: ButterflyParams | dict | None = None, config: str = "paper",
-                 force_mode: str | None = None, ground_m: float | None = None, render_mode: str | None = None) -> None:
+                 force_mode: str | None = None, ground_m: float | None = None, render_mode: str | None = None,
+                 width: int = 640, height: int = 480, camera: str = "follow") -> None:
         if inputs not in ("relative", "ground"):
             raise UserError(f"inputs must be relative or ground, got {inputs!r}.")
         if action_mode not in ACTION_MODES:
@@ -110,6 +113,16 @@ class ButterflyPitchEnv(gym.Env):
                                                     unit="deg"))
         self.ground_m = None if ground_m is None else checks.positive("ground_m", ground_m, "m")
         self.render_mode = render_mode
+        from lifelike_mj.butterfly.render import CAMERAS
+        from lifelike_mj.render.video import check_size
+
+        check_size(width, height, "frame")
+        if camera not in CAMERAS:
+            raise UserError(f"camera must be one of {', '.join(CAMERAS)}, got {camera!r}.")
+        self.width, self.height, self.camera = int(width), int(height), camera
+        self._renderer = None
+        self._renderer_model = None
+        self._viewer = None
         self._controller = ButterflyController("constant", PAPER_FLAP, {"phi_deg": 0.0})
         self._flight_options = {"backend": backend, "config": config, "force_mode": force_mode}
         bound = self.max_dphi if action_mode == "dphi" else self.phi_limit
@@ -152,9 +165,46 @@ class ButterflyPitchEnv(gym.Env):
         truncated = not terminated and self.flight.steps >= self.n_steps
         return obs, float(reward) if math.isfinite(reward) else 0.0, terminated, truncated, info
 
+    def render(self):
+        """``rgb_array``: the current state drawn offscreen (EGL or OSMesa; no display needed), an
+        ``(height, width, 3)`` uint8 array, from ``camera`` (``follow``, ``side`` or ``chase``).
+        ``human``: the MuJoCo viewer (needs a display). On either backend the MuJoCo model is drawn."""
+        if self.render_mode is None or self.flight is None:
+            return None
+        self.flight.sync()
+        if self.render_mode == "human":
+            from lifelike_mj.render.viewer import launch_viewer, require_display
+
+            if self._viewer is None:
+                require_display("butterfly")
+                self._viewer = launch_viewer(self.flight.model, self.flight.data)
+            self._viewer.sync()
+            return None
+        from lifelike_mj.butterfly.render import dress, flight_camera
+        from lifelike_mj.render.offscreen import Offscreen
+
+        if self._renderer is None or self._renderer_model is not self.flight.model:
+            self.close()
+            self._renderer = Offscreen(dress(self.flight.model), self.width, self.height)
+            self._renderer_model = self.flight.model
+        self._renderer.update(self.flight.model, self.flight.data, flight_camera(self.flight, self.camera))
+        return self._renderer.draw()
+
+    def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+        if self._viewer is not None:
+            self._viewer.close()
+            self._viewer = None
+
     # ---- internals ------------------------------------------------------------------------------
 
     def _new_flight(self, condition: Condition) -> Flight:
+        """A flight from ``condition``: the current one started again when the condition is the same."""
+        if self.flight is not None and self.flight.condition == condition:
+            self.flight.reset()
+            return self.flight
         return Flight(self._controller, self.params, condition, dt_s=self.dt_s, pitch_law=self._law,
                       **self._flight_options)
 
@@ -173,7 +223,7 @@ class ButterflyPitchEnv(gym.Env):
 
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)
-        state["flight"] = None
+        state.update(flight=None, _renderer=None, _renderer_model=None, _viewer=None)
         return state
 
     def __setstate__(self, state: dict) -> None:

@@ -77,7 +77,7 @@ def test_bad_arguments_are_one_sentence():
     from lifelike_mj.errors import UserError
 
     for kw in ({"inputs": "air"}, {"action_mode": "angle"}, {"frame_skip": 0}, {"duration_s": -1},
-               {"wind_m_s": (100.0, 0.0)}, {"render_mode": "human"}):
+               {"wind_m_s": (100.0, 0.0)}, {"render_mode": "movie"}, {"camera": "top"}, {"width": 0}):
         with pytest.raises(UserError):
             ButterflyPitchEnv(**kw)
 
@@ -98,3 +98,25 @@ def test_the_wind_env_draws_its_condition_from_the_seed():
     assert obs[4] == info["y0_m"] and info["flight_weight"] > 0
     fixed = gym.make("lifelike_mj/ButterflyPitchWind-v0", conditions=[(5.0, (0.0, 1.0))]).unwrapped
     assert fixed.reset(seed=0)[1]["wind_m_s"] == (0.0, 1.0)
+
+
+@pytest.mark.parametrize("backend", ["paper", "mujoco"])
+def test_rgb_array_frames_headless(backend, gl_backend):
+    env = gym.make("lifelike_mj/ButterflyPitch-v0", backend=backend, render_mode="rgb_array", width=160, height=120)
+    env.reset(seed=0)
+    first = env.render()
+    assert first.shape == (120, 160, 3) and first.dtype == np.uint8
+    for _ in range(30):
+        env.step(np.array([0.01]))
+    later = env.render()
+    assert np.abs(later.astype(int) - first.astype(int)).sum() > 0  # the wings moved
+    env.close()
+
+
+def test_reset_starts_the_same_flight_again():
+    env = ButterflyPitchEnv(duration_s=0.1)
+    a = _rollout(env, [0.02] * 120)
+    b = _rollout(env, [0.02] * 120)
+    for (oa, ra, *_), (ob, rb, *_) in zip(a, b):
+        np.testing.assert_array_equal(oa, ob)
+        assert ra == rb
