@@ -9,6 +9,8 @@ named before the colon) ``gymnasium.make("lifelike_mj.envs:lifelike_mj/Butterfly
 * ``lifelike_mj/ButterflyPitchWind-v0``: :class:`~lifelike_mj.envs.butterfly.ButterflyPitchWindEnv`,
   the same with the start altitude and the wind drawn per episode (``butterfly evolve``'s
   ``robust_map`` task).
+* :class:`~lifelike_mj.envs.vector.ButterflyPitchVectorEnv`: N of either, stepped in one native call
+  (``gymnasium.make_vec("lifelike_mj/ButterflyPitch-v0", num_envs=N, vectorization_mode="vector_entry_point")``).
 
 Each environment's docstring is its documentation page (spaces with names and units, reward,
 starting state, episode end, arguments, version history).
@@ -23,13 +25,20 @@ ENVS = {
 }
 
 
+_VECTOR = {
+    "lifelike_mj/ButterflyPitch-v0": "lifelike_mj.envs.vector:ButterflyPitchVectorEnv",
+    "lifelike_mj/ButterflyPitchWind-v0": "lifelike_mj.envs.vector:ButterflyPitchWindVectorEnv",
+}
+
+
 def register_envs() -> None:
     """Register every environment with Gymnasium (idempotent; done on import of this module)."""
     from gymnasium.envs.registration import register, registry
 
     for env_id, entry_point in ENVS.items():
         if env_id not in registry:
-            register(id=env_id, entry_point=entry_point, disable_env_checker=False)
+            register(id=env_id, entry_point=entry_point, disable_env_checker=False,
+                     vector_entry_point=_VECTOR.get(env_id))
 
 
 def __getattr__(name: str):
@@ -37,9 +46,13 @@ def __getattr__(name: str):
         from lifelike_mj.envs import butterfly
 
         return getattr(butterfly, name)
+    if name == "ButterflyPitchVectorEnv":
+        from lifelike_mj.envs.vector import ButterflyPitchVectorEnv
+
+        return ButterflyPitchVectorEnv
     raise AttributeError(name)
 
 
-__all__ = ["ENVS", "ButterflyPitchEnv", "ButterflyPitchWindEnv", "register_envs"]
+__all__ = ["ENVS", "ButterflyPitchEnv", "ButterflyPitchVectorEnv", "ButterflyPitchWindEnv", "register_envs"]
 
 register_envs()

@@ -189,6 +189,28 @@ _law = builtin_law
 fly_steps = njit(cache=True, error_model="numpy")(_fly_loop)
 
 
+@njit(cache=True, parallel=True, error_model="numpy")
+def step_batch(phis, flaps, airs, consts, states, ks, n_steps, dt, diverged):
+    """Advance ``len(phis)`` butterflies ``n_steps`` steps each at the pitch ``phis[b]`` (rad), in one
+    native call on parallel threads (Oe 2010 eq. 7-11, RK4, as :func:`fly_steps`): rows of ``flaps``
+    (the flap pattern), ``airs`` (air velocity forward, up; m/s), ``consts`` (:func:`constants_row`)
+    and ``states`` (the state arrays, :data:`S_Y` ...) per butterfly; ``ks`` the step counts, advanced;
+    ``diverged[b]`` set to the step of a runaway (such a butterfly is not stepped again)."""
+    no_rows = np.empty((0, 5))
+    for b in prange(len(phis)):
+        if diverged[b] >= 0:
+            continue
+        cp = np.empty(1)
+        cp[0] = phis[b]
+        dv, _ = fly_steps(KIND_CONSTANT, cp, flaps[b], airs[b, 0], airs[b, 1], consts[b], states[b], ks[b], n_steps,
+                          dt, n_steps + 1, no_rows, 0)
+        if dv >= 0:
+            diverged[b] = dv
+            ks[b] = dv
+        else:
+            ks[b] += n_steps
+
+
 @functools.lru_cache(maxsize=64)
 def fly_steps_with(law) -> Callable:
     """:func:`_fly_loop` compiled with the pitch law ``law(kind, cp, obs)`` (see
