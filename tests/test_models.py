@@ -126,3 +126,17 @@ def test_build_model_applies_mass_and_span():
             cp = m.site_pos[m.site(f"wing_{side}_cp").id]
             np.testing.assert_allclose(cp, [0.0, sign * 0.8 * 0.06, 0.0], atol=1e-12)
             assert _area(_wing_triangle(m, side)) == pytest.approx(0.06 * p.width_m / 2.0, rel=1e-5)
+
+
+def test_every_subpackage_is_installed():
+    """A non-editable install (CI's) carries every package folder: pyproject lists them all."""
+    from pathlib import Path
+
+    import pytest
+
+    tomllib = pytest.importorskip("tomllib")  # Python 3.11+
+
+    root = Path(__file__).resolve().parent.parent
+    listed = set(tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+    found = {".".join(p.parent.relative_to(root).parts) for p in (root / "lifelike_mj").rglob("__init__.py")}
+    assert found <= listed, sorted(found - listed)

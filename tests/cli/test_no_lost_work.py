@@ -88,7 +88,8 @@ def test_two_concurrent_processes_one_wins(tmp_path):
         assert second.returncode == 2 and "another run is writing" in second.stderr, second.stderr
         first.send_signal(signal.SIGINT)
         out, err = first.communicate(timeout=60)
-        assert first.returncode == 130 and json.loads((tmp_path / "c.json").read_text())["provenance"]["interrupted"]
+        assert first.returncode == 130, err[-3000:]
+        assert json.loads((tmp_path / "c.json").read_text())["provenance"]["interrupted"]
     finally:
         if first.poll() is None:
             first.kill()
