@@ -24,10 +24,6 @@ def _preset(args):
     return load_preset(args.preset)
 
 
-def _count(n) -> int:
-    return int(n)
-
-
 def _tank(args):
     from lifelike_mj.fish.scene import tank_size
 
@@ -45,13 +41,6 @@ def _add_fish(p) -> None:
                         "(every side at least 2.5 body lengths)")
 
 
-def _check_camera(camera: str) -> None:
-    from lifelike_mj.fish.render import CAMERAS
-
-    if camera not in CAMERAS:
-        raise UserError(f"unknown camera {camera!r}; choose one of {', '.join(CAMERAS)}.")
-
-
 def cmd_swim(args) -> None:
     from lifelike_mj.fish.experiments import swim_summary, write_swim
     from lifelike_mj.fish.sim import swim
@@ -60,7 +49,7 @@ def cmd_swim(args) -> None:
     if args.video_duration != 10.0 and not args.video:
         raise UserError("--video-duration only applies with --video.")
     params = _preset(args)
-    n = _count(args.fish)
+    n = args.fish
     r = swim(params, n, positive("--duration", args.duration), args.seed, _tank(args), progress=True)
     summary = swim_summary(r)
     if args.out:
@@ -117,7 +106,7 @@ def add_view_args(p: argparse.ArgumentParser) -> None:
 def view(args) -> None:
     from lifelike_mj.fish.render import view_fish
 
-    view_fish(_preset(args), _count(args.fish), args.seed, _tank(args), duration_s=args.duration, camera=args.camera)
+    view_fish(_preset(args), args.fish, args.seed, _tank(args), duration_s=args.duration, camera=args.camera)
 
 
 def add_render_args(p: argparse.ArgumentParser) -> None:
@@ -129,7 +118,7 @@ def add_render_args(p: argparse.ArgumentParser) -> None:
 def render(args) -> dict:
     from lifelike_mj.fish.render import render_fish
 
-    return render_fish(args.out, _preset(args), _count(args.fish), positive("--duration", args.duration), args.seed,
+    return render_fish(args.out, _preset(args), args.fish, positive("--duration", args.duration), args.seed,
                        _tank(args), fps=args.fps, width=args.width, height=args.height, camera=args.camera,
                        progress=True)
 

@@ -17,8 +17,6 @@ from collections.abc import Sequence
 
 import mujoco
 
-from lifelike_mj.errors import Diverged
-
 _BAD = {
     int(mujoco.mjtWarning.mjWARN_BADQACC): "accelerations",
     int(mujoco.mjtWarning.mjWARN_BADQPOS): "positions",
@@ -91,13 +89,6 @@ class Watch:
                 hit.append(i)
             self.before[i] = now
         return hit
-
-    def check(self, step: int, cause: str, where: str = "the simulation") -> None:
-        """Raise :class:`Diverged` (at ``step``) if a new warning came: the sentence says what MuJoCo found,
-        when, and ``cause`` (the likely cause, in the caller's words)."""
-        hit = self.new()
-        if hit:
-            raise Diverged(describe(self.datas[hit[0]], where) + " " + cause, step)
 
 
 def describe(data: mujoco.MjData, where: str = "the simulation") -> str:
