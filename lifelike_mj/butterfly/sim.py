@@ -75,12 +75,9 @@ MIN_STEPS_PER_BEAT = 8
 def likely_cause_sentence(params: ButterflyParams, dt_s: float) -> str:
     """The likely cause of a diverging flight: the physical constants furthest from the paper's
     (Oe 2010 Table 1) and the time step, as one clause."""
-    from dataclasses import fields
-
     from lifelike_mj.physics.stability import likely_cause
 
-    names = [f.name for f in fields(ButterflyParams)]
-    raised = likely_cause(params, ButterflyParams(), names)
+    raised = likely_cause(params, ButterflyParams())
     text = f"{raised}, " if raised else ""
     return (f"the likely cause is {text}the time step ({dt_s:.3g} s) or the controller: try a smaller --dt or the "
             "paper's constants.")

@@ -36,7 +36,7 @@ seed gives the same tracks in any chunking.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
@@ -49,7 +49,7 @@ from lifelike_mj.fish.scene import BODY_LENGTH_M, FishScene, box_areas, build_sc
 from lifelike_mj.physics import mjabi
 from lifelike_mj.physics.callbacks import passive_callback
 from lifelike_mj.physics.fluid import normal_drag_scalar
-from lifelike_mj.physics.stability import describe, was_reset, watching
+from lifelike_mj.physics.stability import describe, likely_cause, was_reset, watching
 from lifelike_mj.stepper import StepCounter
 
 # ---- userdata layout (per model; the callback is process-global) ----------------------------------
@@ -640,10 +640,7 @@ class Tank(StepCounter):
 
     def _unstable_cause(self) -> str:
         """The likely cause of a MuJoCo instability: the parameters raised most above the default preset."""
-        from lifelike_mj.physics.stability import likely_cause
-
-        names = [f.name for f in fields(FishParams) if f.name not in ("name", "description", "transition")]
-        raised = likely_cause(self.params, FishParams(), names)
+        raised = likely_cause(self.params, FishParams())
         dt_ms = 1000 * self.params.timestep_s
         if raised:
             return (f"the likely cause is the parameters furthest from the calibrated default: {raised}; bring them "
@@ -659,13 +656,10 @@ class Tank(StepCounter):
                     f"accelerate are too high (from accelerate: {T[0, 0]:.2f}, from coast: {T[1, 0]:.2f} per step).")
         what = "became NaN" if kind == 2 else (f"kept up {speed:.2f} m/s ({speed / BODY_LENGTH_M:.1f} body lengths/s over "
                                                 f"{RUNAWAY_TAU_S:g} s, above runaway_speed_bl_s = {p.runaway_speed_bl_s:g})")
-        from lifelike_mj.physics.stability import likely_cause
-
-        names = [f.name for f in fields(FishParams) if f.name not in ("name", "description", "transition")]
-        top = likely_cause(p, FishParams(), names, top=1)
+        top = likely_cause(p, FishParams(), top=1)
         if top and not top.startswith(("P_a ", "P_b ")):
             return (f"the speed ran away: fish {fish} {what} at t = {t:.2f} s; the likely cause is the parameters "
-                    f"furthest from the calibrated default: {likely_cause(p, FishParams(), names)}: bring them back.")
+                    f"furthest from the calibrated default: {likely_cause(p, FishParams())}: bring them back.")
         return (f"the speed ran away: fish {fish} {what} at t = {t:.2f} s; {name} = {val:g} is too high "
                 f"(the chance to accelerate again is {prob:.2f} per step): lower {name}.")
 

@@ -114,9 +114,15 @@ def reset_time() -> float | None:
     return None
 
 
-def likely_cause(current: object, default: object, names: Sequence[str], top: int = 2) -> str:
+def likely_cause(current: object, default: object, names: Sequence[str] | None = None, top: int = 2) -> str:
     """The parameters of ``current`` that differ most from ``default`` (by ratio), as
-    ``"r_max_N = 20 (default 0.03)"`` phrases, for the "likely cause" part of a divergence message."""
+    ``"r_max_N = 20 (default 0.03)"`` phrases, for the "likely cause" part of a divergence message.
+    ``names``: the parameters to compare (default: every field of the dataclass ``current``; fields that
+    are not numbers are skipped)."""
+    if names is None:
+        from dataclasses import fields
+
+        names = [f.name for f in fields(current)]
     scored = []
     for n in names:
         a, b = getattr(current, n), getattr(default, n)
