@@ -138,9 +138,10 @@ class ButterflyPitchEnv(gym.Env):
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
+        self.condition = self._episode_condition()
         self.flight = self._new_flight(self.condition)
         self._phi = 0.0
-        return self._observation(), {"observation_names": OBSERVATION_NAMES}
+        return self._observation(), self._reset_info()
 
     def step(self, action):
         if self.flight is None:
@@ -199,6 +200,13 @@ class ButterflyPitchEnv(gym.Env):
             self._viewer = None
 
     # ---- internals ------------------------------------------------------------------------------
+
+    def _episode_condition(self) -> Condition:
+        """The start altitude and wind of the next episode (fixed here; drawn in the wind variant)."""
+        return self.condition
+
+    def _reset_info(self) -> dict[str, Any]:
+        return {"observation_names": OBSERVATION_NAMES}
 
     def _new_flight(self, condition: Condition) -> Flight:
         """A flight from ``condition``: the current one started again when the condition is the same."""
@@ -263,13 +271,11 @@ class ButterflyPitchWindEnv(ButterflyPitchEnv):
             if not self.conditions:
                 raise UserError("conditions must hold at least one (y0_m, (a, b)) pair.")
 
-    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
-        gym.Env.reset(self, seed=seed)
+    def _episode_condition(self) -> Condition:
+        return self.conditions[int(self.np_random.integers(len(self.conditions)))]
+
+    def _reset_info(self) -> dict[str, Any]:
         from lifelike_mj.butterfly.evolution import flight_weight
 
-        self.condition = self.conditions[int(self.np_random.integers(len(self.conditions)))]
-        self.flight = self._new_flight(self.condition)
-        self._phi = 0.0
-        return self._observation(), {"observation_names": OBSERVATION_NAMES, "y0_m": self.condition.y0_m,
-                                     "wind_m_s": tuple(self.condition.wind_m_s),
-                                     "flight_weight": flight_weight(self.condition.wind_m_s[0])}
+        return {**super()._reset_info(), "y0_m": self.condition.y0_m, "wind_m_s": tuple(self.condition.wind_m_s),
+                "flight_weight": flight_weight(self.condition.wind_m_s[0])}
