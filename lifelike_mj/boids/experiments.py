@@ -208,12 +208,10 @@ def write_sweep(result: dict, sweep: Sweep, values: list[list[float]], out_dir: 
     from lifelike_mj.io import write_json
 
     out = Path(out_dir)
-    from dataclasses import asdict
 
     from lifelike_mj.provenance import provenance
 
-    base = {("W_a" if k == "wa" else "W_c" if k == "wc" else k): v for k, v in asdict(sweep.base).items()}
-    prov = provenance(base=base, axes=list(sweep.axes), values=[list(map(float, v)) for v in values], n=sweep.n,
+    prov = provenance(base=_settings(sweep.base), axes=list(sweep.axes), values=[list(map(float, v)) for v in values], n=sweep.n,
                       steps=sweep.n_steps)
     files = [write_json(out / "sweep.json", {**result, "provenance": prov})]
     if len(values) == 2:
@@ -240,15 +238,20 @@ def measured_run(params: BoidParams, n: int = N_AGENTS, seed: int = 0, n_steps: 
     return run, result
 
 
+def _settings(params: BoidParams) -> dict:
+    """Every setting of ``params``, the matrices under the paper's names W_a and W_c."""
+    from dataclasses import asdict
+
+    return {{"wa": "W_a", "wc": "W_c"}.get(k, k): v for k, v in asdict(params).items()}
+
+
 def run_provenance(run: BoidRun) -> dict:
     """Everything that made ``run``: the matrices (Nakamura 2013 eq. 1-3), zones, weights, box, agents,
     seed and steps recorded, with the package version and the command."""
-    from dataclasses import asdict
 
     from lifelike_mj.provenance import provenance
 
-    p = asdict(run.params)
-    return provenance(**{("W_a" if k == "wa" else "W_c" if k == "wc" else k): v for k, v in p.items()},
+    return provenance(**_settings(run.params),
                       n=int(run.positions.shape[1]), seed=int(run.seed), steps=int(run.steps[-1]),
                       recorded_steps=int(len(run.steps)))
 
