@@ -148,6 +148,14 @@ class Sweep:
         text = json.dumps({"base": repr(self.base), "axes": self.axes, "n": self.n, "steps": self.n_steps})
         return "boids-sweep:" + hashlib.sha256(text.encode()).hexdigest()[:16]
 
+    def check_cells(self, values: list[list[float]]) -> None:
+        """Build every cell's parameters once, so that a bad axis or weight is a :class:`UserError` before
+        any run starts."""
+        import itertools
+
+        for cell in itertools.product(*values):
+            self.params_of([*cell, 0])
+
     def params_of(self, row) -> BoidParams:
         p = self.base
         for axis, value in zip(self.axes, row[:-1]):
@@ -182,8 +190,7 @@ def run_sweep(sweep: Sweep, values: list[list[float]], seeds, executor: str = "p
 
     grid = list(itertools.product(*values))
     rows = np.array([[*g, s] for g in grid for s in seeds], dtype=float)
-    for g in grid:  # every cell's parameters are checked before any run starts
-        sweep.params_of([*g, 0])
+    sweep.check_cells(values)
     with make_evaluator(sweep, executor=executor, workers=workers, ray_address=ray_address) as ev:
         res = ev(rows)
     table = []
