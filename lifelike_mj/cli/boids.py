@@ -119,12 +119,9 @@ def cmd_sweep(args) -> None:
             axes.append(name)
             values.append(rng)
         sweep = Sweep(_params(args), tuple(axes), args.n, args.steps)
-    import itertools
-
     from lifelike_mj.progress import stage
 
-    for cell in itertools.product(*values):  # bad axes or weights: one sentence before any run
-        sweep.params_of([*cell, 0])
+    sweep.check_cells(values)  # bad axes or weights: one sentence before the progress bar starts
     n_runs = len(seed_list) * int(np.prod([len(v) for v in values]))
     with stage(f"sweep: {n_runs} runs on {args.executor}"):
         res = run_sweep(sweep, values, seed_list, executor=args.executor, workers=args.workers,
