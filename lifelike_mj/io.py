@@ -82,31 +82,35 @@ def write_text(path: str | Path, text: str) -> Path:
 
 def strict(data: object) -> object:
     """``data`` made fit for strict JSON: every NaN or infinite float becomes ``null``, and a dict that
-    held one gains ``"undefined": {key: reason}`` naming it (NaN: not defined for this run; +-inf: unbounded)."""
+    held one as a value gains ``"undefined": {key: reason}`` naming it (NaN: not defined for this run;
+    +-inf: unbounded)."""
     import math
 
-    def walk(v: object, notes: dict | None) -> object:
-        if isinstance(v, dict):
-            mine: dict = {}
-            out = {k: walk(x, mine) if not isinstance(x, float) else _num(k, x, mine) for k, x in v.items()}
-            if mine:
-                out["undefined"] = {**out.get("undefined", {}), **mine} if isinstance(out.get("undefined"), dict) else mine
-            return out
-        if isinstance(v, (list, tuple)):
-            return [walk(x, notes) for x in v]
-        if isinstance(v, float) and not math.isfinite(v):
-            return None
+    def plain(v: object) -> object:
         if hasattr(v, "item") and hasattr(v, "dtype") and getattr(v, "shape", None) == ():  # a NumPy scalar
-            return walk(v.item(), notes)
+            return v.item()
         return v
 
-    def _num(key: str, x: float, notes: dict) -> float | None:
-        if math.isfinite(x):
-            return x
-        notes[str(key)] = "not defined for this run (NaN)" if math.isnan(x) else f"unbounded ({x})"
-        return None
+    def walk(v: object) -> object:
+        v = plain(v)
+        if isinstance(v, dict):
+            out, why = {}, {}
+            for k, x in v.items():
+                x = plain(x)
+                if isinstance(x, float) and not math.isfinite(x):
+                    why[str(k)] = "not defined for this run (NaN)" if math.isnan(x) else f"unbounded ({x})"
+                out[k] = walk(x)
+            if why:
+                old = out.get("undefined")
+                out["undefined"] = {**old, **why} if isinstance(old, dict) else why
+            return out
+        if isinstance(v, (list, tuple)):
+            return [walk(x) for x in v]
+        if isinstance(v, float) and not math.isfinite(v):
+            return None
+        return v
 
-    return walk(data, None)
+    return walk(data)
 
 
 def dumps(data: object, indent: int | None = 2) -> str:
