@@ -89,18 +89,18 @@ def check_writable(path: str | Path, what: str = "output") -> Path:
         raise UserError(f"{what} {p} is a folder; give a file name.")
     if p.exists() and not p.is_file():
         raise UserError(f"{what} {p} exists and is not a regular file.")
-    parent = _existing_parent(p)
-    if not parent.is_dir():
-        raise UserError(f"{what} {p} cannot be written: {parent} is a file, not a folder.")
-    _probe(parent, p, what)
+    _probe(_existing_parent(p), p, what, "written")
     return p
 
 
-def _probe(folder: Path, target: Path, what: str) -> None:
-    """Whether a file can be made in ``folder`` (an anonymous temporary file, gone at once: ``os.access``
-    says yes to root everywhere, even in /proc)."""
+def _probe(folder: Path, target: Path, what: str, verb: str) -> None:
+    """:class:`UserError` unless ``folder`` is a folder in which a file can be made (tried with an
+    anonymous temporary file, gone at once: ``os.access`` says yes to root everywhere, even in /proc);
+    ``verb`` ("written", "made") phrases the sentence about ``target``."""
     import tempfile
 
+    if not folder.is_dir():
+        raise UserError(f"{what} {target} cannot be {verb}: {folder} is a file, not a folder.")
     try:
         with tempfile.TemporaryFile(dir=folder):
             pass
@@ -127,10 +127,7 @@ def check_output_dir(path: str | Path, what: str, names: Iterable[str] = (), *, 
     p = Path(path)
     if p.exists() and not p.is_dir():
         raise UserError(f"{what} {p} is a file; give a folder.")
-    parent = p if p.exists() else _existing_parent(p)
-    if not parent.is_dir():
-        raise UserError(f"{what} {p} cannot be made: {parent} is a file, not a folder.")
-    _probe(parent, p, what)
+    _probe(p if p.exists() else _existing_parent(p), p, what, "made")
     if not overwrite:
         there = [n for n in names if (p / n).exists()]
         if there:
