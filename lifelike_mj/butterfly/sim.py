@@ -182,6 +182,12 @@ class Flight(StepCounter):
             return float(self._s[S_FIT])
         return float(self._fit[0])
 
+    @property
+    def was_reset(self) -> bool:
+        """Whether MuJoCo found this flight unstable and reset its simulation: then nothing after the
+        last good step is valid (the fitness included) and the flight stays diverged until ``reset()``."""
+        return bool(self._cause)
+
     def step(self, n: int = 1) -> None:
         """Advance ``n`` time steps. A runaway speed raises :class:`~lifelike_mj.errors.Diverged`
         naming the step; the flight then stays diverged (``reset()`` starts it again)."""

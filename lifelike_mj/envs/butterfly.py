@@ -21,6 +21,19 @@ RUNAWAY_M_S = 1.0e4
 MAX_ALTITUDE_M = 1.0e5
 
 
+def as_condition(value: Any) -> Condition:
+    """A flight condition from ``(y0_m, (a, b))`` (start altitude, m; where the wind comes from: front,
+    above; m/s) or a :class:`~lifelike_mj.butterfly.Condition`; :class:`UserError` otherwise."""
+    if isinstance(value, Condition):
+        return value
+    try:
+        y0, w = value
+        y0, a, b = float(y0), float(w[0]), float(w[1])
+    except (TypeError, ValueError, IndexError):
+        raise UserError(f"a flight condition is a (y0_m, (a, b)) pair in m and m/s, got {value!r}.") from None
+    return Condition(y0, (a, b))  # which says what is out of range
+
+
 class ButterflyPitchEnv(gym.Env):
     """``lifelike_mj/ButterflyPitch-v0``: choose the butterfly's pitch once per step so that it flies
     level and fast (Oe 2010 section 6).
@@ -62,11 +75,14 @@ class ButterflyPitchEnv(gym.Env):
 
     At rest at ``y0_m`` (default 0 m), wings at the top of the stroke, pitch 0. Nothing is random: the
     episode depends only on the actions (``reset(seed=...)`` is accepted for the common shape).
+    ``reset(options={"condition": (y0_m, (a, b))})`` flies one episode from another start altitude and
+    wind (the next plain ``reset()`` goes back to the environment's own).
 
     ## Episode end
 
     Truncated after ``duration_s`` (20 s, the paper's flights). Terminated when the flight diverges
-    (a runaway speed, or MuJoCo finding its state unstable; ``info["diverged"]`` says why) or, if
+    (a runaway speed, or MuJoCo finding its state unstable; ``info["diverged"]`` says why; the reward
+    of a step in which MuJoCo reset the simulation is 0, since nothing after the reset is valid) or, if
     ``ground_m`` is given, when the butterfly sinks below ``-ground_m``. The paper's flights have no
     ground, so ``ground_m`` is ``None`` by default.
 
@@ -104,7 +120,7 @@ class ButterflyPitchEnv(gym.Env):
             params = ButterflyParams().with_overrides(**params)
         self.params = params or ButterflyParams()
         self.backend, self.inputs, self.action_mode = backend, inputs, action_mode
-        self.condition = Condition(float(y0_m), (float(wind_m_s[0]), float(wind_m_s[1])))
+        self.condition = self._own_condition = as_condition((y0_m, wind_m_s))
         self.dt_s = checks.positive("dt_s", dt_s, "s")
         self.frame_skip = checks.whole("frame_skip", frame_skip, 1, 10_000)
         self.n_steps = int(round(checks.positive("duration_s", duration_s, "s") / self.dt_s))
@@ -138,7 +154,8 @@ class ButterflyPitchEnv(gym.Env):
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
-        self.condition = self._episode_condition()
+        chosen = (options or {}).get("condition")
+        self.condition = self._episode_condition() if chosen is None else as_condition(chosen)
         self.flight = self._new_flight(self.condition)
         self._phi = 0.0
         return self._observation(), self._reset_info()
@@ -159,7 +176,7 @@ class ButterflyPitchEnv(gym.Env):
             self.flight.step(n)
         except Diverged as exc:
             terminated, info["diverged"] = True, str(exc)
-        reward = self.flight.fitness - before
+        reward = 0.0 if self.flight.was_reset else self.flight.fitness - before  # nothing after a MuJoCo reset counts
         obs = self._observation()
         if self.ground_m is not None and obs[4] < -self.ground_m:
             terminated, info["ground"] = True, True
@@ -203,7 +220,7 @@ class ButterflyPitchEnv(gym.Env):
 
     def _episode_condition(self) -> Condition:
         """The start altitude and wind of the next episode (fixed here; drawn in the wind variant)."""
-        return self.condition
+        return self._own_condition
 
     def _reset_info(self) -> dict[str, Any]:
         return {"observation_names": OBSERVATION_NAMES}
@@ -264,10 +281,7 @@ class ButterflyPitchWindEnv(ButterflyPitchEnv):
         if conditions is None:
             self.conditions = robust_map_conditions()
         else:
-            try:
-                self.conditions = tuple(Condition(float(y0), (float(w[0]), float(w[1]))) for y0, w in conditions)
-            except (TypeError, ValueError, IndexError):
-                raise UserError("conditions must be a list of (y0_m, (a, b)) pairs in m and m/s.") from None
+            self.conditions = tuple(as_condition(c) for c in conditions)
             if not self.conditions:
                 raise UserError("conditions must hold at least one (y0_m, (a, b)) pair.")
 

@@ -1,8 +1,9 @@
 """N butterflies stepped in one native call: the vector form of ``ButterflyPitch-v0`` and
-``ButterflyPitchWind-v0`` on the paper backend."""
+``ButterflyPitchWind-v0`` on the paper and MuJoCo backends."""
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import gymnasium as gym
@@ -10,34 +11,128 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from lifelike_mj.butterfly import PAPER_FLAP, Condition
+from lifelike_mj.butterfly import PAPER_FLAP, ButterflyParams, Condition
 from lifelike_mj.butterfly.backends import paper
-from lifelike_mj.envs.butterfly import OBSERVATION_NAMES, ButterflyPitchEnv, ButterflyPitchWindEnv
+from lifelike_mj.envs.butterfly import OBSERVATION_NAMES, ButterflyPitchEnv, ButterflyPitchWindEnv, as_condition
 from lifelike_mj.errors import UserError
+
+
+class _PaperBatch:
+    """The paper backend's butterflies (eq. 7-11, RK4) as rows of arrays: :func:`paper.step_batch`."""
+
+    def __init__(self, n: int, params: ButterflyParams, dt_s: float) -> None:
+        self.dt = dt_s
+        self.consts = np.tile(paper.constants_row(params), (n, 1))
+        self.flaps = np.tile(PAPER_FLAP.as_array(), (n, 1))
+        self.states = np.zeros((n, paper.N_STATE))
+        self.airs = np.zeros((n, 2))
+        self.ks = np.zeros(n, dtype=np.int64)
+        self.diverged = np.full(n, -1, dtype=np.int64)
+        self.reset = np.zeros(n, dtype=np.int64)  # never set: the paper backend has no solver to reset
+
+    def reset_row(self, i: int, cond: Condition) -> None:
+        self.states[i] = paper.initial_state(cond.y0_m)
+        self.airs[i] = cond.air_velocity()
+        self.ks[i] = 0
+        self.diverged[i] = -1
+
+    def step(self, idx: np.ndarray, phis: np.ndarray, n: int) -> None:
+        if len(idx) == len(self.ks):
+            paper.step_batch(phis, self.flaps, self.airs, self.consts, self.states, self.ks, n, self.dt, self.diverged)
+            return
+        st, ks, dv = self.states[idx], self.ks[idx], self.diverged[idx]
+        paper.step_batch(phis[idx], self.flaps[idx], self.airs[idx], self.consts[idx], st, ks, n, self.dt, dv)
+        self.states[idx], self.ks[idx], self.diverged[idx] = st, ks, dv
+
+    def fitness(self) -> np.ndarray:
+        return self.states[:, paper.S_FIT].copy()
+
+    def columns(self) -> tuple[np.ndarray, ...]:
+        """``y, v_y, v_z, theta, omega`` of every row (m, m/s, rad, rad/s)."""
+        s, f = self.states, PAPER_FLAP.as_array()
+        return (s[:, paper.S_Y], s[:, paper.S_VY], s[:, paper.S_VZ], f[0] + f[1] * s[:, paper.S_CW],
+                -f[1] * f[2] * s[:, paper.S_SW])
+
+
+class _MujocoBatch:
+    """The MuJoCo backend's butterflies: one ``mjData`` per row on one model, stepped together by
+    :func:`lifelike_mj.butterfly.backends.mj.step_batch` with the compiled wing-force callback."""
+
+    def __init__(self, n: int, params: ButterflyParams, dt_s: float, config: str, force_mode: str | None) -> None:
+        from lifelike_mj.butterfly.backends import mj, mujoco_options
+
+        self.mj = mj
+        self.dt = dt_s
+        self.params = params
+        self.options = mujoco_options(config, force_mode)
+        self.model = mj.build_model(params, self.options["config"])
+        self.model.opt.timestep = dt_s
+        self.lay = mj.layout(self.model).as_array()
+        self.flap = PAPER_FLAP.as_array()
+        from lifelike_mj.butterfly import ButterflyController
+
+        self._controller = ButterflyController("constant", PAPER_FLAP, {"phi_deg": 0.0})
+        self.datas: list = [None] * n
+        self.dptrs = np.zeros(n, dtype=np.int64)
+        self.ks = np.zeros(n, dtype=np.int64)
+        self.diverged = np.full(n, -1, dtype=np.int64)
+        self.reset = np.zeros(n, dtype=np.int64)
+        self.fits = np.zeros(n)
+        self.cols = np.zeros((n, 5))
+
+    def reset_row(self, i: int, cond: Condition) -> None:
+        d = self.mj.setup_data(self.model, self._controller, self.params, cond, self.options["force_mode"])
+        self.datas[i] = d
+        self.dptrs[i] = d._address
+        self.ks[i] = 0
+        self.diverged[i] = -1
+        self.reset[i] = 0
+        self.fits[i] = 0.0
+        f = self.flap
+        self.cols[i] = (d.qpos[self.lay[2]], d.qvel[self.lay[4]], d.qvel[self.lay[3]], f[0] + f[1] * math.cos(0.0),
+                        -f[1] * f[2] * math.sin(0.0))
+
+    def step(self, idx: np.ndarray, phis: np.ndarray, n: int) -> None:
+        from lifelike_mj.physics.callbacks import passive_callback
+        from lifelike_mj.physics.stability import watching
+
+        mj = self.mj
+        with passive_callback(mj.COMPILED_PASSIVE), watching():
+            mj.step_batch(self.model._address, self.dptrs, idx, phis, self.ks, n, self.flap, self.lay, self.dt,
+                          self.diverged, self.reset, self.fits, self.cols, mj._OFFSETS)
+
+    def fitness(self) -> np.ndarray:
+        return self.fits.copy()
+
+    def columns(self) -> tuple[np.ndarray, ...]:
+        c = self.cols
+        return c[:, 0], c[:, 1], c[:, 2], c[:, 3], c[:, 4]
 
 
 class ButterflyPitchVectorEnv(VectorEnv):
     """``num_envs`` copies of :class:`~lifelike_mj.envs.butterfly.ButterflyPitchEnv` (or, with
     ``wind=True``, of :class:`~lifelike_mj.envs.butterfly.ButterflyPitchWindEnv`) as one Gymnasium
-    :class:`~gymnasium.vector.VectorEnv`, all stepped together by one compiled, multi-threaded call
-    (:func:`lifelike_mj.butterfly.backends.paper.step_batch`).
+    :class:`~gymnasium.vector.VectorEnv`, all stepped together by one compiled, multi-threaded call:
+    :func:`lifelike_mj.butterfly.backends.paper.step_batch` on the paper backend (eq. 7-11),
+    :func:`lifelike_mj.butterfly.backends.mj.step_batch` on the MuJoCo backend (one ``mjData`` per copy,
+    ``mj_step`` called from native code on every core).
 
     Spaces, reward and episode end are those of the single environment, batched. Gymnasium 1.x
     semantics: ``reset(seed=s)`` seeds copy ``i`` with ``s + i`` (the wind variant then draws the same
     condition as a single env reset with that seed), and autoreset is ``NEXT_STEP``: the step after an
     episode ends resets that copy, ignores its action and returns its first observation with reward 0.
-    The episodes are those of ``num_envs`` single environments, bit for bit (tested).
+    ``reset(options={"conditions": [(y0_m, (a, b)), ...]})`` starts copy ``i`` from the ``i``-th start
+    altitude and wind (m; m/s, where the wind comes from) for that episode, for instance to fly one
+    controller over a grid of winds; autoresets go back to the environment's own conditions.
+    The episodes are those of ``num_envs`` single environments, bit for bit (tested, both backends).
 
-    Only the paper backend (eq. 7-11) is batched; keyword arguments are the single environment's
-    (``backend`` must be ``"paper"``; ``render_mode`` is not offered).
+    Keyword arguments are the single environment's (``render_mode`` is not offered: render a single
+    environment). ``info["diverged"]`` marks the copies whose episode ended by divergence.
     """
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
 
     def __init__(self, num_envs: int = 64, wind: bool = False, **kwargs: Any) -> None:
-        if kwargs.get("backend", "paper") != "paper":
-            raise UserError("the vector environment steps the paper backend; use gymnasium's SyncVectorEnv over "
-                            "ButterflyPitch-v0 for the MuJoCo backend.")
         if kwargs.get("render_mode") is not None:
             raise UserError("the vector environment does not render; render a single ButterflyPitch-v0.")
         if not (isinstance(num_envs, int) and 1 <= num_envs <= 1_000_000):
@@ -49,13 +144,13 @@ class ButterflyPitchVectorEnv(VectorEnv):
         self.observation_space = batch_space(self.single_observation_space, num_envs)
         self.action_space = batch_space(self.single_action_space, num_envs)
         s = self.single
-        self._consts = np.tile(paper.constants_row(s.params), (num_envs, 1))
-        self._flaps = np.tile(PAPER_FLAP.as_array(), (num_envs, 1))
-        self._states = np.zeros((num_envs, paper.N_STATE))
-        self._airs = np.zeros((num_envs, 2))
-        self._ks = np.zeros(num_envs, dtype=np.int64)
-        self._diverged = np.full(num_envs, -1, dtype=np.int64)
+        if s.backend == "paper":
+            self._batch: _PaperBatch | _MujocoBatch = _PaperBatch(num_envs, s.params, s.dt_s)
+        else:
+            opts = s._flight_options
+            self._batch = _MujocoBatch(num_envs, s.params, s.dt_s, opts["config"], opts["force_mode"])
         self._phis = np.zeros(num_envs)
+        self._airs = np.zeros((num_envs, 2))
         self._ended = np.zeros(num_envs, dtype=bool)
         self._rngs: list[np.random.Generator] = [np.random.default_rng() for _ in range(num_envs)]
         self._conditions: list[Condition] = [s.condition] * num_envs
@@ -68,79 +163,68 @@ class ButterflyPitchVectorEnv(VectorEnv):
             if len(seeds) != self.num_envs:
                 raise UserError(f"give one seed or {self.num_envs} seeds, got {len(seeds)}.")
             self._rngs = [gym.utils.seeding.np_random(sd)[0] for sd in seeds]
+        chosen = (options or {}).get("conditions")
+        if chosen is not None:
+            chosen = [as_condition(c) for c in chosen]
+            if len(chosen) != self.num_envs:
+                raise UserError(f"options['conditions'] needs one (y0_m, (a, b)) pair per copy ({self.num_envs}), "
+                                f"got {len(chosen)}.")
         for i in range(self.num_envs):
-            self._reset_one(i)
+            self._reset_one(i, None if chosen is None else chosen[i])
         return self._observations(), self._reset_info(np.ones(self.num_envs, dtype=bool))
 
     def step(self, actions):
         a = np.asarray(actions, dtype=np.float64).reshape(self.num_envs, -1)[:, 0]
         if not np.all(np.isfinite(a)):
             raise ValueError("every action must be a finite number")
-        s = self.single
+        s, b = self.single, self._batch
         resetting = self._ended.copy()
         for i in np.flatnonzero(resetting):
             self._reset_one(i)
         live = ~resetting
-        if s.action_mode == "dphi":
-            target = self._phis + np.clip(a, -s.max_dphi, s.max_dphi)
-        else:
-            target = a
+        target = self._phis + np.clip(a, -s.max_dphi, s.max_dphi) if s.action_mode == "dphi" else a
         self._phis = np.where(live, np.clip(target, -s.phi_limit, s.phi_limit), self._phis)
-        before = self._states[:, paper.S_FIT].copy()
-        n = min(s.frame_skip, s.n_steps)  # every live copy has at least frame_skip steps left, or fewer at the end
-        left = s.n_steps - self._ks
-        steps = np.minimum(n, left)
-        diverged_before = self._diverged.copy()
+        before = b.fitness()
+        steps = np.minimum(s.frame_skip, s.n_steps - b.ks)
         for k in np.unique(steps[live]):  # one native call per distinct step count (one, but at an episode's end)
-            idx = np.flatnonzero(live & (steps == k))
-            self._step_rows(idx, int(k))
-        rewards = np.where(live, self._states[:, paper.S_FIT] - before, 0.0)
+            if k > 0:
+                b.step(np.flatnonzero(live & (steps == k)), self._phis, int(k))
+        rewards = np.where(live & (b.reset == 0), b.fitness() - before, 0.0)  # nothing after a MuJoCo reset counts
         rewards = np.where(np.isfinite(rewards), rewards, 0.0)
         obs = self._observations()
-        terminated = live & (self._diverged >= 0) & (diverged_before < 0)
+        diverged = live & (b.diverged >= 0)
+        terminated = diverged.copy()
         if s.ground_m is not None:
             terminated |= live & (obs[:, 4] < -s.ground_m)
-        truncated = live & ~terminated & (self._ks >= s.n_steps)
+        truncated = live & ~terminated & (b.ks >= s.n_steps)
         self._ended = terminated | truncated
         info = self._reset_info(resetting)
-        if terminated.any():
-            info["diverged"] = terminated & (self._diverged >= 0)
+        if diverged.any():
+            info["diverged"] = diverged
         return obs, rewards, terminated, truncated, info
 
     # ---- internals ------------------------------------------------------------------------------
 
-    def _reset_one(self, i: int) -> None:
+    def _reset_one(self, i: int, condition: Condition | None = None) -> None:
         s = self.single
-        if isinstance(s, ButterflyPitchWindEnv):
+        if condition is not None:
+            self._conditions[i] = condition
+        elif isinstance(s, ButterflyPitchWindEnv):
             self._conditions[i] = s.conditions[int(self._rngs[i].integers(len(s.conditions)))]
-        cond = self._conditions[i]
-        self._states[i] = paper.initial_state(cond.y0_m)
-        self._airs[i] = cond.air_velocity()
-        self._ks[i] = 0
-        self._diverged[i] = -1
+        else:
+            self._conditions[i] = s._own_condition
+        self._batch.reset_row(i, self._conditions[i])
+        self._airs[i] = self._conditions[i].air_velocity()
         self._phis[i] = 0.0
         self._ended[i] = False
 
-    def _step_rows(self, idx: np.ndarray, n: int) -> None:
-        if n <= 0 or not len(idx):
-            return
-        if len(idx) == self.num_envs:
-            paper.step_batch(self._phis, self._flaps, self._airs, self._consts, self._states, self._ks, n,
-                             self.single.dt_s, self._diverged)
-            return
-        st, ks, dv = self._states[idx], self._ks[idx], self._diverged[idx]
-        paper.step_batch(self._phis[idx], self._flaps[idx], self._airs[idx], self._consts[idx], st, ks, n,
-                         self.single.dt_s, dv)
-        self._states[idx], self._ks[idx], self._diverged[idx] = st, ks, dv
-
     def _observations(self) -> np.ndarray:
-        s, f = self._states, PAPER_FLAP.as_array()
-        vy, vz = s[:, paper.S_VY].copy(), s[:, paper.S_VZ].copy()
+        y, vy, vz, theta, omega = self._batch.columns()
+        vy, vz = vy.copy(), vz.copy()
         if self.single.inputs == "relative":
             vz -= self._airs[:, 0]
             vy -= self._airs[:, 1]
-        out = np.stack([s[:, paper.S_PHI], -f[1] * f[2] * s[:, paper.S_SW], f[0] + f[1] * s[:, paper.S_CW], vy,
-                        s[:, paper.S_Y], vz], axis=1)
+        out = np.stack([self._phis, omega, theta, vy, y, vz], axis=1)
         return np.where(np.isfinite(out), out, 0.0)
 
     def _reset_info(self, which: np.ndarray) -> dict:

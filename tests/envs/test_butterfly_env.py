@@ -120,3 +120,37 @@ def test_reset_starts_the_same_flight_again():
     for (oa, ra, *_), (ob, rb, *_) in zip(a, b):
         np.testing.assert_array_equal(oa, ob)
         assert ra == rb
+
+
+def test_reset_options_choose_one_episodes_condition():
+    from lifelike_mj.envs.vector import ButterflyPitchVectorEnv
+    from lifelike_mj.errors import UserError
+
+    env = ButterflyPitchEnv(duration_s=0.1, y0_m=1.0)
+    obs, _ = env.reset(options={"condition": (5.0, (2.0, 0.0))})
+    assert obs[4] == 5.0 and obs[5] == 2.0  # at rest in a 2 m/s head wind: 2 m/s forward through the air
+    obs, _ = env.reset()
+    assert obs[4] == 1.0 and obs[5] == 0.0  # the next plain reset: the env's own condition again
+    vec = ButterflyPitchVectorEnv(2, duration_s=0.1)
+    obs, _ = vec.reset(options={"conditions": [(3.0, (0.0, 0.0)), (-3.0, (0.0, 1.0))]})
+    assert list(obs[:, 4]) == [3.0, -3.0] and list(obs[:, 3]) == [0.0, 1.0]  # wind from above: air moves down
+    for bad, words in (({"condition": "high"}, r"\(y0_m, \(a, b\)\) pair"), ({"condition": (0.0, (99.0, 0.0))}, "wind")):
+        with pytest.raises(UserError, match=words):
+            env.reset(options=bad)
+    with pytest.raises(UserError, match="one .* pair per copy"):
+        vec.reset(options={"conditions": [(0.0, (0.0, 0.0))]})
+
+
+def test_controller_policy_checks_the_env():
+    from lifelike_mj.envs.policies import controller_policy
+    from lifelike_mj.errors import UserError
+
+    with pytest.raises(UserError, match="action_mode='phi'"):
+        controller_policy("ann_paper", ButterflyPitchEnv())
+    with pytest.raises(UserError, match="reads relative velocities .* ground"):
+        controller_policy("ann_paper", ButterflyPitchEnv(action_mode="phi", inputs="ground"))
+    env = ButterflyPitchEnv(action_mode="phi", duration_s=0.05)
+    policy = controller_policy("simple_rule", env)
+    obs, _ = env.reset()
+    assert policy(obs).shape == (1,)
+    env.step(policy(obs))

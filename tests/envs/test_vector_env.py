@@ -10,10 +10,11 @@ from lifelike_mj.envs.butterfly import ButterflyPitchEnv, ButterflyPitchWindEnv 
 from lifelike_mj.envs.vector import ButterflyPitchVectorEnv  # noqa: E402
 
 
-@pytest.mark.parametrize("wind", [False, True])
-@pytest.mark.parametrize("action_mode", ["dphi", "phi"])
-def test_vector_equals_single_envs_with_next_step_autoreset(wind, action_mode):
-    n, kw = 5, {"duration_s": 0.1, "action_mode": action_mode, "frame_skip": 3}
+@pytest.mark.parametrize("backend,wind,action_mode", [("paper", False, "dphi"), ("paper", False, "phi"),
+                                                     ("paper", True, "dphi"), ("paper", True, "phi"),
+                                                     ("mujoco", False, "dphi"), ("mujoco", True, "phi")])
+def test_vector_equals_single_envs_with_next_step_autoreset(backend, wind, action_mode):
+    n, kw = 5, {"duration_s": 0.1, "action_mode": action_mode, "frame_skip": 3, "backend": backend}
     vec = ButterflyPitchVectorEnv(n, wind=wind, **kw)
     singles = [(ButterflyPitchWindEnv if wind else ButterflyPitchEnv)(**kw) for _ in range(n)]
     vobs, vinfo = vec.reset(seed=10)
@@ -51,7 +52,31 @@ def test_gymnasium_make_vec_and_its_checker():
 def test_vector_env_refuses_what_it_does_not_do():
     from lifelike_mj.errors import UserError
 
-    with pytest.raises(UserError, match="paper backend"):
-        ButterflyPitchVectorEnv(4, backend="mujoco")
+    with pytest.raises(UserError, match="does not render"):
+        ButterflyPitchVectorEnv(4, render_mode="rgb_array")
     with pytest.raises(UserError, match="num_envs"):
         ButterflyPitchVectorEnv(0)
+
+
+def test_a_mujoco_reset_ends_that_copy_alone_with_no_reward(tmp_path, monkeypatch):
+    """MuJoCo resets a copy whose state is huge: that copy's episode ends (terminated, diverged, reward 0:
+    nothing after a reset is valid) and starts again on the next step; the others fly on undisturbed."""
+    monkeypatch.chdir(tmp_path)
+    vec = ButterflyPitchVectorEnv(3, backend="mujoco", duration_s=0.1)
+    single = ButterflyPitchEnv(backend="mujoco", duration_s=0.1)
+    vec.reset(seed=0)
+    single.reset(seed=0)
+    a = np.full((3, 1), 0.01)
+    for _ in range(5):
+        vec.step(a)
+        single.step(a[0])
+    b = vec._batch
+    b.datas[1].qpos[int(b.lay[2])] = 1e11  # an altitude of 1e11 m: MuJoCo resets this copy inside mj_step
+    obs, rew, term, trunc, info = vec.step(a)
+    sobs, srew, *_ = single.step(a[0])
+    assert list(term) == [False, True, False] and not trunc.any() and list(info["diverged"]) == [False, True, False]
+    assert rew[1] == 0.0 and rew[0] == rew[2] == srew
+    np.testing.assert_array_equal(obs[0], sobs)
+    obs, rew, term, trunc, _ = vec.step(a)  # NEXT_STEP: copy 1 starts again
+    assert rew[1] == 0.0 and not term.any() and obs[1][4] == 0.0 and obs[1][3] == 0.0
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()

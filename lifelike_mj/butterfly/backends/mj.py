@@ -41,7 +41,7 @@ import numpy as np
 from numba import njit, prange
 
 from lifelike_mj.butterfly.aero import strip_nodes
-from lifelike_mj.butterfly.controllers import ButterflyController
+from lifelike_mj.butterfly.controllers import KIND_CONSTANT, ButterflyController
 from lifelike_mj.butterfly.flight import (
     Condition,
     PitchObservation,
@@ -420,6 +420,41 @@ def _fitness_batch(mptr, dptrs, kinds, cparams, flap, lay, dt, n_steps, diverged
         advance(mptr, base, qpos, qvel, ud, 0, n_steps, kinds[b], cparams[b], flap, 0.0, lay, dt, 0.0, dv, fit)
         diverged[b] = dv[0]
         fitness[b] = fit[0]
+
+
+@njit(cache=True, parallel=True)
+def step_batch(mptr, dptrs, rows, phis, ks, n_steps, flap, lay, dt, diverged, reset, fits, cols, off):
+    """Advance the butterflies ``rows`` (indices into ``dptrs``, one ``mjData`` each on model ``mptr``)
+    ``n_steps`` steps each at the pitch ``phis[b]`` (rad), in one native call on parallel threads: the
+    vector environment's step on the MuJoCo backend. Per butterfly ``b``: ``ks[b]`` the step count
+    (advanced), ``fits[b]`` the running eq. 13 fitness, ``diverged[b]`` set to the step of a runaway,
+    ``reset[b]`` set to 1 when MuJoCo reset the simulation (its clock jumped back: nothing from that call
+    on is valid), and ``cols[b]`` the observed ``y, v_y, v_z`` (m, m/s) and ``theta, omega`` (rad, rad/s)
+    after the step. The compiled passive callback must be installed around the call."""
+    for j in prange(len(rows)):
+        b = rows[j]
+        base = dptrs[b]
+        ud = _f64(_ptr_at(base + off[_O_UD]), N_USERDATA)
+        qpos = _f64(_ptr_at(base + off[_O_QPOS]), int(ud[U_NQ]))
+        qvel = _f64(_ptr_at(base + off[_O_QVEL]), int(ud[U_NV]))
+        clock = _f64(base + off[_O_TIME], 1)
+        t0 = clock[0]
+        k0 = ks[b]
+        advance(mptr, base, qpos, qvel, ud, k0, n_steps, KIND_CONSTANT, phis[b : b + 1], flap, 0.0, lay, dt, phis[b],
+                diverged[b : b + 1], fits[b : b + 1])
+        if diverged[b] >= 0:
+            ks[b] = diverged[b]
+        else:
+            ks[b] = k0 + n_steps
+            if abs(clock[0] - (t0 + n_steps * dt)) > 0.5 * dt:
+                reset[b] = 1
+                diverged[b] = k0 + n_steps
+        t = ks[b] * dt
+        cols[b, 0] = qpos[lay[2]]
+        cols[b, 1] = qvel[lay[4]]
+        cols[b, 2] = qvel[lay[3]]
+        cols[b, 3] = flap[0] + flap[1] * math.cos(flap[2] * t)
+        cols[b, 4] = -flap[1] * flap[2] * math.sin(flap[2] * t)
 
 
 def _record_loop(mptr, dptr, qpos, qvel, ud, k0, n_steps, every, kind, cp, flap, y_ref, lay, dt, phi, out, r0,
