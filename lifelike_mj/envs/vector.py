@@ -10,11 +10,55 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
+from numba import njit
 
 from lifelike_mj.butterfly import PAPER_FLAP, ButterflyParams, Condition
 from lifelike_mj.butterfly.backends import paper
 from lifelike_mj.envs.butterfly import OBSERVATION_NAMES, ButterflyPitchEnv, ButterflyPitchWindEnv, as_condition
 from lifelike_mj.errors import UserError
+
+
+@njit(cache=True, error_model="numpy")
+def _set_pitch(a, phis, live, dphi_mode, max_dphi, phi_limit):
+    """The pitch of each live copy after its action (rad): the change clipped to ``max_dphi`` (action
+    mode ``dphi``) or the pitch itself, then clipped to ``phi_limit``, as the single environment does."""
+    for b in range(len(a)):
+        if live[b]:
+            t = phis[b] + min(max(a[b], -max_dphi), max_dphi) if dphi_mode else a[b]
+            phis[b] = min(max(t, -phi_limit), phi_limit)
+
+
+@njit(cache=True, error_model="numpy")
+def _finish(live, cols, phis, airs, relative, before, after, reset, diverged, ks, n_steps, ground,
+            obs, rewards, terminated, truncated):
+    """Observation, reward and episode end of every copy after a step, as the single environment
+    computes them: ``cols`` rows ``y, v_y, v_z, theta, omega``; a copy that was reset this step (not
+    ``live``) gets reward 0 and no episode end."""
+    for b in range(len(phis)):
+        vy = cols[b, 1]
+        vz = cols[b, 2]
+        if relative:
+            vz -= airs[b, 0]
+            vy -= airs[b, 1]
+        o = obs[b]
+        o[0] = phis[b]
+        o[1] = cols[b, 4]
+        o[2] = cols[b, 3]
+        o[3] = vy
+        o[4] = cols[b, 0]
+        o[5] = vz
+        for j in range(6):
+            if not math.isfinite(o[j]):
+                o[j] = 0.0
+        r = after[b] - before[b]
+        rewards[b] = r if live[b] and reset[b] == 0 and math.isfinite(r) else 0.0
+        term = live[b] and (diverged[b] >= 0 or (ground > 0.0 and o[4] < -ground))
+        terminated[b] = term
+        truncated[b] = live[b] and not term and ks[b] >= n_steps
+
+
+#: Butterfly-steps per call from which the paper backend's batch runs on threads (measured crossover).
+PARALLEL_FROM = 256
 
 
 class _PaperBatch:
@@ -29,6 +73,7 @@ class _PaperBatch:
         self.ks = np.zeros(n, dtype=np.int64)
         self.diverged = np.full(n, -1, dtype=np.int64)
         self.reset = np.zeros(n, dtype=np.int64)  # never set: the paper backend has no solver to reset
+        self.cols = np.zeros((n, 5))
 
     def reset_row(self, i: int, cond: Condition) -> None:
         self.states[i] = paper.initial_state(cond.y0_m)
@@ -37,21 +82,25 @@ class _PaperBatch:
         self.diverged[i] = -1
 
     def step(self, idx: np.ndarray, phis: np.ndarray, n: int) -> None:
+        # threads pay off from a few hundred butterfly-steps per call (starting them costs tens of us)
+        kernel = paper.step_batch if len(idx) * n >= PARALLEL_FROM else paper.step_batch_serial
         if len(idx) == len(self.ks):
-            paper.step_batch(phis, self.flaps, self.airs, self.consts, self.states, self.ks, n, self.dt, self.diverged)
+            kernel(phis, self.flaps, self.airs, self.consts, self.states, self.ks, n, self.dt, self.diverged)
             return
         st, ks, dv = self.states[idx], self.ks[idx], self.diverged[idx]
-        paper.step_batch(phis[idx], self.flaps[idx], self.airs[idx], self.consts[idx], st, ks, n, self.dt, dv)
+        kernel(phis[idx], self.flaps[idx], self.airs[idx], self.consts[idx], st, ks, n, self.dt, dv)
         self.states[idx], self.ks[idx], self.diverged[idx] = st, ks, dv
 
     def fitness(self) -> np.ndarray:
         return self.states[:, paper.S_FIT].copy()
 
-    def columns(self) -> tuple[np.ndarray, ...]:
+    def columns(self) -> np.ndarray:
         """``y, v_y, v_z, theta, omega`` of every row (m, m/s, rad, rad/s)."""
-        s, f = self.states, PAPER_FLAP.as_array()
-        return (s[:, paper.S_Y], s[:, paper.S_VY], s[:, paper.S_VZ], f[0] + f[1] * s[:, paper.S_CW],
-                -f[1] * f[2] * s[:, paper.S_SW])
+        s, f, c = self.states, self.flaps[0], self.cols
+        c[:, 0], c[:, 1], c[:, 2] = s[:, paper.S_Y], s[:, paper.S_VY], s[:, paper.S_VZ]
+        c[:, 3] = f[0] + f[1] * s[:, paper.S_CW]
+        c[:, 4] = -f[1] * f[2] * s[:, paper.S_SW]
+        return c
 
 
 class _MujocoBatch:
@@ -104,9 +153,9 @@ class _MujocoBatch:
     def fitness(self) -> np.ndarray:
         return self.fits.copy()
 
-    def columns(self) -> tuple[np.ndarray, ...]:
-        c = self.cols
-        return c[:, 0], c[:, 1], c[:, 2], c[:, 3], c[:, 4]
+    def columns(self) -> np.ndarray:
+        """``y, v_y, v_z, theta, omega`` of every row (m, m/s, rad, rad/s), written by each step."""
+        return self.cols
 
 
 class ButterflyPitchVectorEnv(VectorEnv):
@@ -150,6 +199,8 @@ class ButterflyPitchVectorEnv(VectorEnv):
             opts = s._flight_options
             self._batch = _MujocoBatch(num_envs, s.params, s.dt_s, opts["config"], opts["force_mode"])
         self._phis = np.zeros(num_envs)
+        self._every = np.arange(num_envs)
+        self._all_live = np.ones(num_envs, dtype=bool)
         self._airs = np.zeros((num_envs, 2))
         self._ended = np.zeros(num_envs, dtype=bool)
         self._rngs: list[np.random.Generator] = [np.random.default_rng() for _ in range(num_envs)]
@@ -174,31 +225,36 @@ class ButterflyPitchVectorEnv(VectorEnv):
         return self._observations(), self._reset_info(np.ones(self.num_envs, dtype=bool))
 
     def step(self, actions):
-        a = np.asarray(actions, dtype=np.float64).reshape(self.num_envs, -1)[:, 0]
-        if not np.all(np.isfinite(a)):
+        n, s, b = self.num_envs, self.single, self._batch
+        a = np.asarray(actions, dtype=np.float64)
+        if a.size != n:
+            raise ValueError(f"expected {n} actions (one per copy), got an array of shape {a.shape}")
+        a = np.ascontiguousarray(a.reshape(n))
+        if not np.isfinite(a).all():
             raise ValueError("every action must be a finite number")
-        s, b = self.single, self._batch
-        resetting = self._ended.copy()
-        for i in np.flatnonzero(resetting):
-            self._reset_one(i)
-        live = ~resetting
-        target = self._phis + np.clip(a, -s.max_dphi, s.max_dphi) if s.action_mode == "dphi" else a
-        self._phis = np.where(live, np.clip(target, -s.phi_limit, s.phi_limit), self._phis)
+        live, all_live = self._all_live, True
+        if self._ended.any():  # NEXT_STEP autoreset of the copies whose episode ended on the last step
+            live, all_live = ~self._ended, False
+            for i in np.flatnonzero(self._ended):
+                self._reset_one(i)
+        _set_pitch(a, self._phis, live, s.action_mode == "dphi", s.max_dphi, s.phi_limit)
         before = b.fitness()
-        steps = np.minimum(s.frame_skip, s.n_steps - b.ks)
-        for k in np.unique(steps[live]):  # one native call per distinct step count (one, but at an episode's end)
-            if k > 0:
-                b.step(np.flatnonzero(live & (steps == k)), self._phis, int(k))
-        rewards = np.where(live & (b.reset == 0), b.fitness() - before, 0.0)  # nothing after a MuJoCo reset counts
-        rewards = np.where(np.isfinite(rewards), rewards, 0.0)
-        obs = self._observations()
-        diverged = live & (b.diverged >= 0)
-        terminated = diverged.copy()
-        if s.ground_m is not None:
-            terminated |= live & (obs[:, 4] < -s.ground_m)
-        truncated = live & ~terminated & (b.ks >= s.n_steps)
+        left = s.n_steps - b.ks
+        if all_live and left.min() >= s.frame_skip:
+            b.step(self._every, self._phis, s.frame_skip)  # one native call for all copies
+        else:
+            steps = np.minimum(s.frame_skip, left)
+            for k in np.unique(steps[live]):  # one call per distinct step count (near an episode's end)
+                if k > 0:
+                    b.step(np.flatnonzero(live & (steps == k)), self._phis, int(k))
+        obs, rewards = np.empty((n, 6)), np.empty(n)
+        terminated, truncated = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
+        _finish(live, b.columns(), self._phis, self._airs, s.inputs == "relative", before, b.fitness(), b.reset,
+                b.diverged, b.ks, s.n_steps, -1.0 if s.ground_m is None else s.ground_m, obs, rewards, terminated,
+                truncated)
         self._ended = terminated | truncated
-        info = self._reset_info(resetting)
+        info = {} if all_live else self._reset_info(~live)
+        diverged = live & (b.diverged >= 0)
         if diverged.any():
             info["diverged"] = diverged
         return obs, rewards, terminated, truncated, info
@@ -219,13 +275,13 @@ class ButterflyPitchVectorEnv(VectorEnv):
         self._ended[i] = False
 
     def _observations(self) -> np.ndarray:
-        y, vy, vz, theta, omega = self._batch.columns()
-        vy, vz = vy.copy(), vz.copy()
-        if self.single.inputs == "relative":
-            vz -= self._airs[:, 0]
-            vy -= self._airs[:, 1]
-        out = np.stack([self._phis, omega, theta, vy, y, vz], axis=1)
-        return np.where(np.isfinite(out), out, 0.0)
+        n, b = self.num_envs, self._batch
+        obs, rewards = np.empty((n, 6)), np.empty(n)
+        flags = np.empty(n, dtype=bool)
+        none = np.zeros(n, dtype=bool)
+        _finish(none, b.columns(), self._phis, self._airs, self.single.inputs == "relative", rewards, rewards, b.reset,
+                b.diverged, b.ks, self.single.n_steps, -1.0, obs, rewards, flags, flags)
+        return obs
 
     def _reset_info(self, which: np.ndarray) -> dict:
         info: dict[str, Any] = {}

@@ -189,13 +189,13 @@ _law = builtin_law
 fly_steps = njit(cache=True, error_model="numpy")(_fly_loop)
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
-def step_batch(phis, flaps, airs, consts, states, ks, n_steps, dt, diverged):
+def _step_batch_loop(phis, flaps, airs, consts, states, ks, n_steps, dt, diverged):
     """Advance ``len(phis)`` butterflies ``n_steps`` steps each at the pitch ``phis[b]`` (rad), in one
     native call on parallel threads (Oe 2010 eq. 7-11, RK4, as :func:`fly_steps`): rows of ``flaps``
     (the flap pattern), ``airs`` (air velocity forward, up; m/s), ``consts`` (:func:`constants_row`)
     and ``states`` (the state arrays, :data:`S_Y` ...) per butterfly; ``ks`` the step counts, advanced;
-    ``diverged[b]`` set to the step of a runaway (such a butterfly is not stepped again)."""
+    ``diverged[b]`` set to the step of a runaway (such a butterfly is not stepped again). For a few
+    butterflies :func:`step_batch_serial` is faster (starting threads costs tens of microseconds)."""
     no_rows = np.empty((0, 5))
     for b in prange(len(phis)):
         if diverged[b] >= 0:
@@ -209,6 +209,11 @@ def step_batch(phis, flaps, airs, consts, states, ks, n_steps, dt, diverged):
             ks[b] = dv
         else:
             ks[b] += n_steps
+
+
+step_batch = njit(cache=True, parallel=True, error_model="numpy")(_step_batch_loop)
+#: :func:`step_batch` on the calling thread (the same arithmetic, so the same numbers).
+step_batch_serial = njit(cache=True, error_model="numpy")(_step_batch_loop)
 
 
 @functools.lru_cache(maxsize=64)
