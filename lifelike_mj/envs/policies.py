@@ -4,6 +4,10 @@ A controller file's pitch law (simple rule, the paper's network, a deeper networ
 reads the environment's observation and returns the pitch to set: ``controller_policy`` for one
 controller, :func:`pitch_actions` for a batch of compiled controllers (one per copy of a vector
 environment, as an evolution strategy asks for them), all in one compiled loop.
+
+The other way round, a network trained by a reinforcement-learning library becomes a controller file:
+train it on :class:`NetworkInputs` and :class:`NetworkActions` over the environment, with eq. 12's
+transfer function as its activation, then :func:`network_controller` (``examples/gym_sb3_ppo.py``).
 """
 
 from __future__ import annotations
@@ -11,10 +15,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
+import gymnasium as gym
 import numpy as np
+from gymnasium import spaces
 from numba import njit
 
-from lifelike_mj.butterfly import ButterflyController
+from lifelike_mj.butterfly import PAPER_FLAP, ButterflyController, ann, ann_controller
 from lifelike_mj.butterfly import controllers as _controllers
 from lifelike_mj.butterfly.flight import pitch_command
 from lifelike_mj.errors import UserError
@@ -65,3 +71,60 @@ def controller_policy(controller: ButterflyController | str | Path, env) -> Call
         return act[0] if o.ndim == 1 else act
 
     return policy
+
+
+# ---- a network trained elsewhere (RL), in the controller file's form -------------------------------
+
+
+class NetworkInputs(gym.ObservationWrapper):
+    """The observation scaled as a network controller's inputs (Oe 2010 section 6.1, the scales of
+    :mod:`lifelike_mj.butterfly.ann`): ``phi / 30 deg``, ``omega / peak rate``, ``(theta - centre) /
+    half range``, ``v_y / 2 m/s``, ``y / 10 m``, ``v_z / 3 m/s`` (dimensionless, about [-1, 1]). A policy
+    that reads these and acts through :class:`NetworkActions` is a network of the controller file's kind
+    (:func:`network_controller` writes it out)."""
+
+    def __init__(self, env: gym.Env) -> None:
+        super().__init__(env)
+        u = env.unwrapped
+        cp = ann.compile_params(u.inputs, ann.default_scales(PAPER_FLAP), np.zeros(ann.N_WEIGHTS))
+        self._scale = cp[ann.A_SCALE : ann.A_W].copy()
+        self._shift = np.array([0.0, 0.0, cp[ann.A_THETA_C], 0.0, 0.0, 0.0])
+        box = env.observation_space
+        self.observation_space = spaces.Box((box.low - self._shift) * self._scale, (box.high - self._shift) * self._scale,
+                                            (6,), dtype=np.float64)
+
+    def observation(self, observation: np.ndarray) -> np.ndarray:
+        return (np.asarray(observation, dtype=np.float64) - self._shift) * self._scale
+
+
+class NetworkActions(gym.ActionWrapper):
+    """The action as a network controller's output neuron (Oe 2010 eq. 12): the agent gives the neuron's
+    sum ``u`` in [-2, 2] (``G`` is flat beyond, ``G(2) = 1 - 1.5e-8``) and the environment changes the
+    pitch by ``max_dphi G(u)``, as the network does. Needs ``action_mode="dphi"``."""
+
+    def __init__(self, env: gym.Env) -> None:
+        super().__init__(env)
+        if env.unwrapped.action_mode != "dphi":
+            raise UserError("NetworkActions changes the pitch by max_dphi G(u): make the env with action_mode='dphi'.")
+        self._max = float(env.unwrapped.max_dphi)
+        self.action_space = spaces.Box(-2.0, 2.0, (1,), dtype=np.float64)
+
+    def action(self, action: np.ndarray) -> np.ndarray:
+        u = float(np.clip(np.asarray(action, dtype=np.float64).reshape(-1)[0], -2.0, 2.0))
+        return np.array([self._max * ann.transfer(u)])
+
+
+def network_controller(layers: list[tuple[np.ndarray, np.ndarray]], inputs: str = "relative",
+                       provenance: dict | None = None) -> ButterflyController:
+    """A network controller (the controller file's ``ann`` type) from a trained network's layers
+    ``[(W, b), ...]`` (``W`` of shape (outputs, inputs), as ``torch.nn.Linear`` keeps it): hidden layers
+    with eq. 12's ``G``, a single output neuron, inputs as :class:`NetworkInputs` gives them and the
+    output as :class:`NetworkActions` uses it. ``butterfly fly`` and the viewer fly the result."""
+    sizes = [int(np.asarray(layers[0][0]).shape[1])] + [int(np.asarray(w).shape[0]) for w, _ in layers]
+    flat = []
+    for w, b in layers:
+        w, b = np.asarray(w, dtype=np.float64), np.asarray(b, dtype=np.float64).reshape(-1)
+        for j in range(w.shape[0]):  # per neuron: its input weights, then its bias
+            flat.extend(w[j].tolist())
+            flat.append(float(b[j]))
+    return ann_controller(np.array(flat), PAPER_FLAP, inputs, provenance=provenance, layers=sizes)
