@@ -7,7 +7,8 @@ Run: ``python benchmarks/compare_ga_rl.py [--steps 1000000] [--seeds 3] [--ppo-s
 Every method learns through the same environment and spends the same number of environment steps:
 ``ButterflyPitch-v0`` (the paper task: still air from 0 m) or ``ButterflyPitchWind-v0`` (the
 ``robust_map`` distribution: a start altitude or a wind drawn per episode), 20 s episodes, one decision
-every ``--frame-skip`` simulation steps (24: 1000 decisions per episode).
+every ``--frame-skip`` simulation steps (12: 2000 decisions per episode) with the paper's pitch rate
+limit, 3 deg per simulation step (36 deg per decision).
 
 * RCGA (the paper's GA) and CMA-ES evolve the paper's 6-6-1 network (49 weights within +-5); one
   evaluation is one episode (a fresh condition per episode on the wind task, as the RL agent sees them),
@@ -33,8 +34,8 @@ import numpy as np
 
 import lifelike_mj
 from lifelike_mj import evolve
-from lifelike_mj.butterfly import PAPER_FLAP, ann, ann_controller
-from lifelike_mj.butterfly.controllers import KIND_ANN
+from lifelike_mj.butterfly import PAPER_FLAP, ann
+from lifelike_mj.butterfly.controllers import KIND_ANN, KIND_MLP
 from lifelike_mj.envs.policies import pitch_actions
 from lifelike_mj.envs.vector import ButterflyPitchVectorEnv
 from lifelike_mj.io import write_json
@@ -42,6 +43,11 @@ from lifelike_mj.provenance import provenance
 
 EPISODE_S = 20.0
 MAP_STEP, MAP_MAX = 0.5, 3.0
+
+
+def network(weights: np.ndarray, frame_skip: int) -> np.ndarray:
+    """The compiled paper network with the pitch rate limit of one decision every ``frame_skip`` steps."""
+    return ann.compile_params("relative", ann.default_scales(PAPER_FLAP), weights, 3.0 * frame_skip)
 
 
 class EnvEpisodes:
@@ -60,8 +66,8 @@ class EnvEpisodes:
     def evaluate(self, X: np.ndarray) -> np.ndarray:
         n = len(X)
         env = ButterflyPitchVectorEnv(n, wind=self.wind, action_mode="phi", frame_skip=self.frame_skip,
-                                      duration_s=EPISODE_S)
-        cps = np.array([ann_controller(w, PAPER_FLAP).compiled()[1] for w in X])
+                                      duration_s=EPISODE_S, max_dphi_deg=3.0 * self.frame_skip)
+        cps = np.array([network(w, self.frame_skip) for w in X])
         obs, _ = env.reset(seed=self.seed * 1_000_003 + self.episodes)  # a fresh condition per episode
         self.episodes += n
         kinds = np.full(n, KIND_ANN)
@@ -81,7 +87,8 @@ def measure(kinds: np.ndarray, cps: np.ndarray, frame_skip: int) -> dict:
     grid = np.arange(-round(MAP_MAX / MAP_STEP), round(MAP_MAX / MAP_STEP) + 1) * MAP_STEP
     conds = [(0.0, (0.0, 0.0))] + [(0.0, (float(a), float(b))) for b in grid for a in grid]
     n = len(conds)
-    env = ButterflyPitchVectorEnv(n, action_mode="phi", frame_skip=frame_skip, duration_s=EPISODE_S)
+    env = ButterflyPitchVectorEnv(n, action_mode="phi", frame_skip=frame_skip, duration_s=EPISODE_S,
+                                  max_dphi_deg=3.0 * frame_skip)
     obs, _ = env.reset(seed=0, options={"conditions": conds})
     k, c = np.repeat(kinds[:1], n), np.repeat(cps[:1], n, axis=0)
     air_fwd = np.array([-a for _, (a, _b) in conds])
@@ -109,9 +116,10 @@ def run_ga(optimizer: str, wind: bool, steps: int, frame_skip: int, seed: int) -
     res = evolve.optimize(problem, optimizer, seed=seed, generations=generations, population=population,
                           progress=False)
     wall = time.perf_counter() - t
-    cps = ann_controller(res.best_x, PAPER_FLAP).compiled()[1][None, :]
+    cps = network(res.best_x, frame_skip)[None, :]
     return {"method": optimizer, "seed": seed, "train_wall_s": wall, "env_steps": problem.episodes * per_episode,
-            "episodes": problem.episodes, "population": population, "generations": generations, "best_training_return": float(res.best_f),
+            "episodes": problem.episodes, "population": population, "generations": generations,
+            "best_training_return": float(res.best_f),
             **measure(np.array([KIND_ANN]), cps, frame_skip)}
 
 
@@ -120,7 +128,9 @@ def run_ppo(wind: bool, steps: int, frame_skip: int, seed: int) -> dict:
     ex = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(ex)
     model, wall = ex.train(steps, seed, wind, frame_skip)
-    kind, cp = ex.export(model).compiled()
+    ctrl = ex.export(model)  # the controller file's network; measured here at the env's rate limit
+    cp = ann.compile_mlp("relative", ctrl.input_scale(), ctrl.parameters["weights"], ctrl.layers, 3.0 * frame_skip)
+    kind = KIND_MLP
     return {"method": "ppo", "seed": seed, "train_wall_s": wall, "env_steps": steps,
             "episodes": steps // int(round(EPISODE_S * 1200 / frame_skip)), "best_training_return": None,
             **measure(np.array([kind]), cp[None, :], frame_skip)}
@@ -129,7 +139,7 @@ def run_ppo(wind: bool, steps: int, frame_skip: int, seed: int) -> dict:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=1_000_000, help="environment steps per method and task")
-    ap.add_argument("--frame-skip", type=int, default=24)
+    ap.add_argument("--frame-skip", type=int, default=12)
     ap.add_argument("--seeds", type=int, default=3, help="seeds of RCGA and CMA-ES")
     ap.add_argument("--ppo-seeds", type=int, default=1)
     ap.add_argument("--tasks", default="paper,wind")

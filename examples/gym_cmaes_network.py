@@ -22,6 +22,8 @@ import numpy as np
 
 import lifelike_mj
 from lifelike_mj.butterfly import PAPER_FLAP, ann, ann_controller
+from lifelike_mj.butterfly.controllers import KIND_ANN
+from lifelike_mj.envs.policies import pitch_actions
 from lifelike_mj.envs.vector import ButterflyPitchVectorEnv
 from lifelike_mj.io import write_json
 
@@ -30,13 +32,13 @@ def episode_returns(weights: np.ndarray, duration_s: float) -> np.ndarray:
     """The summed reward (eq. 13's H) of one episode per row of ``weights``, all flown together."""
     n = len(weights)
     env = ButterflyPitchVectorEnv(n, action_mode="phi", duration_s=duration_s)
-    cps = [ann_controller(w, PAPER_FLAP, "relative").compiled()[1] for w in weights]
+    cps = np.array([ann_controller(w, PAPER_FLAP, "relative").compiled()[1] for w in weights])
+    kinds = np.full(n, KIND_ANN)
     obs, _ = env.reset(seed=0)
     total, done = np.zeros(n), np.zeros(n, dtype=bool)
     while not done.all():
-        # the observation holds air-relative velocities already: the network gets them with zero air
-        phi = np.array([ann.ann_pitch(cp, o[2], o[1], o[4], o[3], o[5], 0.0, 0.0, o[0]) for cp, o in zip(cps, obs)])
-        obs, reward, term, trunc, _ = env.step(phi[:, None])
+        # each network reads its copy's observation and sets the pitch (one compiled loop for all)
+        obs, reward, term, trunc, _ = env.step(pitch_actions(kinds, cps, obs))
         total += np.where(done, 0.0, reward)
         done |= term | trunc
     return total

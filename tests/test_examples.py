@@ -11,6 +11,8 @@ import pytest
 
 EXAMPLES = sorted((Path(__file__).resolve().parent.parent / "examples").glob("*.py"))
 NEEDS_GL = {"render_your_run.py"}
+#: Examples of an optional extra: run where it is installed, skipped (with the reason) elsewhere.
+NEEDS_MODULE = {"gym_sb3_ppo.py": "stable_baselines3"}
 
 
 def test_there_are_examples():
@@ -21,6 +23,8 @@ def test_there_are_examples():
 def test_example_runs(script, tmp_path, request):
     if script.name in NEEDS_GL:
         request.getfixturevalue("gl_backend")
+    if script.name in NEEDS_MODULE:
+        pytest.importorskip(NEEDS_MODULE[script.name], reason="the rl extra (pip install torch==2.13.0 'lifelike-mj[rl]')")
     args = [str(tmp_path)] if script.name in NEEDS_GL else []
     r = subprocess.run([sys.executable, str(script), *args], capture_output=True, text=True, cwd=tmp_path,
                        env=dict(os.environ), timeout=600)

@@ -9,8 +9,11 @@ named before the colon) ``gymnasium.make("lifelike_mj.envs:lifelike_mj/Butterfly
 * ``lifelike_mj/ButterflyPitchWind-v0``: :class:`~lifelike_mj.envs.butterfly.ButterflyPitchWindEnv`,
   the same with the start altitude and the wind drawn per episode (``butterfly evolve``'s
   ``robust_map`` task).
-* :class:`~lifelike_mj.envs.vector.ButterflyPitchVectorEnv`: N of either, stepped in one native call
+* :class:`~lifelike_mj.envs.vector.ButterflyPitchVectorEnv`: N of either, on either backend, stepped in
+  one native call
   (``gymnasium.make_vec("lifelike_mj/ButterflyPitch-v0", num_envs=N, vectorization_mode="vector_entry_point")``).
+* :mod:`lifelike_mj.envs.policies`: controller files as policies of these environments, and networks
+  trained through them (by an RL library) as controller files.
 
 Each environment's docstring is its documentation page (spaces with names and units, reward,
 starting state, episode end, arguments, version history).
