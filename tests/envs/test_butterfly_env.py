@@ -11,11 +11,12 @@ import lifelike_mj.envs  # noqa: E402,F401  (registers the environments)
 from lifelike_mj.envs.butterfly import OBSERVATION_NAMES, ButterflyPitchEnv  # noqa: E402
 
 
+@pytest.mark.parametrize("env_id", ["lifelike_mj/ButterflyPitch-v0", "lifelike_mj/ButterflyPitchWind-v0"])
 @pytest.mark.parametrize("backend", ["paper", "mujoco"])
-def test_gymnasiums_checker_passes(backend):
+def test_gymnasiums_checker_passes(backend, env_id):
     from gymnasium.utils.env_checker import check_env
 
-    env = gym.make("lifelike_mj/ButterflyPitch-v0", backend=backend, duration_s=0.5).unwrapped
+    env = gym.make(env_id, backend=backend, duration_s=0.5).unwrapped
     check_env(env, skip_render_check=True)
 
 
