@@ -26,6 +26,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import importlib.util
+import json
 import platform
 import time
 from pathlib import Path
@@ -34,7 +35,7 @@ import numpy as np
 
 import lifelike_mj
 from lifelike_mj import evolve
-from lifelike_mj.butterfly import PAPER_FLAP, ann
+from lifelike_mj.butterfly import PAPER_FLAP, ann, controllers
 from lifelike_mj.butterfly.controllers import KIND_ANN, KIND_MLP
 from lifelike_mj.envs.policies import pitch_actions
 from lifelike_mj.envs.vector import ButterflyPitchVectorEnv
@@ -142,24 +143,39 @@ def main() -> None:
     ap.add_argument("--frame-skip", type=int, default=12)
     ap.add_argument("--seeds", type=int, default=3, help="seeds of RCGA and CMA-ES")
     ap.add_argument("--ppo-seeds", type=int, default=1)
+    ap.add_argument("--first-seed", type=int, default=0, help="seeds run from this one on (to add seeds to a result)")
+    ap.add_argument("--merge", default=None, help="a result of an earlier run whose rows join this one's (other seeds)")
+    ap.add_argument("--reference", default="ann_paper,ann_robust",
+                    help="controller files measured as they fly in `butterfly fly` (frame skip 1, 3 deg per step)")
     ap.add_argument("--tasks", default="paper,wind")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "ga_vs_rl.json"))
     args = ap.parse_args()
-    rows = []
+    rows, merged_from = [], None
+    if args.merge:
+        earlier = json.loads(Path(args.merge).read_text())
+        rows, merged_from = earlier["rows"], earlier["provenance"]
     for task in args.tasks.split(","):
         wind = task == "wind"
         for opt in ("rcga", "cmaes"):
-            for s in range(args.seeds):
+            for s in range(args.first_seed, args.first_seed + args.seeds):
                 rows.append({"task": task, **run_ga(opt, wind, args.steps, args.frame_skip, s)})
                 print(rows[-1], flush=True)
-        for s in range(args.ppo_seeds):
+        for s in range(args.first_seed, args.first_seed + args.ppo_seeds):
             rows.append({"task": task, **run_ppo(wind, args.steps, args.frame_skip, s)})
             print(rows[-1], flush=True)
-    write_json(args.out, {"rows": rows, "steps": args.steps, "frame_skip": args.frame_skip,
+    references = []
+    for name in filter(None, args.reference.split(",")):
+        kind, cp = controllers.load(name).compiled()
+        references.append({"controller": name, **measure(np.array([kind]), cp[None, :], 1)})
+        print(references[-1], flush=True)
+    write_json(args.out, {"rows": rows, "references_frame_skip_1": references, "merged_from": merged_from,
+                          "steps": args.steps, "frame_skip": args.frame_skip,
                           "machine": f"{platform.processor() or platform.machine()}",
                           "version": lifelike_mj.__version__,
                           "provenance": provenance(steps=args.steps, frame_skip=args.frame_skip, seeds=args.seeds,
-                                                   ppo_seeds=args.ppo_seeds, tasks=args.tasks)})
+                                                   ppo_seeds=args.ppo_seeds, tasks=args.tasks,
+                                                   first_seed=args.first_seed, merge=args.merge,
+                                                   reference=args.reference)})
     print("| task | method | seeds | H from 0 m, still air: median (min-max) | wind-map cells passed of 169: median "
           "(min-max) | training wall time, median |\n|---|---|---|---|---|---|")
     for task in args.tasks.split(","):
@@ -172,6 +188,9 @@ def main() -> None:
             w = [r["train_wall_s"] for r in sel]
             print(f"| {task} | {m} | {len(sel)} | {np.median(h):.0f} ({min(h):.0f}-{max(h):.0f}) | {np.median(c):.0f} "
                   f"({min(c)}-{max(c)}) | {np.median(w):.0f} s |")
+    for r in references:
+        print(f"| (reference, frame skip 1) | {r['controller']} | | {r['H_still_air_0m']:.0f} | "
+              f"{r['windmap_cells_passed']} | |")
 
 
 if __name__ == "__main__":
