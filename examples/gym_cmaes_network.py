@@ -1,9 +1,13 @@
-"""Train the paper's 6-6-1 pitch network through the Gymnasium API with pycma, then export it as a
-controller file that `lifelike-mj butterfly fly` flies.
+"""Train a pitch policy through the Gymnasium API with pycma, then export it as a controller file that
+`lifelike-mj butterfly fly` flies: the paper's 6-6-1 network, or a linear policy.
 
     python examples/gym_cmaes_network.py                      # a quick run (a few seconds)
     python examples/gym_cmaes_network.py --generations 60 --duration 20 --out my_net.json
+    python examples/gym_cmaes_network.py --policy linear --generations 60 --duration 20 --out my_linear.json
     lifelike-mj butterfly fly --controller my_net.json        # then fly what you trained
+
+The linear policy is the network's output neuron alone (`"layers": [6, 1]`, 7 weights): the pitch
+changes by 3 deg x G(w . x + b) per step, x the network's scaled inputs (Oe 2010 eq. 12's G).
 
 Each generation, CMA-ES asks for `popsize` weight vectors; one vector environment holds one butterfly
 per candidate (`ButterflyPitchVectorEnv`, all stepped in one native call), each network chooses its
@@ -22,18 +26,20 @@ import numpy as np
 
 import lifelike_mj
 from lifelike_mj.butterfly import PAPER_FLAP, ann, ann_controller
-from lifelike_mj.butterfly.controllers import KIND_ANN
 from lifelike_mj.envs.policies import pitch_actions
 from lifelike_mj.envs.vector import ButterflyPitchVectorEnv
 from lifelike_mj.io import write_json
 
+POLICIES = {"network": list(ann.PAPER_LAYERS), "linear": [ann.N_INPUTS, 1]}
 
-def episode_returns(weights: np.ndarray, duration_s: float) -> np.ndarray:
+
+def episode_returns(weights: np.ndarray, duration_s: float, layers=ann.PAPER_LAYERS) -> np.ndarray:
     """The summed reward (eq. 13's H) of one episode per row of ``weights``, all flown together."""
     n = len(weights)
     env = ButterflyPitchVectorEnv(n, action_mode="phi", duration_s=duration_s)
-    cps = np.array([ann_controller(w, PAPER_FLAP, "relative").compiled()[1] for w in weights])
-    kinds = np.full(n, KIND_ANN)
+    compiled = [ann_controller(w, PAPER_FLAP, "relative", layers=layers).compiled() for w in weights]
+    kinds = np.array([k for k, _ in compiled])
+    cps = np.array([cp for _, cp in compiled])
     obs, _ = env.reset(seed=0)
     total, done = np.zeros(n), np.zeros(n, dtype=bool)
     while not done.all():
@@ -46,28 +52,31 @@ def episode_returns(weights: np.ndarray, duration_s: float) -> np.ndarray:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--policy", choices=sorted(POLICIES), default="network")
     ap.add_argument("--generations", type=int, default=3)
     ap.add_argument("--popsize", type=int, default=16)
     ap.add_argument("--duration", type=float, default=2.0, help="seconds per episode (the paper: 20)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--out", default="gym_cmaes_network.json")
     args = ap.parse_args()
-    es = cma.CMAEvolutionStrategy(np.zeros(ann.N_WEIGHTS), 0.5, {
+    layers = POLICIES[args.policy]
+    es = cma.CMAEvolutionStrategy(np.zeros(ann.n_weights(layers)), 0.5, {
         "popsize": args.popsize, "seed": args.seed, "bounds": [-5.0, 5.0], "verbose": -9})
     best_w, best_h = None, -np.inf
     for g in range(args.generations):
         X = np.array(es.ask())
-        H = episode_returns(X, args.duration)
+        H = episode_returns(X, args.duration, layers)
         es.tell(list(X), list(-H))
         i = int(np.argmax(H))
         if H[i] > best_h:
             best_w, best_h = X[i].copy(), float(H[i])
         print(f"generation {g + 1}: best H {H[i]:.1f} (so far {best_h:.1f})", flush=True)
-    ctrl = ann_controller(best_w, PAPER_FLAP, "relative")
+    ctrl = ann_controller(best_w, PAPER_FLAP, "relative", layers=layers)
     data = ctrl.to_dict()
     data["provenance"] = {"source": "examples/gym_cmaes_network.py (pycma through ButterflyPitchVectorEnv)",
                           "command": "python " + " ".join(sys.argv), "best_fitness": best_h,
-                          "generations": args.generations, "popsize": args.popsize, "seed": args.seed,
+                          "policy": args.policy, "layers": layers, "generations": args.generations,
+                          "popsize": args.popsize, "seed": args.seed,
                           "episode_duration_s": args.duration, "package_version": lifelike_mj.__version__,
                           "created": datetime.now(timezone.utc).isoformat(timespec="seconds")}
     write_json(args.out, data)

@@ -23,8 +23,9 @@ Weight order (the genome): for hidden neuron ``h = 0..5``: its 6 input weights t
 (indices ``7h .. 7h + 6``); then the 6 output weights (42..47) and the output bias (48).
 
 Networks of other shapes (``layers``, e.g. ``[6, 8, 8, 1]``: six inputs, two hidden layers of eight,
-one output) use the same inputs, transfer function, output scaling and weight order (per layer, per
-neuron: its input weights, then its bias), and run in :func:`mlp_pitch`; the paper's ``[6, 6, 1]``
+one output; or ``[6, 1]``, the output neuron alone: a linear policy) use the same inputs, transfer
+function, output scaling and weight order (per layer, per neuron: its input weights, then its bias),
+and run in :func:`mlp_pitch`; the paper's ``[6, 6, 1]``
 keeps its unrolled :func:`ann_pitch` (and :func:`mlp_pitch` computes the same numbers bit for bit).
 
 Compiled code sees the controller as a float array (see ``A_*`` below); :func:`ann_pitch` and
@@ -151,16 +152,17 @@ def n_weights(layers) -> int:
 
 
 def check_layers(layers) -> tuple[int, ...]:
-    """``layers`` as a tuple if it is a valid network shape (6 inputs, 1 output, 1 to
-    :data:`MAX_HIDDEN_LAYERS` hidden layers of 1 to :data:`MAX_WIDTH` neurons), else a ``ValueError``."""
+    """``layers`` as a tuple if it is a valid network shape (6 inputs, 1 output, 0 to
+    :data:`MAX_HIDDEN_LAYERS` hidden layers of 1 to :data:`MAX_WIDTH` neurons; ``[6, 1]`` is the output
+    neuron alone, a linear policy passed through ``G``), else a ``ValueError``."""
     try:
         t = tuple(int(x) for x in layers)
         ok = all(float(x) == int(x) and not isinstance(x, bool) for x in layers)
     except (TypeError, ValueError):
         raise ValueError(f"layers must be a list of whole numbers, got {layers!r}") from None
-    if not ok or len(t) < 3 or t[0] != N_INPUTS or t[-1] != 1:
+    if not ok or len(t) < 2 or t[0] != N_INPUTS or t[-1] != 1:
         raise ValueError(f"layers must start with {N_INPUTS} (the inputs) and end with 1 (the output), "
-                         f"with at least one hidden layer, got {list(layers)}")
+                         f"got {list(layers)}")
     if len(t) - 2 > MAX_HIDDEN_LAYERS or not all(1 <= h <= MAX_WIDTH for h in t[1:-1]):
         raise ValueError(f"at most {MAX_HIDDEN_LAYERS} hidden layers of 1 to {MAX_WIDTH} neurons, got {list(t)}")
     return t

@@ -135,6 +135,19 @@ def test_mlp_of_the_paper_shape_computes_the_6_6_1_network_bit_for_bit():
     assert fit[0] == fit[1]
 
 
+def test_a_linear_policy_is_the_output_neuron_alone():
+    """``"layers": [6, 1]``: the pitch changes by max_dphi G(w . x + b), x the scaled inputs (eq. 12)."""
+    w = np.array([0.3, -0.2, 0.5, 1.1, -2.0, 0.4, 0.05])
+    c = butterfly.ann_controller(w, layers=[6, 1])
+    kind, cp = c.compiled()
+    assert kind == controllers.KIND_MLP and c.parameters["layers"] == [6, 1]
+    theta, omega, y, vy, vz, phi = 0.4, -3.0, 0.7, -0.2, 1.5, 0.1
+    x = np.array(ann.scaled_inputs(cp, theta, omega, y, vy, vz, 0.0, 0.0, phi))
+    want = phi + np.radians(3.0) * ann.transfer(float(w[:6] @ x + w[6]))
+    assert ann.mlp_pitch(cp, theta, omega, y, vy, vz, 0.0, 0.0, phi) == pytest.approx(want, rel=1e-12)
+    assert Flight(c).record(duration_s=0.5).finite
+
+
 def test_an_8_8_network_evolves_and_flies(tmp_path, capsys):
     from lifelike_mj.cli import main
 
