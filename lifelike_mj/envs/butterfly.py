@@ -110,6 +110,11 @@ class ButterflyPitchEnv(gym.Env):
                  phi_limit_deg: float = 30.0, params: ButterflyParams | dict | None = None, config: str = "paper",
                  force_mode: str | None = None, ground_m: float | None = None, render_mode: str | None = None,
                  width: int = 640, height: int = 480, camera: str = "follow") -> None:
+        from lifelike_mj.butterfly.backends import check_backend, mujoco_options
+
+        check_backend(backend)
+        if backend == "mujoco":
+            mujoco_options(config, force_mode)  # an unknown configuration is refused here, not at reset
         if inputs not in ("relative", "ground"):
             raise UserError(f"inputs must be relative or ground, got {inputs!r}.")
         if action_mode not in ACTION_MODES:

@@ -77,7 +77,8 @@ def test_episode_reward_is_the_evolution_fitness(backend):
 def test_bad_arguments_are_one_sentence():
     from lifelike_mj.errors import UserError
 
-    for kw in ({"inputs": "air"}, {"action_mode": "angle"}, {"frame_skip": 0}, {"duration_s": -1},
+    for kw in ({"backend": "jax"}, {"backend": "mujoco", "config": "wide"},
+               {"inputs": "air"}, {"action_mode": "angle"}, {"frame_skip": 0}, {"duration_s": -1},
                {"wind_m_s": (100.0, 0.0)}, {"render_mode": "movie"}, {"camera": "top"}, {"width": 0}):
         with pytest.raises(UserError):
             ButterflyPitchEnv(**kw)
