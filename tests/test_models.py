@@ -21,8 +21,11 @@ P = ButterflyParams()
 
 
 def _is_butterfly(m: mujoco.MjModel) -> bool:
+    """A model of the planar backends' layout (the 3D butterfly, with feathering hinges, has its own)."""
     names = {m.body(i).name for i in range(m.nbody)}
-    return {"butterfly", "wing_left", "wing_right"} <= names and m.nuserdata >= mjbackend.N_USERDATA
+    joints = {m.joint(j).name for j in range(m.njnt)}
+    return ({"butterfly", "wing_left", "wing_right"} <= names and m.nuserdata >= mjbackend.N_USERDATA
+            and "feather_left" not in joints)
 
 
 def _wing_triangle(m: mujoco.MjModel, side: str) -> np.ndarray:
