@@ -28,7 +28,9 @@ import lifelike_mj
 from lifelike_mj.butterfly import PAPER_FLAP, ann, ann_controller
 from lifelike_mj.envs.policies import pitch_actions
 from lifelike_mj.envs.vector import ButterflyPitchVectorEnv
+from lifelike_mj.errors import UserError
 from lifelike_mj.io import write_json
+from lifelike_mj.paths import check_output_file
 
 POLICIES = {"network": list(ann.PAPER_LAYERS), "linear": [ann.N_INPUTS, 1]}
 
@@ -58,7 +60,12 @@ def main() -> int:
     ap.add_argument("--duration", type=float, default=2.0, help="seconds per episode (the paper: 20)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--out", default="gym_cmaes_network.json")
+    ap.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
     args = ap.parse_args()
+    try:  # before any work: never replace a file unasked
+        check_output_file(args.out, "--out", suffixes=(".json",), overwrite=args.overwrite)
+    except UserError as exc:
+        ap.exit(2, f"{ap.prog}: error: {exc}\n")
     layers = POLICIES[args.policy]
     es = cma.CMAEvolutionStrategy(np.zeros(ann.n_weights(layers)), 0.5, {
         "popsize": args.popsize, "seed": args.seed, "bounds": [-5.0, 5.0], "verbose": -9})

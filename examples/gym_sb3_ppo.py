@@ -25,15 +25,23 @@ import time
 from datetime import datetime, timezone
 
 import gymnasium as gym
-import torch
-from stable_baselines3 import PPO
-from stable_baselines3.common.env_util import make_vec_env
-from stable_baselines3.common.vec_env import VecNormalize
+
+try:
+    import torch
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.env_util import make_vec_env
+    from stable_baselines3.common.vec_env import VecNormalize
+except ImportError as exc:  # the rl extra is optional
+    print(f"gym_sb3_ppo.py: error: this example needs the rl extra ({exc.name} is missing): "
+          "pip install torch==2.13.0 'lifelike-mj[rl]'", file=sys.stderr)
+    raise SystemExit(2) from None
 
 import lifelike_mj
 from lifelike_mj.envs.butterfly import ButterflyPitchEnv, ButterflyPitchWindEnv
 from lifelike_mj.envs.policies import NetworkActions, NetworkInputs, network_controller
+from lifelike_mj.errors import UserError
 from lifelike_mj.io import write_json
+from lifelike_mj.paths import check_output_file
 
 
 class PaperTransfer(torch.nn.Module):
@@ -79,7 +87,12 @@ def main() -> int:
     ap.add_argument("--wind", action="store_true", help="train on ButterflyPitchWind-v0 (winds and start altitudes drawn)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--out", default="gym_sb3_ppo.json")
+    ap.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
     args = ap.parse_args()
+    try:  # before any work: never replace a file unasked
+        check_output_file(args.out, "--out", suffixes=(".json",), overwrite=args.overwrite)
+    except UserError as exc:
+        ap.exit(2, f"{ap.prog}: error: {exc}\n")
     model, wall = train(args.steps, args.seed, args.wind, args.frame_skip, verbose=1)
     env = make_env(False, args.frame_skip)
     obs, _ = env.reset()
