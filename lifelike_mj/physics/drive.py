@@ -18,18 +18,79 @@ light body.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
+
+from lifelike_mj.physics import mjabi
+
+_vp = mjabi.voidptr_from_int
+_ptr_at = mjabi.ptr_at
+_f64 = mjabi.f64_at
+_mj_fullM = mjabi.mj_fullM
+_mj_rne = mjabi.mj_rne
+_O_QFRC = mjabi.O_QFRC
+
+
+@njit(cache=True)
+def _torques(M, c, driven, free, a_star, out):
+    """``out[r]``: the torque on ``driven[r]`` (module docstring); ``M_bb`` factored by Cholesky (it is
+    the free body's inertia seen through the joints: symmetric positive definite)."""
+    nb, k = len(free), len(driven)
+    L = np.zeros((nb, nb))
+    for i in range(nb):
+        for j in range(i + 1):
+            s = M[free[i], free[j]]
+            for p in range(j):
+                s -= L[i, p] * L[j, p]
+            L[i, j] = math.sqrt(s) if i == j else s / L[j, j]
+    x = np.empty((nb, k + 1))  # M_bb^-1 [M_bj | c_b]
+    y = np.empty(nb)
+    for col in range(k + 1):
+        for i in range(nb):
+            s = M[free[i], driven[col]] if col < k else c[free[i]]
+            for p in range(i):
+                s -= L[i, p] * y[p]
+            y[i] = s / L[i, i]
+        for i in range(nb - 1, -1, -1):
+            s = y[i]
+            for p in range(i + 1, nb):
+                s -= L[p, i] * x[p, col]
+            x[i, col] = s / L[i, i]
+    for r in range(k):
+        t = c[driven[r]]
+        for p in range(nb):
+            t -= M[driven[r], free[p]] * x[p, k]
+        for q in range(k):
+            s = M[driven[r], driven[q]]
+            for p in range(nb):
+                s -= M[driven[r], free[p]] * x[p, q]
+            t += s * a_star[q]
+        out[r] = t
 
 
 def prescribed_torques(M: np.ndarray, c: np.ndarray, driven: np.ndarray, a_star: np.ndarray) -> np.ndarray:
     """The generalized forces (N m on hinges) on the ``driven`` degrees of freedom that give them the
     accelerations ``a_star`` (rad/s^2), with the others free: see the module docstring. ``M``: the
     dense ``(nv, nv)`` inertia matrix; ``c``: the ``nv`` bias forces less the applied ones."""
-    nv = M.shape[0]
-    driven = np.asarray(driven, dtype=np.int64)
-    free = np.setdiff1d(np.arange(nv), driven)
-    m_bb, m_bj = M[np.ix_(free, free)], M[np.ix_(free, driven)]
-    m_jb, m_jj = M[np.ix_(driven, free)], M[np.ix_(driven, driven)]
-    x = np.linalg.solve(m_bb, np.column_stack([m_bj, c[free]]))
-    k = len(driven)
-    return (m_jj - m_jb @ x[:, :k]) @ np.asarray(a_star, dtype=np.float64) + c[driven] - m_jb @ x[:, k]
+    driven = np.ascontiguousarray(driven, dtype=np.int64)
+    free = np.setdiff1d(np.arange(M.shape[0]), driven).astype(np.int64)
+    out = np.empty(len(driven))
+    _torques(np.ascontiguousarray(M, dtype=np.float64), np.ascontiguousarray(c, dtype=np.float64), driven, free,
+             np.ascontiguousarray(a_star, dtype=np.float64), out)
+    return out
+
+
+@njit(cache=True)
+def native_torques(mptr, dptr, off, nv, driven, free, a_star, M, c, out):
+    """:func:`prescribed_torques` from inside a compiled passive callback: ``M`` from ``mj_fullM``,
+    ``c`` from ``mj_rne`` less what ``qfrc_passive`` holds so far (the air's forces added before the
+    call count as applied). ``M`` (``nv * nv``) and ``c`` (``nv``) are scratch; ``off``: the mjData
+    offsets (:func:`lifelike_mj.physics.mjabi.offsets_tuple`)."""
+    _mj_fullM(_vp(mptr), _vp(dptr), _vp(M.ctypes.data))
+    _mj_rne(_vp(mptr), _vp(dptr), np.int32(0), _vp(c.ctypes.data))
+    qfrc = _f64(_ptr_at(dptr + off[_O_QFRC]), nv)
+    for i in range(nv):
+        c[i] -= qfrc[i]
+    _torques(M.reshape((nv, nv)), c, driven, free, a_star, out)

@@ -10,7 +10,8 @@ addresses of the arrays that the Python bindings expose; a mismatch (a MuJoCo ve
 layout we do not understand) raises instead of corrupting memory.
 
 The same module declares MuJoCo's functions to numba (:data:`mj_step`, :data:`mj_applyFT`,
-:data:`mj_objectVelocity`, :data:`mj_ray`) as external functions resolved by name in ``libmujoco``
+:data:`mj_objectVelocity`, :data:`mj_ray`, :data:`mj_fullM`, :data:`mj_rne`) as external functions
+resolved by name in ``libmujoco``
 (the very library the bindings loaded), so compiled code calls them without Python.
 
 **Caching.** A compiled function is cached on disk (numba ``cache=True``) only if it holds nothing
@@ -102,6 +103,10 @@ def libmujoco() -> ctypes.CDLL:
     lib.mj_objectVelocity.restype = None
     lib.mj_kinematics.argtypes = [vp, vp]
     lib.mj_kinematics.restype = None
+    lib.mj_fullM.argtypes = [vp, vp, vp]
+    lib.mj_fullM.restype = None
+    lib.mj_rne.argtypes = [vp, vp, ci, vp]
+    lib.mj_rne.restype = None
     lib.mj_ray.argtypes = [vp, vp, vp, vp, vp, ctypes.c_ubyte, ci, vp, vp]  # ... flg_static, bodyexclude, geomid, normal
     lib.mj_ray.restype = ctypes.c_double
     return lib
@@ -195,6 +200,10 @@ mj_step = _external("mj_step", types.void(_vp_t, _vp_t))
 mj_applyFT = _external("mj_applyFT", types.void(_vp_t, _vp_t, _vp_t, _vp_t, _vp_t, _i32, _vp_t))
 #: ``void mj_objectVelocity(m, d, int objtype, int objid, res[6], int flg_local)``
 mj_objectVelocity = _external("mj_objectVelocity", types.void(_vp_t, _vp_t, _i32, _i32, _vp_t, _i32))
+#: ``void mj_fullM(m, d, mjtNum* dst)``: the dense ``nv x nv`` inertia matrix (row-major)
+mj_fullM = _external("mj_fullM", types.void(_vp_t, _vp_t, _vp_t))
+#: ``void mj_rne(m, d, int flg_acc, mjtNum* result)``: ``M qacc + c`` (``flg_acc = 0``: the bias ``c``)
+mj_rne = _external("mj_rne", types.void(_vp_t, _vp_t, _i32, _vp_t))
 #: ``mjtNum mj_ray(m, d, pnt[3], vec[3], geomgroup, mjtBool flg_static, int bodyexclude, geomid[1], normal[3])``
 mj_ray = _external("mj_ray", types.float64(_vp_t, _vp_t, _vp_t, _vp_t, _vp_t, types.uint8, _i32, _vp_t, _vp_t))
 

@@ -58,3 +58,22 @@ def test_the_joints_own_inertia_alone_misses_the_recoil(model):
     d.qfrc_applied[dofs] = M[dofs, dofs] * a_star + (d.qfrc_bias - d.qfrc_passive)[dofs]
     mujoco.mj_forward(model, d)
     assert np.abs(d.qacc[dofs] / a_star - 1.0).max() > 0.2
+
+
+def test_the_compiled_drive_reads_mujoco_itself_and_gives_the_same_torques(model):
+    from lifelike_mj.physics import mjabi
+    from lifelike_mj.physics.drive import native_torques
+
+    d = _state(model, 7)
+    mujoco.mj_forward(model, d)
+    d.qfrc_passive[:] = np.linspace(-1e-4, 1e-4, model.nv)  # as if the air had pushed already
+    dofs = np.array([model.jnt_dofadr[model.joint(n).id] for n in DRIVEN], dtype=np.int64)
+    free = np.setdiff1d(np.arange(model.nv), dofs).astype(np.int64)
+    a_star = np.linspace(-200.0, 300.0, len(dofs))
+    M = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, d, M)
+    want = prescribed_torques(M, d.qfrc_bias - d.qfrc_passive, dofs, a_star)
+    got = np.empty(len(dofs))
+    native_torques(model._address, d._address, mjabi.offsets_tuple(), model.nv, dofs, free, a_star,
+                   np.empty(model.nv * model.nv), np.empty(model.nv), got)
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-15)
