@@ -29,11 +29,9 @@ def _set_pitch(a, phis, live, dphi_mode, max_dphi, phi_limit):
 
 
 @njit(cache=True, error_model="numpy")
-def _finish(live, cols, phis, airs, relative, before, after, reset, diverged, ks, n_steps, ground,
-            obs, rewards, terminated, truncated):
-    """Observation, reward and episode end of every copy after a step, as the single environment
-    computes them: ``cols`` rows ``y, v_y, v_z, theta, omega``; a copy that was reset this step (not
-    ``live``) gets reward 0 and no episode end."""
+def _observe(cols, phis, airs, relative, obs):
+    """Every copy's observation, as the single environment builds it: ``cols`` rows ``y, v_y, v_z,
+    theta, omega``; velocities made air-relative if ``relative``; anything not finite shown as 0."""
     for b in range(len(phis)):
         vy = cols[b, 1]
         vz = cols[b, 2]
@@ -50,9 +48,19 @@ def _finish(live, cols, phis, airs, relative, before, after, reset, diverged, ks
         for j in range(6):
             if not math.isfinite(o[j]):
                 o[j] = 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _finish(live, cols, phis, airs, relative, before, after, reset, diverged, ks, n_steps, ground,
+            obs, rewards, terminated, truncated):
+    """Observation (:func:`_observe`), reward and episode end of every copy after a step, as the single
+    environment computes them; a copy that was reset this step (not ``live``) gets reward 0 and no
+    episode end."""
+    _observe(cols, phis, airs, relative, obs)
+    for b in range(len(phis)):
         r = after[b] - before[b]
         rewards[b] = r if live[b] and reset[b] == 0 and math.isfinite(r) else 0.0
-        term = live[b] and (diverged[b] >= 0 or (ground > 0.0 and o[4] < -ground))
+        term = live[b] and (diverged[b] >= 0 or (ground > 0.0 and obs[b, 4] < -ground))
         terminated[b] = term
         truncated[b] = live[b] and not term and ks[b] >= n_steps
 
@@ -107,20 +115,21 @@ class _MujocoBatch:
     """The MuJoCo backend's butterflies: one ``mjData`` per row on one model, stepped together by
     :func:`lifelike_mj.butterfly.backends.mj.step_batch` with the compiled wing-force callback."""
 
-    def __init__(self, n: int, params: ButterflyParams, dt_s: float, config: str, force_mode: str | None) -> None:
+    def __init__(self, n: int, params: ButterflyParams, dt_s: float, config: str, force_mode: str | None,
+                 controller) -> None:
         from lifelike_mj.butterfly.backends import mj, mujoco_options
+        from lifelike_mj.physics.callbacks import passive_callback
+        from lifelike_mj.physics.stability import watching
 
-        self.mj = mj
+        self.mj, self._passive_callback, self._watching = mj, passive_callback, watching
         self.dt = dt_s
         self.params = params
         self.options = mujoco_options(config, force_mode)
         self.model = mj.build_model(params, self.options["config"])
         self.model.opt.timestep = dt_s
         self.lay = mj.layout(self.model).as_array()
-        self.flap = PAPER_FLAP.as_array()
-        from lifelike_mj.butterfly import ButterflyController
-
-        self._controller = ButterflyController("constant", PAPER_FLAP, {"phi_deg": 0.0})
+        self.flap = controller.flap.as_array()
+        self._controller = controller  # setup_data reads its flap pattern
         self.datas: list = [None] * n
         self.dptrs = np.zeros(n, dtype=np.int64)
         self.ks = np.zeros(n, dtype=np.int64)
@@ -142,11 +151,8 @@ class _MujocoBatch:
                         -f[1] * f[2] * math.sin(0.0))
 
     def step(self, idx: np.ndarray, phis: np.ndarray, n: int) -> None:
-        from lifelike_mj.physics.callbacks import passive_callback
-        from lifelike_mj.physics.stability import watching
-
         mj = self.mj
-        with passive_callback(mj.COMPILED_PASSIVE), watching():
+        with self._passive_callback(mj.COMPILED_PASSIVE), self._watching():
             mj.step_batch(self.model._address, self.dptrs, idx, phis, self.ks, n, self.flap, self.lay, self.dt,
                           self.diverged, self.reset, self.fits, self.cols, mj._OFFSETS)
 
@@ -197,7 +203,7 @@ class ButterflyPitchVectorEnv(VectorEnv):
             self._batch: _PaperBatch | _MujocoBatch = _PaperBatch(num_envs, s.params, s.dt_s)
         else:
             opts = s._flight_options
-            self._batch = _MujocoBatch(num_envs, s.params, s.dt_s, opts["config"], opts["force_mode"])
+            self._batch = _MujocoBatch(num_envs, s.params, s.dt_s, opts["config"], opts["force_mode"], s._controller)
         self._phis = np.zeros(num_envs)
         self._every = np.arange(num_envs)
         self._all_live = np.ones(num_envs, dtype=bool)
@@ -275,12 +281,8 @@ class ButterflyPitchVectorEnv(VectorEnv):
         self._ended[i] = False
 
     def _observations(self) -> np.ndarray:
-        n, b = self.num_envs, self._batch
-        obs, rewards = np.empty((n, 6)), np.empty(n)
-        flags = np.empty(n, dtype=bool)
-        none = np.zeros(n, dtype=bool)
-        _finish(none, b.columns(), self._phis, self._airs, self.single.inputs == "relative", rewards, rewards, b.reset,
-                b.diverged, b.ks, self.single.n_steps, -1.0, obs, rewards, flags, flags)
+        obs = np.empty((self.num_envs, 6))
+        _observe(self._batch.columns(), self._phis, self._airs, self.single.inputs == "relative", obs)
         return obs
 
     def _reset_info(self, which: np.ndarray) -> dict:
