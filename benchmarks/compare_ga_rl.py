@@ -37,7 +37,7 @@ import lifelike_mj
 from lifelike_mj import evolve
 from lifelike_mj.butterfly import PAPER_FLAP, ann, controllers
 from lifelike_mj.butterfly.controllers import KIND_ANN, KIND_MLP
-from lifelike_mj.envs.policies import pitch_actions
+from lifelike_mj.envs.policies import episode_returns, pitch_actions
 from lifelike_mj.envs.vector import ButterflyPitchVectorEnv
 from lifelike_mj.io import write_json
 from lifelike_mj.provenance import provenance
@@ -69,15 +69,9 @@ class EnvEpisodes:
         env = ButterflyPitchVectorEnv(n, wind=self.wind, action_mode="phi", frame_skip=self.frame_skip,
                                       duration_s=EPISODE_S, max_dphi_deg=3.0 * self.frame_skip)
         cps = np.array([network(w, self.frame_skip) for w in X])
-        obs, _ = env.reset(seed=self.seed * 1_000_003 + self.episodes)  # a fresh condition per episode
+        seed = self.seed * 1_000_003 + self.episodes  # a fresh condition per episode
         self.episodes += n
-        kinds = np.full(n, KIND_ANN)
-        total, done = np.zeros(n), np.zeros(n, dtype=bool)
-        while not done.all():
-            obs, r, term, trunc, _ = env.step(pitch_actions(kinds, cps, obs))
-            total += np.where(done, 0.0, r)
-            done |= term | trunc
-        return total
+        return episode_returns(env, np.full(n, KIND_ANN), cps, seed=seed)
 
     def fingerprint(self) -> str:
         return "env-episodes:" + hashlib.sha256(f"{self.wind} {self.frame_skip} {self.seed}".encode()).hexdigest()[:12]

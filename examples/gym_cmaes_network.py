@@ -26,7 +26,7 @@ import numpy as np
 
 import lifelike_mj
 from lifelike_mj.butterfly import PAPER_FLAP, ann, ann_controller
-from lifelike_mj.envs.policies import pitch_actions
+from lifelike_mj.envs import policies
 from lifelike_mj.envs.vector import ButterflyPitchVectorEnv
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import write_json
@@ -42,14 +42,8 @@ def episode_returns(weights: np.ndarray, duration_s: float, layers=ann.PAPER_LAY
     compiled = [ann_controller(w, PAPER_FLAP, "relative", layers=layers).compiled() for w in weights]
     kinds = np.array([k for k, _ in compiled])
     cps = np.array([cp for _, cp in compiled])
-    obs, _ = env.reset(seed=0)
-    total, done = np.zeros(n), np.zeros(n, dtype=bool)
-    while not done.all():
-        # each network reads its copy's observation and sets the pitch (one compiled loop for all)
-        obs, reward, term, trunc, _ = env.step(pitch_actions(kinds, cps, obs))
-        total += np.where(done, 0.0, reward)
-        done |= term | trunc
-    return total
+    # each network reads its copy's observation and sets the pitch (one compiled loop for all)
+    return policies.episode_returns(env, kinds, cps, seed=0)
 
 
 def main() -> int:

@@ -48,6 +48,21 @@ def pitch_actions(kinds: np.ndarray, cparams: np.ndarray, obs: np.ndarray) -> np
     return out
 
 
+def episode_returns(env, kinds: np.ndarray, cparams: np.ndarray, *, seed: int | None = None,
+                    options: dict | None = None) -> np.ndarray:
+    """One episode of each copy of the vector environment ``env`` (``action_mode="phi"``) flown by its
+    compiled controller (:func:`pitch_actions`), from ``env.reset(seed=seed, options=options)``: the
+    summed rewards, eq. 13's H of each flight. The steps after a copy's episode ends (its autoreset)
+    are not counted."""
+    obs, _ = env.reset(seed=seed, options=options)
+    total, done = np.zeros(env.num_envs), np.zeros(env.num_envs, dtype=bool)
+    while not done.all():
+        obs, reward, term, trunc, _ = env.step(pitch_actions(kinds, cparams, obs))
+        total += np.where(done, 0.0, reward)
+        done |= term | trunc
+    return total
+
+
 def controller_policy(controller: ButterflyController | str | Path, env) -> Callable[[np.ndarray], np.ndarray]:
     """``policy(obs) -> action`` that flies ``controller`` (an object, or a controller file's name or
     path) through ``env`` (a single or vector ``ButterflyPitch`` environment with ``action_mode="phi"``):
