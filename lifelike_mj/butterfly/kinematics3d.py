@@ -71,7 +71,8 @@ class Kinematics:
         self.command = command or KinematicsCommand()
         self.omega_c = (2.0 * math.pi * self.command.frequency_hz if omega_c is None
                         else checks.positive("omega_c", omega_c, "rad/s"))
-        self.p = self.command.as_array()  # the parameters flown
+        self._target = self.command.as_array()  # the command's parameters, as the filter reads them
+        self.p = self._target.copy()  # the parameters flown
         self.dp = np.zeros_like(self.p)  # and their rates (per s)
         self.psi = 0.0  # the flap phase (rad)
 
@@ -80,25 +81,26 @@ class Kinematics:
         if not isinstance(command, KinematicsCommand):
             raise UserError(f"a kinematics command is a KinematicsCommand, got {command!r}.")
         self.command = command
+        self._target = command.as_array()
 
     def advance(self, dt: float) -> None:
         """Advance ``dt`` seconds: the filter exactly (critically damped, constant command over the step),
         the phase by the trapezoid of the frequency (exact for a frequency linear over the step)."""
         w = self.omega_c
         e = math.exp(-w * dt)
-        x0 = self.p - self.command.as_array()
+        x0 = self.p - self._target
         v0 = self.dp
         # x(t) = (x0 + (v0 + w x0) t) e^{-wt}: the critically damped solution
         b = v0 + w * x0
         f0 = self.p[0]
-        self.p = self.command.as_array() + (x0 + b * dt) * e
+        self.p = self._target + (x0 + b * dt) * e
         self.dp = (b - w * (x0 + b * dt)) * e
         self.psi += math.pi * (f0 + self.p[0]) * dt
 
     def joint_references(self) -> np.ndarray:
         """``(5, 3)``: angle (rad), rate (rad/s) and acceleration (rad/s^2) of each of :data:`JOINTS` now."""
         p, dp = self.p, self.dp
-        x = p - self.command.as_array()
+        x = p - self._target
         ddp = -self.omega_c ** 2 * x - 2.0 * self.omega_c * dp  # the filter's acceleration
         psi, dpsi, ddpsi = self.psi, 2.0 * math.pi * p[0], 2.0 * math.pi * dp[0]
         out = np.empty((5, 3))
