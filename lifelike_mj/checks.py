@@ -63,3 +63,15 @@ def whole(name: str, v: object, lo: int | None = None, hi: int | None = None) ->
             rng = "a whole number"
         raise UserError(f"{name} must be {rng}, got {v!r}.")
     return int(v)
+
+
+def vector(name: str, v: object, n: int, unit: str = "") -> tuple[float, ...]:
+    """``v`` as a tuple of ``n`` floats; a :class:`UserError` unless it is a sequence of ``n`` finite numbers."""
+    try:
+        items = list(v)  # type: ignore[call-overload]
+    except TypeError:
+        items = None
+    if items is None or len(items) != n or not all(is_number(x) and math.isfinite(float(x)) for x in items):
+        u = f" ({unit})" if unit else ""
+        raise UserError(f"{name} must be {n} finite numbers{u}, got {v!r}.")
+    return tuple(float(x) for x in items)

@@ -23,6 +23,7 @@ import math
 from dataclasses import dataclass, fields
 
 import numpy as np
+from numba import njit
 
 from lifelike_mj import checks
 from lifelike_mj.errors import UserError
@@ -63,6 +64,54 @@ class KinematicsCommand:
         return tuple(f.name for f in fields(KinematicsCommand))
 
 
+@njit(cache=True)
+def filter_at(p0, dp0, target, psi0, omega_c, tau, p, dp, ddp):
+    """The kinematics ``tau`` seconds after the state ``p0, dp0, psi0`` under a constant ``target``: writes the
+    parameters ``p``, their rates ``dp`` and accelerations ``ddp``; returns the flap phase (rad).
+
+    The critically damped filter ``x'' = -omega_c^2 x - 2 omega_c x'`` (``x = p - target``) solved exactly:
+    ``x(tau) = (x0 + b tau) e^(-omega_c tau)`` with ``b = v0 + omega_c x0``; the phase is the exact integral
+    of ``2 pi f`` (``f = p[0]``) over ``[0, tau]``. Shared by :class:`Kinematics` and the compiled callback,
+    which evaluates it at each Runge-Kutta stage."""
+    w = omega_c
+    e = math.exp(-w * tau)
+    for i in range(len(p0)):
+        x0 = p0[i] - target[i]
+        b = dp0[i] + w * x0
+        x = (x0 + b * tau) * e
+        p[i] = target[i] + x
+        dp[i] = (b - w * (x0 + b * tau)) * e
+        ddp[i] = -w * w * x - 2.0 * w * dp[i]
+    x0 = p0[0] - target[0]
+    b = dp0[0] + w * x0
+    # integral of x over [0, tau]: x0 (1 - e)/w + b (1 - e (1 + w tau))/w^2
+    integral = x0 * (1.0 - e) / w + b * (1.0 - e * (1.0 + w * tau)) / (w * w)
+    return psi0 + 2.0 * math.pi * (target[0] * tau + integral)
+
+
+@njit(cache=True)
+def joint_refs(p, dp, ddp, psi, out):
+    """``out[j]``: angle (rad), rate (rad/s) and acceleration (rad/s^2) of joint ``j`` of :data:`JOINTS`, from
+    the parameters, their rates and accelerations and the flap phase (module docstring)."""
+    dpsi = 2.0 * math.pi * p[0]
+    ddpsi = 2.0 * math.pi * dp[0]
+    for j in range(5):
+        im, ia, ip = _TERMS[j, 0], _TERMS[j, 1], _TERMS[j, 2]
+        ph, dph, ddph = (p[ip], dp[ip], ddp[ip]) if ip >= 0 else (0.0, 0.0, 0.0)
+        u, du, ddu = psi + ph, dpsi + dph, ddpsi + ddph
+        c, s = math.cos(u), math.sin(u)
+        a, da, dda = p[ia], dp[ia], ddp[ia]
+        out[j, 0] = p[im] + a * c
+        out[j, 1] = dp[im] + da * c - a * du * s
+        out[j, 2] = ddp[im] + dda * c - 2.0 * da * du * s - a * ddu * s - a * du * du * c
+
+
+#: Per joint of :data:`JOINTS`: the parameter indices of its mean, amplitude and phase (-1: none).
+_TERMS = np.array([(1, 3, -1), (2, 4, -1), (5, 7, 9), (6, 8, 9), (10, 11, 12)], dtype=np.int64)
+#: Number of kinematics parameters (the fields of :class:`KinematicsCommand`).
+N_PARAMS = 13
+
+
 class Kinematics:
     """The kinematics flown: the parameters, their rates and the flap phase, advanced step by step
     towards the latest :class:`KinematicsCommand` (module docstring)."""
@@ -71,8 +120,8 @@ class Kinematics:
         self.command = command or KinematicsCommand()
         self.omega_c = (2.0 * math.pi * self.command.frequency_hz if omega_c is None
                         else checks.positive("omega_c", omega_c, "rad/s"))
-        self._target = self.command.as_array()  # the command's parameters, as the filter reads them
-        self.p = self._target.copy()  # the parameters flown
+        self.target = self.command.as_array()  # the command's parameters, as the filter reads them
+        self.p = self.target.copy()  # the parameters flown
         self.dp = np.zeros_like(self.p)  # and their rates (per s)
         self.psi = 0.0  # the flap phase (rad)
 
@@ -81,37 +130,17 @@ class Kinematics:
         if not isinstance(command, KinematicsCommand):
             raise UserError(f"a kinematics command is a KinematicsCommand, got {command!r}.")
         self.command = command
-        self._target = command.as_array()
+        self.target = command.as_array()
 
     def advance(self, dt: float) -> None:
-        """Advance ``dt`` seconds: the filter exactly (critically damped, constant command over the step),
-        the phase by the trapezoid of the frequency (exact for a frequency linear over the step)."""
-        w = self.omega_c
-        e = math.exp(-w * dt)
-        x0 = self.p - self._target
-        v0 = self.dp
-        # x(t) = (x0 + (v0 + w x0) t) e^{-wt}: the critically damped solution
-        b = v0 + w * x0
-        f0 = self.p[0]
-        self.p = self._target + (x0 + b * dt) * e
-        self.dp = (b - w * (x0 + b * dt)) * e
-        self.psi += math.pi * (f0 + self.p[0]) * dt
+        """Advance ``dt`` seconds: the filter and the phase exactly (:func:`filter_at`, the command held)."""
+        p, dp, ddp = np.empty(N_PARAMS), np.empty(N_PARAMS), np.empty(N_PARAMS)
+        self.psi = filter_at(self.p, self.dp, self.target, self.psi, self.omega_c, dt, p, dp, ddp)
+        self.p, self.dp = p, dp
 
     def joint_references(self) -> np.ndarray:
         """``(5, 3)``: angle (rad), rate (rad/s) and acceleration (rad/s^2) of each of :data:`JOINTS` now."""
-        p, dp = self.p, self.dp
-        x = p - self._target
-        ddp = -self.omega_c ** 2 * x - 2.0 * self.omega_c * dp  # the filter's acceleration
-        psi, dpsi, ddpsi = self.psi, 2.0 * math.pi * p[0], 2.0 * math.pi * dp[0]
+        ddp = -self.omega_c ** 2 * (self.p - self.target) - 2.0 * self.omega_c * self.dp  # the filter's acceleration
         out = np.empty((5, 3))
-        # (mean index, amplitude index, phase index or -1) per joint
-        terms = ((1, 3, -1), (2, 4, -1), (5, 7, 9), (6, 8, 9), (10, 11, 12))
-        for j, (im, ia, ip) in enumerate(terms):
-            ph, dph, ddph = (p[ip], dp[ip], ddp[ip]) if ip >= 0 else (0.0, 0.0, 0.0)
-            u, du, ddu = psi + ph, dpsi + dph, ddpsi + ddph
-            c, s = math.cos(u), math.sin(u)
-            a, da, dda = p[ia], dp[ia], ddp[ia]
-            out[j, 0] = p[im] + a * c
-            out[j, 1] = dp[im] + da * c - a * du * s
-            out[j, 2] = ddp[im] + dda * c - 2.0 * da * du * s - a * ddu * s - a * du * du * c
+        joint_refs(self.p, self.dp, ddp, self.psi, out)
         return out

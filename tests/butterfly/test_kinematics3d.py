@@ -73,3 +73,22 @@ def test_bad_commands_are_one_sentence():
         KinematicsCommand(amplitude_left=float("nan"))
     with pytest.raises(UserError, match="KinematicsCommand"):
         Kinematics().set_command({"frequency_hz": 10.0})
+
+
+def test_the_phase_is_the_exact_integral_of_the_frequency_whatever_the_steps():
+    """One long step and many short ones give the same state (the filter and the phase are solved exactly),
+    and the phase is the integral of 2 pi f along the way (checked by a fine trapezoid)."""
+    cmd = KinematicsCommand(frequency_hz=14.0, amplitude_left=0.7)
+    one, many = Kinematics(), Kinematics()
+    one.set_command(cmd)
+    many.set_command(cmd)
+    one.advance(0.05)
+    fs = [many.p[0]]
+    for _ in range(5000):
+        many.advance(0.05 / 5000)
+        fs.append(many.p[0])
+    np.testing.assert_allclose(one.p, many.p, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(one.dp, many.dp, rtol=1e-9, atol=1e-9)
+    assert one.psi == pytest.approx(many.psi, rel=1e-12)
+    assert one.psi == pytest.approx(2 * math.pi * np.trapezoid(fs, dx=0.05 / 5000), rel=1e-8)
+    assert one.psi > 2 * math.pi * 10.0 * 0.05  # the frequency rose from 10 Hz towards 14 Hz
