@@ -12,8 +12,13 @@ amplitude and offset, feathering, the abdomen), which change smoothly whenever a
     flight.step(1200)                       # one second
     print(flight.state()["position_m"])     # x forward, y to the left, z up (m)
 
-A controller is any callable ``controller(flight) -> KinematicsCommand | None``, called before every
-``control_every``-th step (``None``: keep the command).
+A controller is a 3D controller file (:mod:`~lifelike_mj.butterfly.control3d`: a network from the body's
+attitude and motion to changes of the kinematics, flown in the compiled loop towards a task's references),
+or any callable ``controller(flight) -> KinematicsCommand | None``, called from Python before every
+``control_every``-th step (``None``: keep the command)::
+
+    from lifelike_mj.butterfly import evolve3d
+    Flight3D(controller="level", task=evolve3d.turn(90.0)).step(6000)
 
 World frame: x forward at the start, y to the left, z up; the body's pitch is nose-up positive, its roll
 right-wing-down positive, its yaw to the left positive.
@@ -23,17 +28,19 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from pathlib import Path
 
 import mujoco
 import numpy as np
 
 from lifelike_mj import checks
 from lifelike_mj.butterfly.backends import mj3d
-from lifelike_mj.butterfly.kinematics3d import JOINTS, Kinematics, KinematicsCommand
+from lifelike_mj.butterfly.kinematics3d import JOINTS, N_PARAMS, Kinematics, KinematicsCommand
 from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.errors import Diverged, UserError
+from lifelike_mj.physics import mjabi
 from lifelike_mj.physics.callbacks import passive_callback
-from lifelike_mj.physics.stability import describe, was_reset, watching
+from lifelike_mj.physics.stability import describe, watching
 from lifelike_mj.stepper import StepCounter
 
 #: Names of :meth:`Flight3D.state` and their units.
@@ -46,6 +53,7 @@ STATE_UNITS = {
     "joint_rates_rad_s": "rad/s: the same joints' rates",
 }
 
+_NO_PATH = np.empty((0, 7))
 #: The fewest time steps per wing beat a 3D flight accepts.
 MIN_STEPS_PER_BEAT = 8
 #: A speed above this (m/s) is a runaway: the flight has diverged.
@@ -71,36 +79,52 @@ def quat_from_pitch(pitch_rad: float) -> np.ndarray:
 class Flight3D(StepCounter):
     """One 3D butterfly in free flight (module docstring).
 
-    ``command``: the kinematics at the start (default: the paper's 10 Hz flap over [-60, 75] deg, no
-    feathering); ``params``: the physical constants (mass, wing size, air; Oe 2010 Table 1);
-    ``controller`` and ``control_every``: see the module docstring; ``wind_m_s``: the air's velocity
-    (world frame, m/s); ``start_m``: the thorax's start position. Model options: ``force_law``
-    (``strip``: eq. 1 on wing panels; ``tip``: the paper's tip-speed formula; ``none``), ``drag_frame``
-    (``body`` or ``world``), ``body_areas_m2`` (the body's drag areas along x, y, z; default the paper's
-    ``A_b`` on every axis), ``masses`` (``animal`` or ``paper``), ``n_strips`` and ``n_chord`` (panels per
-    wing), ``drive_hz`` (the joints' tracking bandwidth), ``omega_c`` (rad/s, how fast the kinematics
-    follow a command; default one wing beat). ``assist="hold"`` holds the attitude at
-    ``pitch_law(flight)`` (rad, nose up), set once per step, roll and yaw 0: the reduction check to the
-    planar model, not free flight.
+    ``command``: the kinematics at the start (default: the controller's base command, else the paper's
+    10 Hz flap over [-60, 75] deg, no feathering); ``params``: the physical constants (mass, wing size,
+    air; Oe 2010 Table 1). ``controller``: a 3D controller (:class:`~lifelike_mj.butterfly.control3d.Controller3D`,
+    or the name or path of a controller file), flown in the compiled loop towards ``task``'s references
+    (:class:`~lifelike_mj.butterfly.evolve3d.Task3D`; default level flight at 1.5 m/s), or any callable
+    ``controller(flight) -> KinematicsCommand | None`` run from Python before every ``control_every``-th
+    step. ``wind_m_s``: the air's velocity (world frame, m/s); ``start_m``: the thorax's start position.
+    Model options: ``force_law`` (``strip``: eq. 1 on wing panels; ``tip``: the paper's tip-speed formula;
+    ``none``), ``drag_frame`` (``body`` or ``world``), ``body_areas_m2`` (the body's drag areas along x, y,
+    z; default the paper's ``A_b`` on every axis), ``masses`` (``animal`` or ``paper``), ``n_strips`` and
+    ``n_chord`` (panels per wing), ``drive_hz`` (the joints' tracking bandwidth), ``omega_c`` (rad/s, how
+    fast the kinematics follow a command; default the controller's, else one wing beat).
+    ``assist="hold"`` holds the attitude at ``pitch_law(flight)`` (rad, nose up), set once per step, roll
+    and yaw 0: the reduction check to the planar model, not free flight.
     """
 
     def __init__(self, command: KinematicsCommand | None = None, params: ButterflyParams | None = None, *,
-                 controller: Callable | None = None, control_every: int = 1, wind_m_s=(0.0, 0.0, 0.0),
+                 controller=None, task=None, control_every: int = 1, wind_m_s=(0.0, 0.0, 0.0),
                  start_m=(0.0, 0.0, 0.0), force_law: str = "strip", drag_frame: str = "body",
                  body_areas_m2=None, masses: str = "animal", dt_s: float = 1.0 / 1200.0, n_strips: int = 16,
                  n_chord: int = 3, drive_hz: float = 50.0, omega_c: float | None = None, assist: str = "none",
                  pitch_law: Callable | None = None, _model: mujoco.MjModel | None = None) -> None:
+        from lifelike_mj.butterfly import control3d, evolve3d
+
+        self.network = None
+        if isinstance(controller, (str, Path)):
+            controller = control3d.load_controller(controller)
+        if isinstance(controller, control3d.Controller3D):
+            self.network, controller = controller, None
+            omega_c = self.network.omega_c_rad_s if omega_c is None else omega_c
+            command = command or self.network.base
+        elif controller is not None and not callable(controller):
+            raise UserError(f"a controller is a 3D controller or a function of the flight returning a command, "
+                            f"got {controller!r}.")
         self.command = command or KinematicsCommand()
         if not isinstance(self.command, KinematicsCommand):
             raise UserError(f"a kinematics command is a KinematicsCommand, got {self.command!r}.")
+        self.task = task if task is not None else evolve3d.level(1.5)
+        if not isinstance(self.task, evolve3d.Task3D):
+            raise UserError(f"a task is a Task3D (evolve3d.level, turn, course), got {self.task!r}.")
         self.params = params or ButterflyParams()
         self.dt = checks.positive("time step dt_s", dt_s, "s")
         period = 1.0 / self.command.frequency_hz
         if self.dt > period / MIN_STEPS_PER_BEAT:
             raise UserError(f"time step {self.dt:g} s does not resolve the {period:g} s wing beat: it must be at most "
                             f"1/{MIN_STEPS_PER_BEAT} of it ({period / MIN_STEPS_PER_BEAT:g} s).")
-        if controller is not None and not callable(controller):
-            raise UserError(f"a controller is a function of the flight returning a command, got {controller!r}.")
         if assist == "hold" and not callable(pitch_law):
             raise UserError("the attitude hold needs pitch_law, a function of the flight returning the pitch (rad).")
         self.controller, self.control_every = controller, checks.whole("control_every", control_every, 1)
@@ -116,6 +140,15 @@ class Flight3D(StepCounter):
         self._root_q = int(self._model.jnt_qposadr[self._model.joint("root").id])
         self._root_d = int(self._model.jnt_dofadr[self._model.joint("root").id])
         self._q, self._driven, _ = mj3d.driven_dofs(self._model)
+        n_rows = len(self.task.rows)
+        self._task = self.task.as_array(n_rows)
+        self._n_rows = n_rows
+        net = self.network
+        self._layers = net.layers if net else np.zeros(1, dtype=np.int64)
+        self._weights = net.weights if net else np.zeros(0)
+        self._scale = net.scale if net else np.zeros(9)
+        self._every = net.every if net else 1
+        self._base = (net.base if net else self.command).as_array()
         self.reset()
 
     # ---- the stepper shape ---------------------------------------------------------------------
@@ -135,52 +168,99 @@ class Flight3D(StepCounter):
     def reset(self, seed: int | None = None) -> None:
         """Back to the start: at rest at ``start_m``, level, heading +x, the kinematics at the start command.
         The flight has no randomness yet; ``seed`` is accepted for the common shape."""
+        from lifelike_mj.butterfly.evolve3d import new_record
+
         self._k = 0
-        self.kinematics = Kinematics(self.command, self.omega_c)
-        self._data = mj3d.setup_data(self._model, self.kinematics, self.params, air_m_s=self.wind_m_s,
-                                     **self.options)
+        kin = Kinematics(self.command, self.omega_c)
+        self._data = mj3d.setup_data(self._model, kin, self.params, air_m_s=self.wind_m_s, **self.options)
         self._data.qpos[self._root_q : self._root_q + 3] = self.start_m
+        self._rec = new_record(1, self._n_rows)[0]
         self._diverged = ""
 
+    @property
+    def kinematics(self) -> Kinematics:
+        """The kinematics now (a copy: parameters, rates, phase and command; change them with :meth:`set_command`)."""
+        ud = self._data.userdata
+        k = Kinematics(self.command, ud[mj3d.U_OMEGA_C])
+        k.p = ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS].copy()
+        k.dp = ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS].copy()
+        k.psi = float(ud[mj3d.U_PSI0])
+        k.target = ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS].copy()
+        return k
+
     def set_command(self, command: KinematicsCommand) -> None:
-        """The kinematics head for ``command`` from now on (smoothly)."""
-        self.kinematics.set_command(command)
+        """The kinematics head for ``command`` from now on (smoothly). A 3D controller's next command replaces it."""
+        if not isinstance(command, KinematicsCommand):
+            raise UserError(f"a kinematics command is a KinematicsCommand, got {command!r}.")
+        self.command = command
+        self._data.userdata[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS] = command.as_array()
+
+    def _fly(self, n: int) -> None:
+        from lifelike_mj.butterfly import control3d
+
+        m, d = self._model, self._data
+        control3d.fly_steps(m._address, d._address, mjabi.offsets_tuple(), m.nq, m.nv, n, self.dt, self._every,
+                            self._layers, self._weights, self._base, self._scale, self._task, self._rec, _NO_PATH, 0,
+                            math.inf)
 
     def step(self, n: int = 1) -> None:
-        """Advance ``n`` time steps (the controller, if any, before every ``control_every``-th). An unstable
+        """Advance ``n`` time steps (a Python controller, if any, before every ``control_every``-th). An unstable
         flight raises :class:`~lifelike_mj.errors.Diverged` naming the step and the cause."""
+        from lifelike_mj.butterfly.control3d import R_DIVERGED
+
         n = checks.whole("the number of steps", n, 0)
         self._check_alive()
-        m, d, kin = self._model, self._data, self.kinematics
+        d = self._data
         hold = self.options["assist"] == "hold"
         with passive_callback(mj3d.COMPILED_PASSIVE), watching():
-            for _ in range(n):
-                if self.controller is not None and self._k % self.control_every == 0:
-                    command = self.controller(self)
-                    if command is not None:
-                        kin.set_command(command)
-                if hold:
-                    pitch = float(self.pitch_law(self))
-                    d.qpos[self._root_q + 3 : self._root_q + 7] = quat_from_pitch(pitch)
-                    d.qvel[self._root_d + 3 : self._root_d + 6] = 0.0
-                mj3d.load_kinematics(d, kin)
-                t0 = d.time
-                mujoco.mj_step(m, d)
-                kin.advance(self.dt)
-                self._k += 1
-                if was_reset(d, t0, 1, self.dt):
+            if self.controller is None and not hold:
+                self._fly(n)
+            else:
+                for _ in range(n):
+                    if self.controller is not None and self._k % self.control_every == 0:
+                        command = self.controller(self)
+                        if command is not None:
+                            self.set_command(command)
+                    if hold:
+                        d.qpos[self._root_q + 3 : self._root_q + 7] = quat_from_pitch(float(self.pitch_law(self)))
+                        d.qvel[self._root_d + 3 : self._root_d + 6] = 0.0
+                    self._fly(1)
+                    if self._rec[R_DIVERGED] >= 0:
+                        break
+            done = int(self._rec[1]) - self._k
+            self._k += done
+            if self._rec[R_DIVERGED] >= 0:
+                if d.time < 0.5 * self._k * self.dt:  # MuJoCo reset the simulation (its clock went back)
                     self._diverged = describe(d, "the 3D flight")
-                elif not np.abs(d.qvel[self._root_d : self._root_d + 3]).max() < RUNAWAY_M_S:
+                else:
                     self._diverged = f"the 3D flight diverged: its speed ran away above {RUNAWAY_M_S:g} m/s;"
-                if self._diverged:
-                    self._diverged += f" (step {self._k}, t = {self.time:.4f} s)"
-                    break
+                self._diverged += f" (step {self._k}, t = {self.time:.4f} s)"
         self._check_alive()
 
     def _check_alive(self) -> None:
         if self._diverged:
             raise Diverged(f"{self._diverged} the likely cause is the time step ({self.dt:g} s), the constants or "
                            "the controller's commands.")
+
+    @property
+    def reward(self) -> float:
+        """The task's reward summed over the steps flown (s; :func:`~lifelike_mj.butterfly.control3d.reward` per
+        second): divided by the time flown, the mean in ``[0, 1]`` the evolution maximises."""
+        return float(self._rec[0])
+
+    @property
+    def waypoints_passed(self) -> int:
+        """How many of the task's waypoints have been passed (within its radius), in order."""
+        from lifelike_mj.butterfly.control3d import R_PASSED
+
+        return int(self._rec[R_PASSED]) if self.task.kind == "waypoints" else 0
+
+    @property
+    def closest_approach_m(self) -> np.ndarray:
+        """The closest approach (m) so far to each of the task's waypoints (inf: not yet aimed at)."""
+        from lifelike_mj.butterfly.control3d import R_WP
+
+        return self._rec[R_WP : R_WP + self._n_rows].copy()
 
     def state(self) -> dict[str, np.ndarray]:
         """Named arrays with units (:data:`STATE_UNITS`)."""
@@ -193,7 +273,24 @@ class Flight3D(StepCounter):
     def forces(self) -> dict[str, np.ndarray]:
         """The air's forces and the joints' torques at the current state (:func:`mj3d.forces`; N, N m, world
         frame), computed afresh (one ``mj_forward``; the simulation is not advanced)."""
-        mj3d.load_kinematics(self._data, self.kinematics)
+        self._data.userdata[mj3d.U_T0] = self._data.time
         with passive_callback(mj3d.COMPILED_PASSIVE):
             mujoco.mj_forward(self._model, self._data)
         return mj3d.forces(self._data)
+
+    def record(self, n_steps: int | None = None, *, duration_s: float | None = None, every: int = 12) -> dict:
+        """Fly on ``n_steps`` steps (or ``duration_s`` seconds) and return the path sampled every ``every``
+        steps, the current state first: ``t_s``, and :meth:`state`'s arrays stacked (one row per sample)."""
+        if (n_steps is None) == (duration_s is None):
+            raise UserError("give either n_steps or duration_s.")
+        every = checks.whole("every", every, 1)
+        n = (checks.whole("the number of steps", n_steps, 1) if n_steps is not None
+             else max(1, int(round(checks.positive("duration", duration_s, "s") / self.dt))))
+        rows, times = [self.state()], [self.time]
+        for _ in range(n // every):
+            self.step(every)
+            rows.append(self.state())
+            times.append(self.time)
+        out = {k: np.array([r[k] for r in rows]) for k in rows[0]}
+        out["t_s"] = np.array(times)
+        return out

@@ -8,6 +8,8 @@ MuJoCo model's flight: the motion stays in the sagittal plane and the path is th
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from lifelike_mj.butterfly.controllers import ButterflyController
@@ -59,3 +61,92 @@ def reduction(controller: ButterflyController | str = "simple_rule", duration_s:
             "max_sideways_m": float(np.abs(path[:, 1]).max()),
             "planar_end_m": [float(planar.z[-1]), float(planar.y[-1])],
             "reduced_end_m": [float(path[-1, 0]), float(path[-1, 2])]}
+
+
+# ---- what a 3D controller does: level flight, turns, courses ----------------------------------
+
+
+def _beat_means(t: np.ndarray, x: np.ndarray, period_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Means of ``x`` over consecutive windows of ``period_s`` (one wing beat): the flapping averaged out."""
+    per = max(1, int(round(period_s / (t[1] - t[0]))))
+    n = (len(t) - 1) // per
+    xs = x[1 : 1 + n * per].reshape((n, per) + x.shape[1:]).mean(axis=1)
+    ts = t[1 : 1 + n * per].reshape(n, per).mean(axis=1)
+    return ts, xs
+
+
+def level_check(controller, speed_m_s: float = 1.5, duration_s: float = 60.0, settle_s: float = 5.0, **flight) -> dict:
+    """Fly ``controller`` level at ``speed_m_s`` for ``duration_s`` and measure it: the speed over ground
+    each second after ``settle_s`` (m/s), the altitude throughout (m; the reference is the start, 0 m), and
+    the body's roll and pitch throughout (deg)."""
+    from lifelike_mj.butterfly import evolve3d
+    from lifelike_mj.butterfly.sim3d import Flight3D
+
+    f = Flight3D(controller=controller, task=evolve3d.level(speed_m_s), **flight)
+    rec = f.record(duration_s=duration_s, every=12)
+    t, pos, att = rec["t_s"], rec["position_m"], rec["attitude_rad"]
+    per_s = int(round(1.0 / (t[1] - t[0])))
+    after = t >= settle_s - 1e-9
+    p = pos[after][::per_s]
+    speeds = np.linalg.norm(np.diff(p[:, :2], axis=0), axis=1) / (per_s * (t[1] - t[0]))
+    return {"speed_command_m_s": speed_m_s, "duration_s": float(t[-1]), "settle_s": settle_s,
+            "speed_min_m_s": float(speeds.min()), "speed_max_m_s": float(speeds.max()),
+            "speed_mean_m_s": float(speeds.mean()),
+            "speed_within_10_percent": bool(np.all(np.abs(speeds / speed_m_s - 1.0) <= 0.1)),
+            "altitude_min_m": float(pos[:, 2].min()), "altitude_max_m": float(pos[:, 2].max()),
+            "altitude_within_0_3_m": bool(np.abs(pos[:, 2]).max() <= 0.3),
+            "roll_max_deg": float(np.degrees(np.abs(att[:, 0]).max())),
+            "pitch_min_deg": float(np.degrees(att[:, 1].min())), "pitch_max_deg": float(np.degrees(att[:, 1].max())),
+            "distance_m": float(np.linalg.norm(pos[-1, :2] - pos[0, :2]))}
+
+
+def turn_check(controller, angle_deg: float, at_s: float = 2.0, hold_s: float = 10.0, speed_m_s: float = 1.5,
+               **flight) -> dict:
+    """Fly ``controller`` level, command a new heading ``angle_deg`` (left > 0) at ``at_s`` and hold it for
+    ``hold_s``; measure when the course over ground (beat-averaged) first comes within 10 deg of it, the
+    largest error over the last half of the hold (deg), the turn's radius (m, speed over the mean rate of
+    turn while turning) and its mean bank (roll, deg)."""
+    from lifelike_mj.butterfly import evolve3d
+    from lifelike_mj.butterfly.sim3d import Flight3D
+
+    f = Flight3D(controller=controller, task=evolve3d.turn(angle_deg, at_s, speed_m_s), **flight)
+    period = 1.0 / f.command.frequency_hz
+    rec = f.record(duration_s=at_s + hold_s, every=12)
+    t, pos, att = rec["t_s"], rec["position_m"], rec["attitude_rad"]
+    ts, ps = _beat_means(t, pos, period)
+    _, rolls = _beat_means(t, att[:, 0], period)
+    vel = np.diff(ps[:, :2], axis=0) / period
+    tv = 0.5 * (ts[1:] + ts[:-1])
+    course = np.unwrap(np.arctan2(vel[:, 1], vel[:, 0]))
+    target = math.radians(angle_deg)
+    err = np.degrees(np.abs((course - target + np.pi) % (2 * np.pi) - np.pi))
+    after = tv > at_s
+    reached = np.nonzero(after & (err <= 10.0))[0]
+    done_at = float(tv[reached[0]]) if len(reached) else float("nan")
+    hold = tv >= at_s + 0.5 * hold_s
+    turning = after & (tv <= (done_at if len(reached) else tv[-1]))
+    rate = float(np.abs(np.diff(course)[turning[1:]]).mean() / period) if turning[1:].any() else float("nan")
+    speed = float(np.linalg.norm(vel[turning], axis=1).mean()) if turning.any() else float("nan")
+    return {"angle_deg": angle_deg, "command_at_s": at_s, "reached_within_10_deg_at_s": done_at,
+            "turn_time_s": done_at - at_s, "held_error_max_deg": float(err[hold].max()),
+            "held_within_10_deg": bool(len(reached) > 0 and err[hold].max() <= 10.0),
+            "radius_m": speed / rate if rate and rate > 0 else float("nan"),
+            "bank_mean_deg": float(np.degrees(rolls[(ts > at_s) & (ts <= done_at)].mean())) if len(reached) else float("nan"),
+            "altitude_min_m": float(pos[:, 2].min()), "altitude_max_m": float(pos[:, 2].max())}
+
+
+def course_check(controller, seed: int, n: int = 10, max_s: float = 60.0, **flight) -> dict:
+    """Fly ``controller`` along the course of ``n`` waypoints drawn by ``seed``
+    (:func:`~lifelike_mj.butterfly.evolve3d.course`) for at most ``max_s``; report the waypoints passed (in
+    order, within the course's 0.3 m) and the closest approach to each (m)."""
+    from lifelike_mj.butterfly import evolve3d
+    from lifelike_mj.butterfly.sim3d import Flight3D
+
+    task = evolve3d.course(seed, n)
+    f = Flight3D(controller=controller, task=task, **flight)
+    while f.time < max_s and f.waypoints_passed < n:
+        f.step(120)
+    closest = f.closest_approach_m
+    return {"seed": seed, "waypoints": n, "passed": f.waypoints_passed, "time_s": f.time,
+            "closest_m": [float(v) if np.isfinite(v) else None for v in closest],
+            "all_within_radius": bool(f.waypoints_passed == n and np.all(closest <= task.radius_m))}

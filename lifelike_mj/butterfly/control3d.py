@@ -1,0 +1,343 @@
+"""Steering the 3D butterfly by its kinematics: observations, networks, guidance and the compiled loop.
+
+A 3D controller sees the body's attitude and motion relative to a **reference** (a heading, an altitude
+and a forward speed) and answers with changes of the kinematics around a **base command**
+(:class:`~lifelike_mj.butterfly.kinematics3d.KinematicsCommand`). The reference comes from a **task**:
+a schedule of references over time (level flight, turns) or a course of waypoints (the reference then
+points at the next waypoint). The network never sees where it is, only how far it is off.
+
+Observation (:data:`OBS_NAMES`; SI units, in the heading frame: forward, left, up):
+roll, pitch, heading error (reference less yaw, wrapped to ``(-pi, pi]``), the thorax's angular
+velocity (roll, pitch, yaw rates in its own axes), forward-speed error, sideways speed, climb rate and
+altitude error (clipped to +-1 m), all ground-relative.
+
+Action (:data:`ACTION_NAMES`): nine numbers ``u`` in ``(-1, 1)`` (the network's last layer through
+``tanh``), each scaled by its entry of ``scale`` (rad; Hz for the frequency) and added to the base
+command: the wings' stroke offset and amplitude, both wings alike (``sym``) and left against right
+(``asym``), the feathering mean (``sym``, ``asym``), the feathering amplitude, the abdomen's mean angle
+and the flap frequency. The kinematics follow each
+new command smoothly (the filter of :mod:`~lifelike_mj.butterfly.kinematics3d`).
+
+Networks: ``layers = [10, ..., 9]``, hidden neurons ``tanh``; ``[10, 9]`` is a linear policy.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from lifelike_mj.butterfly.backends import mj3d
+from lifelike_mj.butterfly.kinematics3d import N_PARAMS, filter_at
+from lifelike_mj.physics import mjabi
+
+OBS_NAMES = ("roll_rad", "pitch_rad", "heading_error_rad", "roll_rate_rad_s", "pitch_rate_rad_s",
+             "yaw_rate_rad_s", "speed_error_m_s", "sideways_m_s", "climb_m_s", "altitude_error_m")
+ACTION_NAMES = ("offset_sym", "offset_asym", "amplitude_sym", "amplitude_asym", "feather_sym", "feather_asym",
+                "feather_amplitude", "abdomen_mean", "frequency")
+N_OBS, N_ACT = len(OBS_NAMES), len(ACTION_NAMES)
+#: Altitude errors beyond this (m) are seen as this.
+ALTITUDE_CLIP_M = 1.0
+#: What the network's inputs are divided by (the observation's units): angles by 1 rad, rates by 10 rad/s,
+#: speeds by 1 m/s, the altitude error by 0.5 m, so that every input is of order one in flight.
+INPUT_SCALE = np.array([1.0, 1.0, 1.0, 10.0, 10.0, 10.0, 1.0, 1.0, 1.0, 0.5])
+
+# task array: kind, then either a schedule (rows of t_start, heading, altitude, speed) or waypoints
+TASK_SCHEDULE, TASK_WAYPOINTS = 0, 1
+#: Task header: kind, rows, pass radius (m), cruise speed (m/s); then 4 numbers per row.
+T_KIND, T_ROWS, T_RADIUS, T_SPEED, T_ROW0 = 0, 1, 2, 3, 4
+
+# per-copy run record (float64): fitness, steps flown, diverged step, waypoints passed, tumble step
+R_FIT, R_STEPS, R_DIVERGED, R_PASSED, R_TUMBLED, R_WP = 0, 1, 2, 3, 4, 5
+#: A roll or pitch beyond this (rad) is a tumble: the flight ends there (no more reward).
+TUMBLE_RAD = math.radians(80.0)
+
+_O_TIME, _O_QPOS, _O_QVEL, _O_UD = mjabi.O_TIME, mjabi.O_QPOS, mjabi.O_QVEL, mjabi.O_UD
+_mj_step = mjabi.mj_step
+_vp = mjabi.voidptr_from_int
+_ptr_at = mjabi.ptr_at
+_f64 = mjabi.f64_at
+
+
+@njit(cache=True)
+def wrap(a):
+    """``a`` (rad) wrapped to ``(-pi, pi]``."""
+    return a - 2.0 * math.pi * math.floor((a + math.pi) / (2.0 * math.pi))
+
+
+@njit(cache=True)
+def attitude(q):
+    """Roll, pitch (nose up > 0), yaw of the quaternion ``q`` (w, x, y, z) (as :func:`sim3d.euler_from_quat`)."""
+    w, x, y, z = q[0], q[1], q[2], q[3]
+    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    s = 2.0 * (w * y - z * x)
+    s = max(-1.0, min(1.0, s))
+    pitch = -math.asin(s)
+    yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    return roll, pitch, yaw
+
+
+@njit(cache=True)
+def observe(qpos, qvel, heading, altitude, speed, obs):
+    """The observation (module docstring) of the free body whose root is at ``qpos[0:7]``, ``qvel[0:6]``,
+    against the reference ``heading`` (rad), ``altitude`` (m) and forward ``speed`` (m/s)."""
+    roll, pitch, yaw = attitude(qpos[3:7])
+    c, s = math.cos(yaw), math.sin(yaw)
+    obs[0] = roll
+    obs[1] = pitch
+    obs[2] = wrap(heading - yaw)
+    obs[3] = qvel[3]
+    obs[4] = -qvel[4]  # nose up positive (the body's y axis points left)
+    obs[5] = qvel[5]
+    obs[6] = c * qvel[0] + s * qvel[1] - speed
+    obs[7] = -s * qvel[0] + c * qvel[1]
+    obs[8] = qvel[2]
+    obs[9] = max(-ALTITUDE_CLIP_M, min(ALTITUDE_CLIP_M, qpos[2] - altitude))
+
+
+@njit(cache=True)
+def network(layers, weights, x, out, scratch):
+    """``out = tanh(last layer)`` of the network ``layers`` (hidden neurons ``tanh``) with ``weights``
+    (per layer, per neuron: its input weights, then its bias) on the observation ``x`` divided by
+    :data:`INPUT_SCALE`. ``scratch``: at least ``2 * max(layers)`` floats."""
+    width = 0
+    for k in range(len(layers)):
+        width = max(width, layers[k])
+    a = scratch[:width]
+    b = scratch[width : 2 * width]
+    for i in range(layers[0]):
+        a[i] = x[i] / INPUT_SCALE[i]
+    w = 0
+    for k in range(1, len(layers)):
+        n_in, n_out = layers[k - 1], layers[k]
+        for j in range(n_out):
+            s = weights[w + n_in]
+            for i in range(n_in):
+                s += weights[w + i] * a[i]
+            b[j] = math.tanh(s)
+            w += n_in + 1
+        for j in range(n_out):
+            a[j] = b[j]
+    for j in range(layers[-1]):
+        out[j] = a[j]
+
+
+def n_weights(layers) -> int:
+    """How many weights a network of ``layers`` has (biases included)."""
+    return int(sum((layers[k - 1] + 1) * layers[k] for k in range(1, len(layers))))
+
+
+@njit(cache=True)
+def command(base, scale, u, target):
+    """The kinematics parameters (``target``, :class:`KinematicsCommand`'s order) of the action ``u``
+    around ``base`` (module docstring)."""
+    for i in range(N_PARAMS):
+        target[i] = base[i]
+    d_off, a_off = scale[0] * u[0], scale[1] * u[1]
+    d_amp, a_amp = scale[2] * u[2], scale[3] * u[3]
+    d_fm, a_fm = scale[4] * u[4], scale[5] * u[5]
+    target[1] += d_off + a_off
+    target[2] += d_off - a_off
+    target[3] += d_amp + a_amp
+    target[4] += d_amp - a_amp
+    target[5] += d_fm + a_fm
+    target[6] += d_fm - a_fm
+    target[7] += scale[6] * u[6]
+    target[8] += scale[6] * u[6]
+    target[10] += scale[7] * u[7]
+    target[0] += scale[8] * u[8]
+
+
+@njit(cache=True)
+def reference(task, t, pos, rec):
+    """The reference (heading rad, altitude m, speed m/s) of ``task`` at time ``t`` and position ``pos``;
+    advances the waypoint counter ``rec[R_PASSED]`` when the current waypoint is within the pass radius,
+    keeping the closest approach to each waypoint in ``rec[R_WP + i]``."""
+    rows = int(task[T_ROWS])
+    if int(task[T_KIND]) == TASK_SCHEDULE:
+        r = 0
+        while r + 1 < rows and task[T_ROW0 + 4 * (r + 1)] <= t:
+            r += 1
+        b = T_ROW0 + 4 * r
+        return task[b + 1], task[b + 2], task[b + 3]
+    i = int(rec[R_PASSED])
+    if i >= rows:
+        i = rows - 1
+    b = T_ROW0 + 4 * i
+    dx, dy, dz = task[b] - pos[0], task[b + 1] - pos[1], task[b + 2] - pos[2]
+    dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+    if dist < rec[R_WP + i]:
+        rec[R_WP + i] = dist
+    if dist < task[T_RADIUS] and rec[R_PASSED] < rows:
+        rec[R_PASSED] += 1.0
+    return math.atan2(dy, dx), task[b + 2], task[T_SPEED]
+
+
+@njit(cache=True)
+def reward(obs):
+    """One step's reward in ``[0, 1]``: 0.1 for flying upright, and 0.3 more for each of the speed (within
+    about 0.3 m/s), the altitude (0.2 m) and the heading (0.3 rad) held."""
+    e_v, e_z, e_h = obs[6] / 0.3, obs[9] / 0.2, obs[2] / 0.3
+    return 0.1 + 0.3 * (1.0 / (1.0 + e_v * e_v) + 1.0 / (1.0 + e_z * e_z) + 1.0 / (1.0 + e_h * e_h))
+
+
+@njit(cache=True)
+def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, base, scale, task, rec, path, path_every,
+              tumble_rad):
+    """Fly one butterfly ``n_steps`` steps from its current state: every ``every`` steps the network turns
+    the observation into a new command; after each ``mj_step`` the kinematics advance exactly in the
+    userdata. ``rec``: the run record (``R_*``); ``path``: rows of (t, x, y, z, roll, pitch, yaw) every
+    ``path_every`` steps (none when 0). A roll or pitch beyond ``tumble_rad`` (a tumble) or a runaway
+    ends the flight (recorded in ``rec``). Without weights the command in the userdata stays."""
+    ud = _f64(_ptr_at(dptr + off[_O_UD]), mj3d.N_USERDATA)
+    qpos = _f64(_ptr_at(dptr + off[_O_QPOS]), nq)
+    qvel = _f64(_ptr_at(dptr + off[_O_QVEL]), nv)
+    time = _f64(dptr + off[_O_TIME], 1)
+    obs = np.empty(N_OBS)
+    u = np.zeros(N_ACT)
+    width = 0
+    for k in range(len(layers)):
+        width = max(width, layers[k])
+    scratch = np.empty(2 * width)
+    p = np.empty(N_PARAMS)
+    dp = np.empty(N_PARAMS)
+    ddp = np.empty(N_PARAMS)
+    w_c = ud[mj3d.U_OMEGA_C]
+    n_path = 0
+    for _ in range(n_steps):
+        if rec[R_DIVERGED] >= 0 or rec[R_TUMBLED] >= 0:
+            return
+        step = int(rec[R_STEPS])
+        heading, altitude, speed = reference(task, time[0], qpos[0:3], rec)
+        observe(qpos, qvel, heading, altitude, speed, obs)
+        if path_every > 0 and step % path_every == 0 and n_path < path.shape[0]:
+            path[n_path, 0] = time[0]
+            for i in range(3):
+                path[n_path, 1 + i] = qpos[i]
+            r_, p_, y_ = attitude(qpos[3:7])
+            path[n_path, 4] = r_
+            path[n_path, 5] = p_
+            path[n_path, 6] = y_
+            n_path += 1
+        if abs(obs[0]) > tumble_rad or abs(obs[1]) > tumble_rad:
+            rec[R_TUMBLED] = step
+            return
+        if step % every == 0 and len(weights) > 0:
+            network(layers, weights, obs, u, scratch)
+            command(base, scale, u, ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS])
+        ud[mj3d.U_T0] = time[0]
+        t0 = time[0]
+        _mj_step(_vp(mptr), _vp(dptr))
+        ud[mj3d.U_PSI0] = filter_at(ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS], ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS],
+                                    ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS], ud[mj3d.U_PSI0], w_c, dt, p, dp, ddp)
+        for i in range(N_PARAMS):
+            ud[mj3d.U_P0 + i] = p[i]
+            ud[mj3d.U_DP0 + i] = dp[i]
+        rec[R_STEPS] = step + 1
+        if abs(time[0] - (t0 + dt)) > 0.5 * dt or not (abs(qvel[0]) + abs(qvel[1]) + abs(qvel[2]) < 1e3):
+            rec[R_DIVERGED] = step + 1
+            return
+        rec[R_FIT] += reward(obs) * dt
+
+
+@njit(cache=True, parallel=True)
+def fly_batch(mptr, dptrs, off, nq, nv, n_steps, dt, every, layers, weights, base, scale, tasks, recs, tumble_rad):
+    """:func:`fly_steps` for many butterflies at once (one ``mjData`` each, ``weights[i]`` and
+    ``tasks[i]`` per copy), threads over the copies; no paths are recorded."""
+    none = np.empty((0, 7))
+    for i in prange(len(dptrs)):
+        fly_steps(mptr, dptrs[i], off, nq, nv, n_steps, dt, every, layers, weights[i], base, scale, tasks[i], recs[i],
+                  none, 0, tumble_rad)
+
+
+# ---- controller files ------------------------------------------------------------------------
+
+FORMAT = "lifelike-mj/butterfly3d-controller"
+#: Default ``scale`` of the actions (rad; Hz for the frequency).
+DEFAULT_SCALE = {"offset_sym": 0.3, "offset_asym": 0.3, "amplitude_sym": 0.3, "amplitude_asym": 0.3, "feather_sym": 0.5,
+                 "feather_asym": 0.3, "feather_amplitude": 0.3, "abdomen_mean": 0.8, "frequency": 3.0}
+
+
+def default_base():
+    """The base command of the shipped 3D controllers: the paper's 10 Hz flap over [-60, 75] deg (Oe 2010
+    section 6), feathered by 0.3 rad a quarter beat ahead (leading edge down on the downstroke)."""
+    from lifelike_mj.butterfly.kinematics3d import KinematicsCommand
+
+    return KinematicsCommand(feather_amplitude_left=0.3, feather_amplitude_right=0.3, feather_phase=-math.pi / 2)
+
+
+class Controller3D:
+    """A 3D controller: a network from the observation to the action (module docstring), the base command
+    and the actions' scales, how often it runs (``every`` steps) and how fast the kinematics follow
+    (``omega_c_rad_s``), with its provenance. Plain data: :meth:`to_dict` / :func:`controller_from_dict`."""
+
+    def __init__(self, layers, weights, base=None, scale: dict | None = None, every: int = 1,
+                 omega_c_rad_s: float = 2.0 * math.pi * 10.0, provenance: dict | None = None, name: str = "") -> None:
+        from lifelike_mj import checks
+        from lifelike_mj.butterfly.kinematics3d import KinematicsCommand
+        from lifelike_mj.errors import UserError
+
+        self.name = name
+        where = f"3D controller {name}" if name else "3D controller"
+        layers = [int(v) for v in layers] if all(checks.is_whole(v) for v in layers) else None
+        if not layers or len(layers) < 2 or layers[0] != N_OBS or layers[-1] != N_ACT or min(layers) < 1:
+            raise UserError(f"{where}: layers must run from {N_OBS} inputs to {N_ACT} outputs, got {layers!r}.")
+        self.layers = np.array(layers, dtype=np.int64)
+        self.weights = np.ascontiguousarray(weights, dtype=np.float64).reshape(-1)
+        if len(self.weights) != n_weights(layers) or not np.all(np.isfinite(self.weights)):
+            raise UserError(f"{where}: layers {layers} need {n_weights(layers)} finite weights, got {len(self.weights)}.")
+        self.base = base if base is not None else default_base()
+        if not isinstance(self.base, KinematicsCommand):
+            raise UserError(f"{where}: the base is a KinematicsCommand, got {self.base!r}.")
+        scale = dict(DEFAULT_SCALE, **(scale or {}))
+        unknown = set(scale) - set(ACTION_NAMES)
+        if unknown:
+            raise UserError(f"{where}: unknown action {sorted(unknown)[0]!r} in scale; actions: {', '.join(ACTION_NAMES)}.")
+        self.scale = np.array([checks.number(f"scale of {a}", scale[a], 0.0, math.pi) for a in ACTION_NAMES])
+        self.every = checks.whole("every", every, 1)
+        self.omega_c_rad_s = checks.positive("omega_c_rad_s", omega_c_rad_s, "rad/s")
+        self.provenance = dict(provenance or {})
+
+    def to_dict(self) -> dict:
+        from dataclasses import asdict
+
+        return {"format": FORMAT, "version": 1, "layers": [int(v) for v in self.layers],
+                "weights": [float(v) for v in self.weights], "base": asdict(self.base),
+                "scale": dict(zip(ACTION_NAMES, (float(v) for v in self.scale))), "every": self.every,
+                "omega_c_rad_s": self.omega_c_rad_s, "provenance": self.provenance}
+
+    def with_weights(self, weights) -> Controller3D:
+        """The same controller with other weights."""
+        return Controller3D(self.layers, weights, self.base, dict(zip(ACTION_NAMES, self.scale)), self.every,
+                            self.omega_c_rad_s, self.provenance, self.name)
+
+
+def controller_from_dict(data: object, name: str = "") -> Controller3D:
+    """A :class:`Controller3D` from plain data (a parsed controller file); one sentence for anything wrong."""
+    from lifelike_mj.butterfly.kinematics3d import KinematicsCommand
+    from lifelike_mj.schema import check_header, check_keys, number_list
+
+    where = f"3D controller {name}" if name else "3D controller"
+    d = check_header(data, FORMAT, where)
+    check_keys(d, ("format", "version", "layers", "weights", "base", "scale", "every", "omega_c_rad_s", "provenance"),
+               where, required=("layers", "weights"))
+    base = d.get("base")
+    if base is not None:
+        if not isinstance(base, dict):
+            from lifelike_mj.errors import UserError
+
+            raise UserError(f"{where}: base must be an object of kinematics parameters, got {base!r}.")
+        check_keys(base, KinematicsCommand.names(), f"{where} base")
+        base = KinematicsCommand(**{k: float(v) for k, v in base.items()})
+    return Controller3D(d["layers"] if isinstance(d["layers"], list) else [],
+                        number_list(d["weights"], "weights", where), base, d.get("scale"), d.get("every", 1),
+                        d.get("omega_c_rad_s", 2.0 * math.pi * 10.0), d.get("provenance"), name)
+
+
+def load_controller(name_or_path) -> Controller3D:
+    """A shipped 3D controller by name (``controllers/butterfly3d/``) or any 3D controller file by path."""
+    from lifelike_mj.paths import load_named_json
+
+    data, path = load_named_json("butterfly3d", name_or_path, "3D controller")
+    return controller_from_dict(data, path.stem)

@@ -1,0 +1,197 @@
+"""Evolving 3D controllers: tasks, the batch evaluation on MuJoCo, and the problem the optimisers solve.
+
+A **task** (:class:`Task3D`) is what a flight is asked to do: a schedule of references (heading, altitude,
+speed from given times: level flight, turns, climbs) or a course of waypoints. :class:`FlightProblem3D`
+scores a controller's weights on a set of tasks at once: every (candidate, task) pair is one butterfly on
+its own ``mjData``, all flown by :func:`~lifelike_mj.butterfly.control3d.fly_batch` on every core. The
+score of a flight is the mean reward per second (:func:`~lifelike_mj.butterfly.control3d.reward`, in
+``[0, 1]``); a flight that tumbles or diverges earns nothing after that.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from lifelike_mj import checks
+from lifelike_mj.butterfly import control3d as c3
+from lifelike_mj.butterfly.params import ButterflyParams
+from lifelike_mj.errors import UserError
+
+
+@dataclass(frozen=True)
+class Task3D:
+    """A task: ``kind="schedule"`` with rows ``(t_start_s, heading_rad, altitude_m, speed_m_s)`` (the
+    reference from each row's time on; the first row's time is 0), or ``kind="waypoints"`` with rows
+    ``(x, y, z)`` in m, visited in order at ``speed_m_s``, each passed when within ``radius_m``."""
+
+    kind: str
+    rows: tuple[tuple[float, ...], ...]
+    radius_m: float = 0.3
+    speed_m_s: float = 1.5
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        if self.kind not in ("schedule", "waypoints"):
+            raise UserError(f"a task is a schedule or waypoints, got {self.kind!r}.")
+        width = 4 if self.kind == "schedule" else 3
+        if not self.rows or any(len(r) != width for r in self.rows):
+            raise UserError(f"a {self.kind} task needs rows of {width} numbers.")
+        for r in self.rows:
+            for v in r:
+                checks.number("a task's number", v)
+        if self.kind == "schedule" and self.rows[0][0] != 0.0:
+            raise UserError("a schedule's first row starts at 0 s.")
+        checks.positive("radius_m", self.radius_m, "m")
+        checks.positive("speed_m_s", self.speed_m_s, "m/s")
+
+    def as_array(self, max_rows: int) -> np.ndarray:
+        """The compiled loop's task array (:data:`~lifelike_mj.butterfly.control3d.T_KIND` ...), padded to
+        ``max_rows`` rows."""
+        out = np.zeros(c3.T_ROW0 + 4 * max_rows)
+        out[c3.T_KIND] = c3.TASK_SCHEDULE if self.kind == "schedule" else c3.TASK_WAYPOINTS
+        out[c3.T_ROWS] = len(self.rows)
+        out[c3.T_RADIUS] = self.radius_m
+        out[c3.T_SPEED] = self.speed_m_s
+        for i, r in enumerate(self.rows):
+            out[c3.T_ROW0 + 4 * i : c3.T_ROW0 + 4 * i + len(r)] = r
+        return out
+
+
+def level(speed_m_s: float = 1.5, heading_rad: float = 0.0, altitude_m: float = 0.0) -> Task3D:
+    """Straight level flight at ``speed_m_s`` (the start altitude 0 m)."""
+    return Task3D("schedule", ((0.0, heading_rad, altitude_m, speed_m_s),), name=f"level {speed_m_s:g} m/s")
+
+
+def turn(angle_deg: float, at_s: float = 2.0, speed_m_s: float = 1.5, climb_m: float = 0.0) -> Task3D:
+    """Level flight, then at ``at_s`` a new heading ``angle_deg`` to the left (negative: right), and a new
+    altitude ``climb_m`` above the start."""
+    return Task3D("schedule", ((0.0, 0.0, 0.0, speed_m_s), (at_s, math.radians(angle_deg), climb_m, speed_m_s)),
+                  name=f"turn {angle_deg:g} deg")
+
+
+def course(seed: int, n: int = 10, spacing_m: float = 1.5, altitude_span_m: float = 0.6, speed_m_s: float = 1.5,
+           radius_m: float = 0.3) -> Task3D:
+    """``n`` waypoints drawn by ``seed``: each ``spacing_m`` from the last in a direction at most 90 deg
+    off the previous leg's, at altitudes within ``+-altitude_span_m / 2`` of the start."""
+    rng = np.random.default_rng(seed)
+    pts, heading, p = [], 0.0, np.zeros(3)
+    for _ in range(n):
+        heading += rng.uniform(-math.pi / 2, math.pi / 2)
+        p = p + spacing_m * np.array([math.cos(heading), math.sin(heading), 0.0])
+        p[2] = rng.uniform(-0.5, 0.5) * altitude_span_m
+        pts.append(tuple(float(v) for v in p))
+    return Task3D("waypoints", tuple(pts), radius_m=radius_m, speed_m_s=speed_m_s, name=f"course seed {seed}")
+
+
+def new_record(n: int, max_rows: int) -> np.ndarray:
+    """Empty run records (:data:`~lifelike_mj.butterfly.control3d.R_FIT` ...) for ``n`` flights."""
+    rec = np.zeros((n, c3.R_WP + max_rows))
+    rec[:, c3.R_DIVERGED] = -1.0
+    rec[:, c3.R_TUMBLED] = -1.0
+    rec[:, c3.R_WP :] = np.inf
+    return rec
+
+
+@dataclass
+class FlightProblem3D:
+    """Evolve a 3D controller's weights (genes = weights less the ``prior``'s) to fly ``tasks`` well: the
+    fitness is the mean over the tasks of the mean reward per second (``[0, 1]``, larger is better)."""
+
+    tasks: tuple[Task3D, ...]
+    template: c3.Controller3D
+    duration_s: float = 4.0
+    dt_s: float = 1.0 / 1200.0
+    gene_bound: float = 3.0
+    params: ButterflyParams = field(default_factory=ButterflyParams)
+    n_strips: int = 8
+    n_chord: int = 2
+    prior: tuple[float, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not self.tasks:
+            raise UserError("an evolution needs at least one task.")
+        checks.positive("duration_s", self.duration_s, "s")
+        if not self.prior:
+            self.prior = tuple(float(v) for v in self.template.weights)
+        if len(self.prior) != self.dim:
+            raise UserError(f"the prior has {len(self.prior)} weights, the network {self.dim}.")
+        self._model = None
+
+    def __getstate__(self) -> dict:
+        state = dict(self.__dict__)
+        state["_model"] = None  # a compiled model is rebuilt in each process
+        return state
+
+    @property
+    def dim(self) -> int:
+        return c3.n_weights(self.template.layers)
+
+    @property
+    def lower(self) -> np.ndarray:
+        return np.full(self.dim, -self.gene_bound)
+
+    @property
+    def upper(self) -> np.ndarray:
+        return np.full(self.dim, self.gene_bound)
+
+    @property
+    def maximize(self) -> bool:
+        return True
+
+    def describe(self) -> dict:
+        t = self.template.to_dict()
+        return {"problem": "butterfly3d-flight", "tasks": [asdict(k) for k in self.tasks], "duration_s": self.duration_s,
+                "dt_s": self.dt_s, "gene_bound": self.gene_bound, "params": asdict(self.params),
+                "n_strips": self.n_strips, "n_chord": self.n_chord, "layers": t["layers"], "base": t["base"],
+                "scale": t["scale"], "every": t["every"], "omega_c_rad_s": t["omega_c_rad_s"],
+                "prior_sha256": hashlib.sha256(np.asarray(self.prior).tobytes()).hexdigest()}
+
+    def fingerprint(self) -> str:
+        return hashlib.sha256(json.dumps(self.describe(), sort_keys=True).encode()).hexdigest()
+
+    def weights(self, x: np.ndarray) -> np.ndarray:
+        """The network weights of the genes ``x``."""
+        return np.asarray(self.prior) + np.asarray(x, dtype=np.float64)
+
+    def model(self):
+        if self._model is None:
+            from lifelike_mj.butterfly.backends import mj3d
+
+            self._model = mj3d.build_model(self.params)
+            self._model.opt.timestep = self.dt_s
+        return self._model
+
+    def fly(self, W: np.ndarray) -> np.ndarray:
+        """Run records ``(n, len(tasks), ...)`` of the weights ``W`` (rows) on every task."""
+        from lifelike_mj.butterfly.backends import mj3d
+        from lifelike_mj.butterfly.kinematics3d import Kinematics
+        from lifelike_mj.physics import mjabi
+        from lifelike_mj.physics.callbacks import passive_callback
+        from lifelike_mj.physics.stability import watching
+
+        m = self.model()
+        W = np.atleast_2d(np.asarray(W, dtype=np.float64))
+        k = len(self.tasks)
+        n = len(W) * k
+        max_rows = max(len(t.rows) for t in self.tasks)
+        tasks = np.tile(np.array([t.as_array(max_rows) for t in self.tasks]), (len(W), 1))
+        ctl = self.template
+        datas = [mj3d.setup_data(m, Kinematics(ctl.base, ctl.omega_c_rad_s), self.params, n_strips=self.n_strips,
+                                 n_chord=self.n_chord) for _ in range(n)]
+        ptrs = np.array([d._address for d in datas], dtype=np.int64)
+        recs = new_record(n, max_rows)
+        with passive_callback(mj3d.COMPILED_PASSIVE), watching():
+            c3.fly_batch(m._address, ptrs, mjabi.offsets_tuple(), m.nq, m.nv, int(round(self.duration_s / self.dt_s)),
+                         self.dt_s, ctl.every, ctl.layers, np.ascontiguousarray(np.repeat(W, k, axis=0)),
+                         ctl.base.as_array(), ctl.scale, tasks, recs, c3.TUMBLE_RAD)
+        return recs.reshape(len(W), k, -1)
+
+    def evaluate(self, X: np.ndarray) -> np.ndarray:
+        X = np.atleast_2d(np.asarray(X, dtype=np.float64))
+        recs = self.fly(np.asarray(self.prior)[None, :] + X)
+        return recs[:, :, c3.R_FIT].mean(axis=1) / self.duration_s

@@ -1,0 +1,136 @@
+"""3D controllers: observations, networks, commands, files, tasks, and the evolution's numbers."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from lifelike_mj.butterfly import control3d as c3
+from lifelike_mj.butterfly import evolve3d as e3
+from lifelike_mj.butterfly.kinematics3d import KinematicsCommand
+from lifelike_mj.butterfly.sim3d import Flight3D, euler_from_quat
+from lifelike_mj.errors import UserError
+
+
+def _quat(roll, pitch, yaw):
+    """w, x, y, z of yaw (about z), then pitch nose up (about -y), then roll (about x)."""
+    def q(axis, a):
+        return np.concatenate([[math.cos(a / 2)], math.sin(a / 2) * np.asarray(axis, float)])
+
+    def mul(a, b):
+        w1, x1, y1, z1 = a
+        w2, x2, y2, z2 = b
+        return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                         w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+
+    return mul(mul(q([0, 0, 1], yaw), q([0, -1, 0], pitch)), q([1, 0, 0], roll))
+
+
+@pytest.mark.parametrize("angles", [(0.3, 0.2, 1.0), (-0.5, -0.4, -2.5), (0.0, 0.7, 3.0)])
+def test_attitude_reads_roll_pitch_yaw_back(angles):
+    q = _quat(*angles)
+    np.testing.assert_allclose(c3.attitude(q), angles, atol=1e-12)
+    np.testing.assert_allclose(euler_from_quat(q), angles, atol=1e-12)
+
+
+def test_the_observation_is_relative_to_the_reference():
+    qpos = np.zeros(12)
+    qpos[3:7] = _quat(0.1, 0.2, math.radians(30))
+    qpos[2] = 0.4
+    qvel = np.zeros(11)
+    qvel[0:3] = (2.0 * math.cos(math.radians(30)), 2.0 * math.sin(math.radians(30)), -0.3)
+    qvel[3:6] = (1.0, -2.0, 3.0)
+    obs = np.empty(c3.N_OBS)
+    c3.observe(qpos, qvel, math.radians(90), 0.1, 1.5, obs)
+    want = [0.1, 0.2, math.radians(60), 1.0, 2.0, 3.0, 0.5, 0.0, -0.3, 0.3]
+    np.testing.assert_allclose(obs, want, atol=1e-12)
+    c3.observe(qpos, qvel, math.radians(90), -5.0, 1.5, obs)
+    assert obs[9] == c3.ALTITUDE_CLIP_M
+
+
+def test_a_linear_network_is_tanh_of_the_scaled_inputs_and_the_command_maps_each_action():
+    layers = np.array([c3.N_OBS, c3.N_ACT])
+    rng = np.random.default_rng(0)
+    w = rng.normal(size=c3.n_weights(layers))
+    x = rng.normal(size=c3.N_OBS)
+    out = np.empty(c3.N_ACT)
+    c3.network(layers, w, x, out, np.empty(2 * c3.N_OBS))
+    W = w.reshape(c3.N_ACT, c3.N_OBS + 1)
+    np.testing.assert_allclose(out, np.tanh(W[:, :-1] @ (x / c3.INPUT_SCALE) + W[:, -1]), rtol=1e-14)
+    base = KinematicsCommand().as_array()
+    scale = np.arange(1.0, 10.0) / 10
+    u = np.array([1.0, 0.5, -1.0, 0.25, 0.2, -0.4, 1.0, -1.0, 0.5])
+    target = np.empty(13)
+    c3.command(base, scale, u, target)
+    d = target - base
+    np.testing.assert_allclose(d[[1, 2]], [0.1 + 0.1, 0.1 - 0.1])
+    np.testing.assert_allclose(d[[3, 4]], [-0.3 + 0.1, -0.3 - 0.1])
+    np.testing.assert_allclose(d[[5, 6]], [0.1 - 0.24, 0.1 + 0.24])
+    np.testing.assert_allclose(d[[7, 8, 10, 0]], [0.7, 0.7, -0.8, 0.45])
+    assert d[9] == d[11] == d[12] == 0.0
+
+
+def test_a_controller_file_round_trips_and_bad_ones_are_one_sentence(tmp_path):
+    ctl = c3.Controller3D([10, 4, 9], np.linspace(-1, 1, c3.n_weights([10, 4, 9])), provenance={"note": "test"})
+    again = c3.controller_from_dict(json.loads(json.dumps(ctl.to_dict())))
+    np.testing.assert_array_equal(again.weights, ctl.weights)
+    assert again.to_dict() == ctl.to_dict()
+    good = ctl.to_dict()
+    with pytest.raises(UserError, match="layers must run from 10 inputs to 9 outputs"):
+        c3.controller_from_dict(dict(good, layers=[6, 1]))
+    with pytest.raises(UserError, match="need 89 finite weights"):
+        c3.controller_from_dict(dict(good, weights=[0.0] * 84))
+    with pytest.raises(UserError, match="unknown key 'wieghts'"):
+        c3.controller_from_dict(dict(good, wieghts=good["weights"]))
+    with pytest.raises(UserError, match="unknown action 'yaw'"):
+        c3.controller_from_dict(dict(good, scale={"yaw": 0.1}))
+    with pytest.raises(UserError, match="base has an unknown key 'flap_hz'"):
+        c3.controller_from_dict(dict(good, base={"flap_hz": 10.0}))
+    path = tmp_path / "c.json"
+    path.write_text(json.dumps(dict(good, weights=[float("nan")] + good["weights"][1:])).replace("NaN", "NaN"))
+    with pytest.raises(UserError, match="not readable JSON"):
+        c3.load_controller(path)
+
+
+def test_tasks_are_checked_and_courses_are_drawn_by_seed():
+    a, b, c = e3.course(3), e3.course(3), e3.course(4)
+    assert a == b and a != c and len(a.rows) == 10
+    legs = np.diff(np.array([(0.0, 0.0)] + [r[:2] for r in a.rows]), axis=0)
+    np.testing.assert_allclose(np.linalg.norm(legs, axis=1), 1.5)
+    assert max(abs(r[2]) for r in a.rows) <= 0.3
+    with pytest.raises(UserError, match="first row starts at 0 s"):
+        e3.Task3D("schedule", ((1.0, 0.0, 0.0, 1.0),))
+    with pytest.raises(UserError, match="rows of 3 numbers"):
+        e3.Task3D("waypoints", ((1.0, 0.0),))
+
+
+def test_the_schedule_and_the_waypoints_give_the_references():
+    rec = e3.new_record(1, 2)[0]
+    task = e3.turn(90.0, at_s=2.0, speed_m_s=1.2, climb_m=0.3).as_array(2)
+    assert c3.reference(task, 1.9, np.zeros(3), rec) == (0.0, 0.0, 1.2)
+    assert c3.reference(task, 2.0, np.zeros(3), rec) == (pytest.approx(math.pi / 2), 0.3, 1.2)
+    wp = e3.Task3D("waypoints", ((1.0, 1.0, 0.2), (2.0, 0.0, 0.0)), radius_m=0.3, speed_m_s=1.0).as_array(2)
+    h, z, v = c3.reference(wp, 0.0, np.zeros(3), rec)
+    assert (h, z, v) == (pytest.approx(math.pi / 4), 0.2, 1.0) and rec[c3.R_PASSED] == 0
+    c3.reference(wp, 0.0, np.array([0.9, 0.9, 0.2]), rec)  # within 0.3 m: passed, aim at the next
+    assert rec[c3.R_PASSED] == 1 and rec[c3.R_WP] == pytest.approx(math.sqrt(0.02))
+    h, _, _ = c3.reference(wp, 0.0, np.array([0.9, 0.9, 0.2]), rec)
+    assert h == pytest.approx(math.atan2(-0.9, 1.1))
+
+
+def test_the_evolution_scores_what_the_stepper_flies():
+    """The fitness of a controller in the batch (threads, many copies) is the reward its Flight3D earns."""
+    layers = [10, 9]
+    w = np.random.default_rng(1).normal(0, 0.2, c3.n_weights(layers))
+    w[4 * 11 + 1] += 1.0
+    tmpl = c3.Controller3D(layers, np.zeros(len(w)))
+    tasks = (e3.level(1.0), e3.turn(90.0, 0.2))
+    prob = e3.FlightProblem3D(tasks, tmpl, duration_s=0.3)
+    fit = prob.evaluate(np.stack([w, w * 0.5]))
+    for task, rec in zip(tasks, prob.fly(w[None, :])[0]):
+        f = Flight3D(controller=tmpl.with_weights(w), task=task, n_strips=8, n_chord=2)
+        f.step(360)
+        assert f.reward == rec[c3.R_FIT]
+    assert fit[0] == pytest.approx(np.mean(prob.fly(w[None, :])[0][:, c3.R_FIT]) / 0.3, rel=1e-15)
+    assert prob.evaluate(w[None, :])[0] == fit[0]  # the same row scores the same in another batch
