@@ -45,11 +45,16 @@ INPUT_SCALE = np.array([1.0, 1.0, 1.0, 10.0, 10.0, 10.0, 1.0, 1.0, 1.0, 0.5])
 
 # task array: kind, then either a schedule (rows of t_start, heading, altitude, speed) or waypoints
 TASK_SCHEDULE, TASK_WAYPOINTS = 0, 1
-#: Task header: kind, rows, pass radius (m), cruise speed (m/s); then 4 numbers per row.
-T_KIND, T_ROWS, T_RADIUS, T_SPEED, T_ROW0 = 0, 1, 2, 3, 4
+#: Task header: kind, rows, pass radius (m), cruise speed (m/s), mean wind (3, m/s), gusts' standard deviation
+#: (m/s) and correlation time (s), flutter's standard deviation (action units) and correlation time (s), the
+#: seed of both; then 4 numbers per row.
+T_KIND, T_ROWS, T_RADIUS, T_SPEED, T_WIND = 0, 1, 2, 3, 4
+T_GUST, T_GUST_TAU, T_FLUTTER, T_FLUTTER_TAU, T_SEED, T_ROW0 = 7, 8, 9, 10, 11, 12
 
-# per-copy run record (float64): fitness, steps flown, diverged step, waypoints passed, tumble step
-R_FIT, R_STEPS, R_DIVERGED, R_PASSED, R_TUMBLED, R_WP = 0, 1, 2, 3, 4, 5
+# per-copy run record (float64): fitness, steps flown, diverged step, waypoints passed, tumble step, the gust
+# (3, m/s) and the flutter (one per action) now, then the closest approach to each waypoint
+R_FIT, R_STEPS, R_DIVERGED, R_PASSED, R_TUMBLED, R_GUST, R_FLUTTER = 0, 1, 2, 3, 4, 5, 8
+R_WP = R_FLUTTER + 9
 #: A roll or pitch beyond this (rad) is a tumble: the flight ends there (no more reward).
 TUMBLE_RAD = math.radians(80.0)
 
@@ -175,6 +180,39 @@ def reference(task, t, pos, rec):
 
 
 @njit(cache=True)
+def _mix(z):
+    # splitmix64's finaliser: a 64-bit hash with full avalanche
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
+
+
+@njit(cache=True)
+def uniform(seed, step, channel):
+    """A number in ``(0, 1)`` that depends only on ``(seed, step, channel)`` (a counter-based generator: the
+    same flight draws the same numbers in any thread, batch or order)."""
+    z = _mix(np.uint64(seed) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(step) * np.uint64(64) + np.uint64(channel))
+    return (float(z >> np.uint64(11)) + 0.5) * (1.0 / 9007199254740992.0)
+
+
+@njit(cache=True)
+def normal(seed, step, channel):
+    """A standard normal number of ``(seed, step, channel)`` (Box-Muller on two :func:`uniform` numbers)."""
+    u1 = uniform(seed, step, 2 * channel)
+    u2 = uniform(seed, step, 2 * channel + 1)
+    return math.sqrt(-2.0 * math.log(u1)) * math.cos(2.0 * math.pi * u2)
+
+
+@njit(cache=True)
+def ou_step(x, sigma, tau, dt, n):
+    """One step of an Ornstein-Uhlenbeck process (a first-order Gauss-Markov process, the Dryden gust
+    model's simplest form): stationary standard deviation ``sigma``, correlation time ``tau`` (s), driven by
+    the standard normal ``n``."""
+    a = math.exp(-dt / tau)
+    return a * x + sigma * math.sqrt(1.0 - a * a) * n
+
+
+@njit(cache=True)
 def reward(obs):
     """One step's reward in ``[0, 1]``: 0.1 for flying upright, and 0.3 more for each of the speed (within
     about 0.3 m/s), the altitude (0.2 m) and the heading (0.3 rad) held."""
@@ -223,8 +261,19 @@ def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, base
         if abs(obs[0]) > tumble_rad or abs(obs[1]) > tumble_rad:
             rec[R_TUMBLED] = step
             return
+        seed = int(task[T_SEED])
+        if task[T_GUST] > 0.0:
+            for i in range(3):
+                rec[R_GUST + i] = ou_step(rec[R_GUST + i], task[T_GUST], task[T_GUST_TAU], dt, normal(seed, step, i))
+        for i in range(3):
+            ud[mj3d.U_AIR + i] = task[T_WIND + i] + rec[R_GUST + i]
         if step % every == 0 and len(weights) > 0:
             network(layers, weights, obs, u, scratch)
+            if task[T_FLUTTER] > 0.0:
+                for i in range(N_ACT):
+                    rec[R_FLUTTER + i] = ou_step(rec[R_FLUTTER + i], task[T_FLUTTER], task[T_FLUTTER_TAU], dt * every,
+                                                 normal(seed, step, 3 + i))
+                    u[i] = max(-1.0, min(1.0, u[i] + rec[R_FLUTTER + i]))
             command(base, scale, u, ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS])
         ud[mj3d.U_T0] = time[0]
         t0 = time[0]

@@ -14,6 +14,7 @@ import hashlib
 import json
 import math
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -27,13 +28,25 @@ from lifelike_mj.errors import UserError
 class Task3D:
     """A task: ``kind="schedule"`` with rows ``(t_start_s, heading_rad, altitude_m, speed_m_s)`` (the
     reference from each row's time on; the first row's time is 0), or ``kind="waypoints"`` with rows
-    ``(x, y, z)`` in m, visited in order at ``speed_m_s``, each passed when within ``radius_m``."""
+    ``(x, y, z)`` in m, visited in order at ``speed_m_s``, each passed when within ``radius_m``.
+
+    The weather: a mean wind ``wind_m_s`` (world frame, m/s, where it blows to) plus gusts, a first-order
+    Gauss-Markov (Ornstein-Uhlenbeck) process on each axis with standard deviation ``gust_m_s`` and
+    correlation time ``gust_tau_s``, starting from calm. ``flutter``: the butterfly's own irregularity, the
+    same process added to each of the controller's actions (standard deviation ``flutter`` in action units,
+    where 1 is the action's full scale; correlation time ``flutter_tau_s``). Both are drawn from ``seed``."""
 
     kind: str
     rows: tuple[tuple[float, ...], ...]
     radius_m: float = 0.3
     speed_m_s: float = 1.5
     name: str = ""
+    wind_m_s: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    gust_m_s: float = 0.0
+    gust_tau_s: float = 1.0
+    flutter: float = 0.0
+    flutter_tau_s: float = 0.2
+    seed: int = 0
 
     def __post_init__(self) -> None:
         if self.kind not in ("schedule", "waypoints"):
@@ -48,6 +61,20 @@ class Task3D:
             raise UserError("a schedule's first row starts at 0 s.")
         checks.positive("radius_m", self.radius_m, "m")
         checks.positive("speed_m_s", self.speed_m_s, "m/s")
+        object.__setattr__(self, "wind_m_s", checks.vector("wind_m_s", self.wind_m_s, 3, "m/s"))
+        checks.number("gust_m_s", self.gust_m_s, 0.0, 10.0, unit="m/s")
+        checks.positive("gust_tau_s", self.gust_tau_s, "s")
+        checks.number("flutter", self.flutter, 0.0, 1.0)
+        checks.positive("flutter_tau_s", self.flutter_tau_s, "s")
+        checks.whole("seed", self.seed, 0, 2**32 - 1)
+
+    def with_weather(self, wind_m_s=(0.0, 0.0, 0.0), gust_m_s: float = 0.0, gust_tau_s: float = 1.0,
+                     flutter: float = 0.0, flutter_tau_s: float = 0.2, seed: int | None = None) -> Task3D:
+        """The same task in other weather (and flutter); the seed defaults to the task's."""
+        from dataclasses import replace
+
+        return replace(self, wind_m_s=tuple(wind_m_s), gust_m_s=gust_m_s, gust_tau_s=gust_tau_s, flutter=flutter,
+                       flutter_tau_s=flutter_tau_s, seed=self.seed if seed is None else seed)
 
     def as_array(self, max_rows: int) -> np.ndarray:
         """The compiled loop's task array (:data:`~lifelike_mj.butterfly.control3d.T_KIND` ...), padded to
@@ -57,6 +84,9 @@ class Task3D:
         out[c3.T_ROWS] = len(self.rows)
         out[c3.T_RADIUS] = self.radius_m
         out[c3.T_SPEED] = self.speed_m_s
+        out[c3.T_WIND : c3.T_WIND + 3] = self.wind_m_s
+        out[c3.T_GUST], out[c3.T_GUST_TAU] = self.gust_m_s, self.gust_tau_s
+        out[c3.T_FLUTTER], out[c3.T_FLUTTER_TAU], out[c3.T_SEED] = self.flutter, self.flutter_tau_s, self.seed
         for i, r in enumerate(self.rows):
             out[c3.T_ROW0 + 4 * i : c3.T_ROW0 + 4 * i + len(r)] = r
         return out
@@ -85,12 +115,13 @@ def course(seed: int, n: int = 10, spacing_m: float = 1.5, altitude_span_m: floa
         p = p + spacing_m * np.array([math.cos(heading), math.sin(heading), 0.0])
         p[2] = rng.uniform(-0.5, 0.5) * altitude_span_m
         pts.append(tuple(float(v) for v in p))
-    return Task3D("waypoints", tuple(pts), radius_m=radius_m, speed_m_s=speed_m_s, name=f"course seed {seed}")
+    return Task3D("waypoints", tuple(pts), radius_m=radius_m, speed_m_s=speed_m_s, name=f"course seed {seed}",
+                  seed=seed)
 
 
 def new_record(n: int, max_rows: int) -> np.ndarray:
     """Empty run records (:data:`~lifelike_mj.butterfly.control3d.R_FIT` ...) for ``n`` flights."""
-    rec = np.zeros((n, c3.R_WP + max_rows))
+    rec = np.zeros((n, c3.R_WP + max_rows))  # the gusts and the flutter start from zero
     rec[:, c3.R_DIVERGED] = -1.0
     rec[:, c3.R_TUMBLED] = -1.0
     rec[:, c3.R_WP :] = np.inf
@@ -195,3 +226,81 @@ class FlightProblem3D:
         X = np.atleast_2d(np.asarray(X, dtype=np.float64))
         recs = self.fly(np.asarray(self.prior)[None, :] + X)
         return recs[:, :, c3.R_FIT].mean(axis=1) / self.duration_s
+
+
+#: The task sets the shipped controllers are evolved on (``evolve3d --tasks``).
+TASK_SETS = {
+    "steer": lambda: (level(1.0), level(2.0), turn(90.0, 1.5, 1.5), turn(-180.0, 1.5, 1.5, 0.3)),
+    "cruise": lambda: (level(1.5), level(2.0), turn(90.0, 1.5, 1.5), turn(-180.0, 1.5, 1.5, 0.3),
+                       level(1.5).with_weather((0.0, 1.0, 0.0), gust_m_s=0.5, seed=1),
+                       turn(-90.0, 1.5, 1.5).with_weather((-1.0, 0.0, 0.0), gust_m_s=0.5, seed=2)),
+}
+
+
+def pd_prior(layers) -> np.ndarray:
+    """The hand-made starting point of a linear controller: the feathering follows the body's pitch (1 rad of
+    feathering, leading edge down, per rad nose up), which alone keeps the body upright for seconds.
+    Networks with hidden layers start from zero."""
+    w = np.zeros(c3.n_weights(layers))
+    if len(layers) == 2:
+        w[c3.ACTION_NAMES.index("feather_sym") * (c3.N_OBS + 1) + c3.OBS_NAMES.index("pitch_rad")] = 1.0
+    return w
+
+
+def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str = "cmaes", seed: int = 0,
+           layers=(10, 9), population: int | None = 16, generations: int = 300, duration_s: float = 4.0,
+           gene_bound: float = 0.4, checkpoint: str | Path | None = None, resume: bool = False, progress: bool = True,
+           overwrite: bool = False, task_set: str = "custom", on_generation=None, start: c3.Controller3D | None = None):
+    """Evolve a 3D controller on ``tasks`` (default: the ``steer`` set) with ``optimizer`` and write it to
+    ``out`` with its provenance (the problem, the optimiser, the budget, the time it took, the fitness
+    history). Returns ``(result, controller)``; nothing is overwritten unasked (the checks and locks of the
+    planar ``butterfly evolve``). ``start``: a controller to start from (its network, base and scales; the genes
+    are then changes of its weights and ``layers`` is ignored), recorded in the provenance."""
+    from lifelike_mj import provenance as _prov
+    from lifelike_mj.evolve import optimize
+    from lifelike_mj.evolve.checkpoint import check_checkpoint_path
+    from lifelike_mj.io import exclusive, write_json
+    from lifelike_mj.machine import machine_info
+    from lifelike_mj.paths import check_output_file, check_writable
+
+    if tasks is None:
+        task_set = "steer"
+        tasks = TASK_SETS["steer"]()
+    if start is not None:
+        template = start
+        layers = [int(v) for v in start.layers]
+    else:
+        layers = [int(v) for v in layers]
+        template = c3.Controller3D(layers, pd_prior(layers) if len(layers) >= 2 and layers[0] == c3.N_OBS else [])
+    problem = FlightProblem3D(tuple(tasks), template, duration_s=duration_s, gene_bound=gene_bound)
+    out = Path(out)
+    ckpt = Path(checkpoint) if checkpoint else out.with_name(out.name + ".ckpt")
+    if ckpt.absolute().resolve() == out.absolute().resolve():
+        raise UserError(f"the checkpoint and the controller file are the same file ({out}); give another checkpoint.")
+    check_output_file(out, "--out", suffixes=(".json",), overwrite=True)
+    check_writable(ckpt, "checkpoint")
+    with exclusive(out, "--out"), exclusive(ckpt, "checkpoint"):
+        check_output_file(out, "--out", suffixes=(".json",), overwrite=overwrite or resume)
+        check_checkpoint_path(ckpt, resume=resume, overwrite=overwrite)
+        res = optimize(problem, optimizer, seed=seed, population=population, generations=generations,
+                       checkpoint=ckpt, resume=resume, progress=progress, overwrite=overwrite,
+                       on_generation=on_generation)
+        if not np.all(np.isfinite(res.best_x)):
+            return res, None
+        prov = _prov.provenance(task_set=task_set, optimizer=res.optimizer, seed=res.seed, population=res.population,
+                                generations=generations, duration_s=duration_s, gene_bound=gene_bound, layers=layers)
+        prov.update({"source": "lifelike-mj butterfly evolve3d", "problem": problem.describe(),
+                     "problem_fingerprint": problem.fingerprint(), "generations_done": res.generations,
+                     "evaluations_done": res.evaluations, "best_fitness": float(res.best_f),
+                     "interrupted": bool(res.interrupted), "resumed": bool(res.resumed),
+                     "evolution_wall_time_s": float(res.wall_time_s),
+                     "machine": machine_info(),
+                     "started_from": None if start is None else {
+                         "name": start.name, **{k: v for k, v in start.provenance.items() if k != "fitness_history"}},
+                     "fitness_history": [dict(h) for h in res.history]})
+        ctrl = template.with_weights(problem.weights(res.best_x))
+        ctrl.name = ""
+        ctrl.provenance = prov
+        ctrl.name = out.stem
+        write_json(out, ctrl.to_dict())
+    return res, ctrl

@@ -85,7 +85,9 @@ class Flight3D(StepCounter):
     or the name or path of a controller file), flown in the compiled loop towards ``task``'s references
     (:class:`~lifelike_mj.butterfly.evolve3d.Task3D`; default level flight at 1.5 m/s), or any callable
     ``controller(flight) -> KinematicsCommand | None`` run from Python before every ``control_every``-th
-    step. ``wind_m_s``: the air's velocity (world frame, m/s); ``start_m``: the thorax's start position.
+    step. ``wind_m_s``: the mean wind (world frame, m/s, where it blows to), replacing the task's (gusts and
+flutter are the task's: :class:`~lifelike_mj.butterfly.evolve3d.Task3D`); ``start_m``: the thorax's start
+position.
     Model options: ``force_law`` (``strip``: eq. 1 on wing panels; ``tip``: the paper's tip-speed formula;
     ``none``), ``drag_frame`` (``body`` or ``world``), ``body_areas_m2`` (the body's drag areas along x, y,
     z; default the paper's ``A_b`` on every axis), ``masses`` (``animal`` or ``paper``), ``n_strips`` and
@@ -96,7 +98,7 @@ class Flight3D(StepCounter):
     """
 
     def __init__(self, command: KinematicsCommand | None = None, params: ButterflyParams | None = None, *,
-                 controller=None, task=None, control_every: int = 1, wind_m_s=(0.0, 0.0, 0.0),
+                 controller=None, task=None, control_every: int = 1, wind_m_s=None,
                  start_m=(0.0, 0.0, 0.0), force_law: str = "strip", drag_frame: str = "body",
                  body_areas_m2=None, masses: str = "animal", dt_s: float = 1.0 / 1200.0, n_strips: int = 16,
                  n_chord: int = 3, drive_hz: float = 50.0, omega_c: float | None = None, assist: str = "none",
@@ -128,7 +130,11 @@ class Flight3D(StepCounter):
         if assist == "hold" and not callable(pitch_law):
             raise UserError("the attitude hold needs pitch_law, a function of the flight returning the pitch (rad).")
         self.controller, self.control_every = controller, checks.whole("control_every", control_every, 1)
-        self.wind_m_s = np.array(checks.vector("wind_m_s", wind_m_s, 3), dtype=float)
+        if wind_m_s is not None:
+            from dataclasses import replace
+
+            self.task = replace(self.task, wind_m_s=checks.vector("wind_m_s", wind_m_s, 3, "m/s"))
+        self.wind_m_s = np.array(self.task.wind_m_s)
         self.start_m = np.array(checks.vector("start_m", start_m, 3), dtype=float)
         self.options = {"force_law": force_law, "drag_frame": drag_frame, "body_areas_m2": body_areas_m2,
                         "assist": assist, "drive_hz": checks.positive("drive_hz", drive_hz, "Hz"),
@@ -164,6 +170,8 @@ class Flight3D(StepCounter):
     def sync(self) -> None:
         """``data`` already shows the current state; this computes what drawing needs."""
         mujoco.mj_kinematics(self._model, self._data)
+        mujoco.mj_comPos(self._model, self._data)
+        mujoco.mj_camlight(self._model, self._data)  # the cameras and lights follow the bodies
 
     def reset(self, seed: int | None = None) -> None:
         """Back to the start: at rest at ``start_m``, level, heading +x, the kinematics at the start command.

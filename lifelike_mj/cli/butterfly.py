@@ -344,6 +344,9 @@ def add_commands(sub) -> None:
     p.add_argument("--dt", type=num(0, 0.0125, lo_open=True, unit="s"), default=1.0 / 1200.0, help="time step, s")
     add_json(p)
     p.set_defaults(func=cmd_compare)
+    from lifelike_mj.cli import butterfly3d
+
+    butterfly3d.add_commands(bf)
 
 
 # ---- the shared verbs -----------------------------------------------------------------------------

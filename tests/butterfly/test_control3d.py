@@ -8,6 +8,7 @@ import pytest
 
 from lifelike_mj.butterfly import control3d as c3
 from lifelike_mj.butterfly import evolve3d as e3
+from lifelike_mj.butterfly.backends import mj3d
 from lifelike_mj.butterfly.kinematics3d import KinematicsCommand
 from lifelike_mj.butterfly.sim3d import Flight3D, euler_from_quat
 from lifelike_mj.errors import UserError
@@ -134,3 +135,43 @@ def test_the_evolution_scores_what_the_stepper_flies():
         assert f.reward == rec[c3.R_FIT]
     assert fit[0] == pytest.approx(np.mean(prob.fly(w[None, :])[0][:, c3.R_FIT]) / 0.3, rel=1e-15)
     assert prob.evaluate(w[None, :])[0] == fit[0]  # the same row scores the same in another batch
+
+
+def test_the_counter_based_numbers_are_uniform_normal_and_repeatable():
+    u = np.array([c3.uniform(7, k, 3) for k in range(20000)])
+    n = np.array([c3.normal(7, k, 1) for k in range(20000)])
+    assert 0.0 < u.min() and u.max() < 1.0
+    assert abs(u.mean() - 0.5) < 0.01 and abs(u.std() - math.sqrt(1 / 12)) < 0.01
+    assert abs(n.mean()) < 0.03 and abs(n.std() - 1.0) < 0.03
+    assert abs(np.corrcoef(n[:-1], n[1:])[0, 1]) < 0.03
+    assert c3.normal(7, 5, 1) == n[5] and c3.normal(8, 5, 1) != n[5] and c3.normal(7, 5, 2) != n[5]
+
+
+def test_gusts_are_a_gauss_markov_process_of_the_stated_deviation_and_time():
+    sigma, tau, dt = 0.5, 1.0, 0.01
+    x, xs = 0.0, []
+    for k in range(200_000):
+        x = c3.ou_step(x, sigma, tau, dt, c3.normal(3, k, 0))
+        xs.append(x)
+    xs = np.array(xs[1000:])
+    assert xs.std() == pytest.approx(sigma, rel=0.1)
+    lag = int(tau / dt)
+    assert np.corrcoef(xs[:-lag], xs[lag:])[0, 1] == pytest.approx(math.exp(-1.0), abs=0.08)
+
+
+def test_a_gusty_flight_is_the_same_for_the_same_seed_and_feels_the_gusts():
+    ctl = c3.Controller3D([10, 9], e3.pd_prior([10, 9]))
+    task = e3.level(1.5).with_weather(wind_m_s=(1.0, 0.0, 0.0), gust_m_s=0.5, flutter=0.2, seed=4)
+    runs = []
+    for seed in (4, 4, 5):
+        f = Flight3D(controller=ctl, task=task.with_weather((1.0, 0.0, 0.0), 0.5, flutter=0.2, seed=seed),
+                     n_strips=8, n_chord=2)
+        airs = []
+        for _ in range(60):
+            f.step(10)
+            airs.append(f.data.userdata[mj3d.U_AIR : mj3d.U_AIR + 3].copy())
+        runs.append((f.data.qpos.copy(), np.array(airs)))
+    np.testing.assert_array_equal(runs[0][0], runs[1][0])
+    assert not np.array_equal(runs[0][0], runs[2][0])
+    airs = runs[0][1]
+    assert np.abs(airs.mean(axis=0)[0] - 1.0) < 0.5 and airs.std(axis=0).min() > 0.0

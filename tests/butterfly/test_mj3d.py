@@ -39,7 +39,7 @@ def _random_state(m, law, assist, seed=1):
     return d, k
 
 
-@pytest.mark.parametrize("law", ["strip", "tip", "none"])
+@pytest.mark.parametrize("law", ["strip", "quasi_steady", "tip", "none"])
 @pytest.mark.parametrize("assist", ["none", "hold"])
 def test_the_compiled_callback_equals_its_python_twin(model, law, assist):
     d, _ = _random_state(model, law, assist)
@@ -182,3 +182,58 @@ def test_bad_flight_options_are_one_sentence():
         Flight3D(dt_s=0.05)
     with pytest.raises(UserError, match="mass layout"):
         Flight3D(masses="heavy")
+
+
+def _fruitfly(alpha_deg):
+    c_l = 0.225 + 1.58 * math.sin(math.radians(2.13 * alpha_deg - 7.20))
+    c_d = 1.92 - 1.55 * math.cos(math.radians(2.04 * alpha_deg - 9.82))
+    return c_l, c_d
+
+
+@pytest.mark.parametrize("alpha_deg", [10.0, 35.0, 60.0])
+def test_the_quasi_steady_law_gives_dickinsons_lift_and_drag_on_a_translating_wing(alpha_deg):
+    """A wing moving through still air at U and angle of attack alpha (no rotation): lift 1/2 rho C_L U^2 S
+    across the flow, on the side the wing is pushed, and drag 1/2 rho C_D U^2 S against it, with the fruit-fly
+    fits of Dickinson, Lehmann & Sane 1999 (S = W L / 2, the whole planform)."""
+    p = ButterflyParams()
+    pan = mj3d.panels(p)
+    U, a = 2.0, math.radians(alpha_deg)
+    v = np.array([U * math.cos(a), 0.0, -U * math.sin(a)])  # forward and down: the air pushes it up
+    out = np.empty(15)
+    mj3d.wing_panels(3, pan.ravel(), len(pan), 1.0, np.eye(3), v, np.zeros(3), p.rho, p.cd, p.width_m / p.span_m, out)
+    c_l, c_d = _fruitfly(alpha_deg)
+    q = 0.5 * p.rho * U * U * 0.5 * p.width_m * p.span_m
+    lift, drag, rot = out[6:9], out[9:12], out[12:15]
+    np.testing.assert_allclose(drag, -q * c_d * v / U, rtol=1e-12, atol=1e-15)
+    lift_dir = np.array([math.sin(a), 0.0, math.cos(a)])  # across the flow, upwards
+    np.testing.assert_allclose(lift, q * c_l * lift_dir, rtol=1e-12, atol=1e-15)
+    np.testing.assert_array_equal(rot, 0.0)
+    np.testing.assert_allclose(out[0:3], lift + drag, rtol=1e-12, atol=1e-15)
+
+
+def test_the_rotational_force_of_a_pitching_wing_is_sane_and_dickinsons():
+    """Pitching about its span at omega while translating at U (alpha 30 deg): the rotational force is
+    C_rot rho U omega times the integral of c^2 over the span, C_rot = pi (3/4 - 1/2), along the normal, on the
+    pushed side when the leading edge turns that way (raising alpha)."""
+    p = ButterflyParams()
+    pan = mj3d.panels(p, n_strips=32, n_chord=1)
+    U, a, w = 1.5, math.radians(30.0), 20.0
+    v = np.array([U * math.cos(a), 0.0, -U * math.sin(a)])
+    out = np.empty(15)
+    # leading edge (+x) up, towards the pushed side +z: rotation about -y (the span axis is +y)
+    mj3d.wing_panels(3, pan.ravel(), len(pan), 1.0, np.eye(3), v, np.array([0.0, -w, 0.0]), p.rho, p.cd,
+                     p.width_m / p.span_m, out)
+    # the flow across the span is the same at every panel (no rotation about other axes moves the span)
+    integral = (p.width_m / p.span_m) ** 2 * p.span_m ** 3 / 3.0
+    want = math.pi * 0.25 * p.rho * U * w * integral
+    np.testing.assert_allclose(out[12:15], [0.0, 0.0, want], rtol=1e-9)
+
+
+def test_the_normal_law_split_into_lift_and_drag_adds_up():
+    m = mj3d.build_model()
+    d, _ = _random_state(m, "strip", "none")
+    with passive_callback(mj3d.COMPILED_PASSIVE):
+        mujoco.mj_forward(m, d)
+    f = mj3d.forces(d)
+    np.testing.assert_allclose(f["wing_lift_N"] + f["wing_drag_N"], f["wing_force_N"], rtol=1e-10, atol=1e-14)
+    assert not f["wing_rotational_N"].any() and np.abs(f["wing_lift_N"]).max() > 0

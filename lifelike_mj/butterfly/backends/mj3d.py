@@ -55,7 +55,14 @@ from lifelike_mj.physics.fluid import normal_drag_scalar
 
 #: Wing-force laws of the 3D callback: none (gravity and the drive only), the paper's tip-speed
 #: formula, eq. 1 on panels.
-FORCE_LAWS = {"none": 0, "tip": 1, "strip": 2}
+FORCE_LAWS = {"none": 0, "tip": 1, "strip": 2, "quasi_steady": 3}
+#: Quasi-steady coefficients of a revolving fruit-fly wing (Dickinson, Lehmann & Sane 1999, Science 284: the
+#: fits C_L = 0.225 + 1.58 sin(2.13 alpha - 7.20), C_D = 1.92 - 1.55 cos(2.04 alpha - 9.82), alpha in deg).
+QS_CL = (0.225, 1.58, 2.13, -7.20)
+QS_CD = (1.92, -1.55, 2.04, -9.82)
+#: Rotational-force coefficient pi (3/4 - x0) of Sane & Dickinson 2002 (J Exp Biol 205) for a wing pitching
+#: about its mid-chord (x0 = 1/2).
+QS_CROT = math.pi * (0.75 - 0.5)
 #: Frames of the body drag: the thorax's axes or the world's.
 DRAG_FRAMES = {"world": 0, "body": 1}
 #: Assists: none, or the attitude held (reduction check).
@@ -79,18 +86,21 @@ U_DP0 = U_P0 + N_PARAMS  # their rates
 U_TARGET = U_DP0 + N_PARAMS  # the command
 U_OUT = U_TARGET + N_PARAMS  # outputs of the last call, below
 O_WING_FORCE, O_WING_MOMENT, O_BODY_DRAG, O_DRIVE, O_HOLD = 0, 6, 12, 15, 20  # within U_OUT
-N_OUT = 23
+O_PARTS = 23  # per wing: translational lift (3), drag (3), rotational (3)
+N_OUT = 41
 U_SCR = U_OUT + N_OUT  # 15: force, torque, point, velocity (6)
-U_M = U_SCR + 15  # MAX_NV * MAX_NV: the inertia matrix
+U_WSCR = U_SCR + 15  # 21: a wing's hinge velocity (3), angular velocity (3), forces (15)
+U_M = U_WSCR + 21  # MAX_NV * MAX_NV: the inertia matrix
 MAX_NV = 11
 U_C = U_M + MAX_NV * MAX_NV  # MAX_NV: the bias forces
 U_ASTAR = U_C + MAX_NV  # 8: the driven dofs' accelerations asked
 U_TAU = U_ASTAR + 8  # 8: their torques
 U_REF = U_TAU + 8  # 15: the joints' references (5 x 3)
 U_KIN = U_REF + 15  # 3 * N_PARAMS: the parameters at the stage (p, dp, ddp)
-U_NPANEL = U_KIN + 3 * N_PARAMS
+U_WL = U_KIN + 3 * N_PARAMS  # W / L: the chord per span of the planform-2 triangle
+U_NPANEL = U_WL + 1
 U_PANEL = U_NPANEL + 1  # per panel: chord position (m, + forward), span position (m, > 0), area (m^2)
-MAX_PANELS = 256
+MAX_PANELS = 240
 N_USERDATA = U_PANEL + 3 * MAX_PANELS
 
 _O_TIME, _O_QPOS, _O_QVEL, _O_QFRC, _O_UD = mjabi.O_TIME, mjabi.O_QPOS, mjabi.O_QVEL, mjabi.O_QFRC, mjabi.O_UD
@@ -103,6 +113,89 @@ _vp = mjabi.voidptr_from_int
 _addr = mjabi.int_from_voidptr
 _ptr_at = mjabi.ptr_at
 _f64 = mjabi.f64_at
+
+
+@njit(cache=True)
+def wing_panels(mode, pan, npan, side, R, lin, omega, rho, cd, wl, out):
+    """The air's force on one wing from its panels (``pan``: chord position, span position, area): ``out`` =
+    force (3, N), moment about the hinge (3, N m), and the force split into translational lift (3), drag (3)
+    and rotational force (3), world frame. ``R``: the wing's axes as columns (chord, span, normal); ``lin``,
+    ``omega``: the hinge's velocity relative to the air and the wing's angular velocity.
+
+    ``mode`` 2, eq. 1: ``-1/2 rho C_d dA v_n |v_n|`` along the normal (Oe 2010 eq. 1). ``mode`` 3, quasi-steady
+    blade elements: with ``U`` the panel's air speed across the span and ``alpha`` its angle to the wing
+    plane, lift ``1/2 rho C_L(alpha) U^2 dA`` across the flow, drag ``1/2 rho C_D(alpha) U^2 dA`` along it
+    (:data:`QS_CL`, :data:`QS_CD`), and the rotational force ``C_rot rho U omega_p c dA`` along the normal
+    (:data:`QS_CROT`; ``omega_p`` the pitching rate that raises ``alpha``, ``c = W r / L`` the local chord).
+    Either law's force is also split into its part along the flow (drag) and across it (lift)."""
+    for k in range(15):
+        out[k] = 0.0
+    cx, cy, cz = R[0, 0], R[1, 0], R[2, 0]
+    sx, sy, sz = R[0, 1], R[1, 1], R[2, 1]
+    nx, ny, nz = R[0, 2], R[1, 2], R[2, 2]
+    wx, wy, wz = omega[0], omega[1], omega[2]
+    w_span = wx * sx + wy * sy + wz * sz
+    for j in range(npan):
+        xc = pan[3 * j]
+        r = side * pan[3 * j + 1]
+        area = pan[3 * j + 2]
+        rx = cx * xc + sx * r
+        ry = cy * xc + sy * r
+        rz = cz * xc + sz * r
+        vx = lin[0] + wy * rz - wz * ry
+        vy = lin[1] + wz * rx - wx * rz
+        vz = lin[2] + wx * ry - wy * rx
+        vn = vx * nx + vy * ny + vz * nz
+        vs = vx * sx + vy * sy + vz * sz
+        ex = vx - vs * sx  # the flow across the span
+        ey = vy - vs * sy
+        ez = vz - vs * sz
+        u2 = ex * ex + ey * ey + ez * ez
+        rot = 0.0
+        sgn = 1.0
+        rox, roy, roz = 0.0, 0.0, 0.0
+        if mode == 2:
+            dfn = normal_drag_scalar(area, rho, cd, vn)
+            fx, fy, fz = dfn * nx, dfn * ny, dfn * nz
+        elif u2 > 0.0:
+            u = math.sqrt(u2)
+            sgn = 1.0 if vn > 0.0 else -1.0
+            alpha = math.degrees(math.asin(min(1.0, abs(vn) / u)))
+            q = 0.5 * rho * u2 * area
+            c_l = QS_CL[0] + QS_CL[1] * math.sin(math.radians(QS_CL[2] * alpha + QS_CL[3]))
+            c_d = QS_CD[0] + QS_CD[1] * math.cos(math.radians(QS_CD[2] * alpha + QS_CD[3]))
+            # across the flow, on the side the normal force pushes: -sgn n less its part along the flow
+            pn = -sgn * (nx * ex + ny * ey + nz * ez) / u2
+            lx, ly, lz = -sgn * nx - pn * ex, -sgn * ny - pn * ey, -sgn * nz - pn * ez
+            ln = math.sqrt(lx * lx + ly * ly + lz * lz)
+            if ln > 0.0:
+                lx, ly, lz = lx / ln, ly / ln, lz / ln
+            fx = q * (c_l * lx - c_d * ex / u)
+            fy = q * (c_l * ly - c_d * ey / u)
+            fz = q * (c_l * lz - c_d * ez / u)
+            # rotational force: the leading edge turning towards the pushed side raises alpha
+            rot = QS_CROT * rho * u * (w_span * sgn) * (wl * abs(r)) * area
+            rox, roy, roz = -sgn * rot * nx, -sgn * rot * ny, -sgn * rot * nz
+            out[12] += rox
+            out[13] += roy
+            out[14] += roz
+        else:
+            fx, fy, fz = 0.0, 0.0, 0.0
+        if u2 > 0.0:
+            along = (fx * ex + fy * ey + fz * ez) / u2
+            out[9] += along * ex
+            out[10] += along * ey
+            out[11] += along * ez
+            out[6] += fx - along * ex
+            out[7] += fy - along * ey
+            out[8] += fz - along * ez
+        gx, gy, gz = fx + rox, fy + roy, fz + roz
+        out[0] += gx
+        out[1] += gy
+        out[2] += gz
+        out[3] += ry * gz - rz * gy
+        out[4] += rz * gx - rx * gz
+        out[5] += rx * gy - ry * gx
 
 
 @njit(cache=True)
@@ -175,6 +268,11 @@ def _passive_kernel(m, d, off):
         hn = math.sqrt(hx * hx + hy * hy)
         sphi = xmat[mb + 6]
         v_fwd = (vbx * hx + vby * hy) / hn if hn > 0.0 else 0.0
+        wscr = _f64(uda + 8 * U_WSCR, 21)
+        lin = wscr[0:3]
+        omega = wscr[3:6]
+        npan = int(ud[U_NPANEL])
+        pan = _f64(uda + 8 * U_PANEL, 3 * MAX_PANELS)
         for i in range(2):
             wing = int(ud[U_WING + i])
             side = 1.0 if i == 0 else -1.0
@@ -190,47 +288,29 @@ def _passive_kernel(m, d, off):
                 vp = ud[U_L] * qvel[int(ud[U_DRIVEN_D + i])] - v_fwd * sphi
                 fn = -ud[U_KHALF] * vp * abs(vp)
                 r = side * ud[U_CP]
-                ssx = fn * r * sx
-                ssy = fn * r * sy
-                ssz = fn * r * sz
-                fsum = fn
+                f[0] = fn * nx
+                f[1] = fn * ny
+                f[2] = fn * nz
+                # moment about the hinge: (r span) x (fn n)
+                tq[0] = fn * r * (sy * nz - sz * ny)
+                tq[1] = fn * r * (sz * nx - sx * nz)
+                tq[2] = fn * r * (sx * ny - sy * nx)
             else:
-                # eq. 1 on the wing's panels, each with its full air-relative velocity
+                # eq. 1 or the quasi-steady law on the wing's panels, each with its full air-relative velocity
                 _mj_objectVelocity(m, d, np.int32(_OBJ_XBODY), np.int32(wing), _vp(vel), np.int32(0))
-                wx = v6[0]
-                wy = v6[1]
-                wz = v6[2]
-                lx = v6[3] - ax
-                ly = v6[4] - ay
-                lz = v6[5] - az
-                cx = xmat[mw + 0]
-                cy = xmat[mw + 3]
-                cz = xmat[mw + 6]
-                npan = int(ud[U_NPANEL])
-                fsum = 0.0
-                ssx = 0.0
-                ssy = 0.0
-                ssz = 0.0
-                for j in range(npan):
-                    xc = ud[U_PANEL + 3 * j]
-                    r = side * ud[U_PANEL + 3 * j + 1]
-                    rx = cx * xc + sx * r
-                    ry = cy * xc + sy * r
-                    rz = cz * xc + sz * r
-                    vn = ((lx + wy * rz - wz * ry) * nx + (ly + wz * rx - wx * rz) * ny
-                          + (lz + wx * ry - wy * rx) * nz)
-                    dfn = normal_drag_scalar(ud[U_PANEL + 3 * j + 2], rho, cd, vn)
-                    fsum += dfn
-                    ssx += dfn * rx
-                    ssy += dfn * ry
-                    ssz += dfn * rz
-            # force along the normal; moment about the hinge (sum of dF r) x n
-            f[0] = fsum * nx
-            f[1] = fsum * ny
-            f[2] = fsum * nz
-            tq[0] = ssy * nz - ssz * ny
-            tq[1] = ssz * nx - ssx * nz
-            tq[2] = ssx * ny - ssy * nx
+                lin[0] = v6[3] - ax
+                lin[1] = v6[4] - ay
+                lin[2] = v6[5] - az
+                for k in range(3):
+                    omega[k] = v6[k]
+                wout = wscr[6:21]
+                wing_panels(mode, pan, npan, side, xmat[mw : mw + 9].reshape((3, 3)), lin, omega, rho, cd,
+                            ud[U_WL], wout)
+                for k in range(3):
+                    f[k] = wout[k]
+                    tq[k] = wout[3 + k]
+                for k in range(9):
+                    out[O_PARTS + 9 * i + k] = wout[6 + k]
             pt[0] = xpos[3 * wing]
             pt[1] = xpos[3 * wing + 1]
             pt[2] = xpos[3 * wing + 2]
@@ -305,21 +385,16 @@ def python_passive(m: mujoco.MjModel, d: mujoco.MjData) -> None:
         for i, side in ((0, 1.0), (1, -1.0)):
             wing = int(ud[U_WING + i])
             Rw = d.xmat[wing].reshape(3, 3)
-            chord, span, n = Rw[:, 0], Rw[:, 1], Rw[:, 2]
+            span, n = Rw[:, 1], Rw[:, 2]
             if mode == 1:
                 vp = ud[U_L] * d.qvel[int(ud[U_DRIVEN_D + i])] - v_fwd * R[2, 0]
                 fn = -ud[U_KHALF] * vp * abs(vp)
                 moment_arm = fn * side * ud[U_CP] * span
+                fw, mw = fn * n, np.cross(moment_arm, n)
             else:
                 mujoco.mj_objectVelocity(m, d, _OBJ_XBODY, wing, vel, 0)
-                npan = int(ud[U_NPANEL])
-                panels = ud[U_PANEL : U_PANEL + 3 * npan].reshape(npan, 3)
-                r = panels[:, :1] * chord[None, :] + side * panels[:, 1:2] * span[None, :]
-                v = (vel[3:] - air)[None, :] + np.cross(vel[:3][None, :], r)
-                dfn = np.array([normal_drag_scalar(a, rho, cd, vn) for a, vn in zip(panels[:, 2], v @ n)])
-                fn = float(dfn.sum())
-                moment_arm = dfn @ r
-            fw, mw = fn * n, np.cross(moment_arm, n)
+                fw, mw, parts = _python_wing(mode, ud, side, Rw, vel[3:] - air, vel[:3].copy())
+                out[O_PARTS + 9 * i : O_PARTS + 9 * i + 9] = parts
             out[O_WING_FORCE + 3 * i : O_WING_FORCE + 3 * i + 3] = fw
             out[O_WING_MOMENT + 3 * i : O_WING_MOMENT + 3 * i + 3] = mw
             mujoco.mj_applyFT(m, d, fw, mw, d.xpos[wing].copy(), wing, d.qfrc_passive)
@@ -344,6 +419,40 @@ def python_passive(m: mujoco.MjModel, d: mujoco.MjData) -> None:
         d.qfrc_passive[driven] += tau
         out[O_DRIVE : O_DRIVE + 5] = tau[:5]
         out[O_HOLD : O_HOLD + nd - 5] = tau[5:]
+
+
+def _python_wing(mode: int, ud: np.ndarray, side: float, Rw: np.ndarray, lin: np.ndarray, omega: np.ndarray):
+    """NumPy twin of :func:`wing_panels`: force, moment about the hinge, parts (lift, drag, rotational)."""
+    rho, cd = ud[U_RHO], ud[U_CD]
+    npan = int(ud[U_NPANEL])
+    panels = ud[U_PANEL : U_PANEL + 3 * npan].reshape(npan, 3)
+    chord, span, n = Rw[:, 0], Rw[:, 1], Rw[:, 2]
+    r = panels[:, :1] * chord[None, :] + side * panels[:, 1:2] * span[None, :]
+    v = lin[None, :] + np.cross(omega[None, :], r)
+    vn = v @ n
+    e = v - np.outer(v @ span, span)  # the flow across the span
+    u2 = np.sum(e * e, axis=1)
+    rot = np.zeros_like(r)
+    if mode == 2:
+        dF = np.array([normal_drag_scalar(a, rho, cd, x) for a, x in zip(panels[:, 2], vn)])[:, None] * n[None, :]
+    else:
+        u = np.sqrt(u2)
+        sgn = np.where(vn > 0, 1.0, -1.0)
+        alpha = np.degrees(np.arcsin(np.minimum(1.0, np.abs(vn) / u)))
+        q = 0.5 * rho * u2 * panels[:, 2]
+        c_l = QS_CL[0] + QS_CL[1] * np.sin(np.radians(QS_CL[2] * alpha + QS_CL[3]))
+        c_d = QS_CD[0] + QS_CD[1] * np.cos(np.radians(QS_CD[2] * alpha + QS_CD[3]))
+        side_n = -sgn[:, None] * n[None, :]
+        lift_dir = side_n - (np.sum(side_n * e, axis=1) / u2)[:, None] * e
+        lift_dir /= np.linalg.norm(lift_dir, axis=1)[:, None]
+        dF = (q * c_l)[:, None] * lift_dir - (q * c_d / u)[:, None] * e
+        w_span = float(omega @ span)
+        mag = QS_CROT * rho * u * (w_span * sgn) * (ud[U_WL] * np.abs(side * panels[:, 1])) * panels[:, 2]
+        rot = mag[:, None] * side_n
+    drag = (np.sum(dF * e, axis=1) / u2)[:, None] * e
+    total = dF + rot
+    parts = np.concatenate([(dF - drag).sum(0), drag.sum(0), rot.sum(0)])
+    return total.sum(0), np.cross(r, total).sum(0), parts
 
 
 # ---- set-up ----------------------------------------------------------------------------------
@@ -452,6 +561,7 @@ def setup_data(m: mujoco.MjModel, kinematics: Kinematics, params: ButterflyParam
     ud[U_FREE_D : U_FREE_D + len(free)] = free
     ud[U_ASSIST] = ASSISTS[assist]
     pan = panels(p, n_strips, n_chord)
+    ud[U_WL] = p.width_m / p.span_m
     ud[U_NPANEL] = len(pan)
     ud[U_PANEL : U_PANEL + pan.size] = pan.ravel()
     d.qpos[m.jnt_qposadr[m.joint("root").id] + 3] = 1.0
@@ -476,10 +586,14 @@ def load_kinematics(d: mujoco.MjData, kinematics: Kinematics) -> None:
 def forces(d: mujoco.MjData) -> dict[str, np.ndarray]:
     """The forces of the callback's last call (N, N m; world frame): each wing's air force and its
     moment about the wing's hinge (rows left, right), the body drag, the drive's five joint torques
-    and the attitude hold's three torques (zero unless held)."""
+    and the attitude hold's three torques (zero unless held); and each wing's force in parts (panel laws
+    only): translational lift (across each panel's flow), drag (along it) and the rotational force."""
     o = d.userdata[U_OUT : U_OUT + N_OUT]
     return {"wing_force_N": o[O_WING_FORCE : O_WING_FORCE + 6].reshape(2, 3).copy(),
             "wing_moment_N_m": o[O_WING_MOMENT : O_WING_MOMENT + 6].reshape(2, 3).copy(),
             "body_drag_N": o[O_BODY_DRAG : O_BODY_DRAG + 3].copy(),
             "drive_torque_N_m": o[O_DRIVE : O_DRIVE + 5].copy(),
+            "wing_lift_N": o[O_PARTS : O_PARTS + 18].reshape(2, 9)[:, 0:3].copy(),
+            "wing_drag_N": o[O_PARTS : O_PARTS + 18].reshape(2, 9)[:, 3:6].copy(),
+            "wing_rotational_N": o[O_PARTS : O_PARTS + 18].reshape(2, 9)[:, 6:9].copy(),
             "hold_torque_N_m": o[O_HOLD : O_HOLD + 3].copy()}

@@ -1,0 +1,65 @@
+"""Figures of 3D flights: paths from above and from the side, and the forces on the wings.
+
+Each function builds a matplotlib ``Figure`` (no pyplot) and writes a PNG only when given a path.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from lifelike_mj.render.plot import finish, new_figure
+
+
+def fig_paths(paths: list[dict], labels: list[str] | None = None, waypoints=None,
+              path: str | os.PathLike | None = None, title: str = "") -> Figure:
+    """Top view (x, y; m) and side view (distance flown over ground, altitude; m) of one or more recorded 3D
+    flights (:meth:`~lifelike_mj.butterfly.sim3d.Flight3D.record`), with the task's waypoints if given."""
+    fig = new_figure(12.0, 4.8)
+    top, side = fig.subplots(1, 2, width_ratios=[1.2, 1])
+    for i, rec in enumerate(paths):
+        pos = rec["position_m"]
+        label = labels[i] if labels else None
+        top.plot(pos[:, 0], pos[:, 1], lw=0.9, label=label)
+        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pos[:, :2], axis=0), axis=1))])
+        side.plot(s, pos[:, 2], lw=0.9, label=label)
+    if waypoints is not None and len(waypoints):
+        wp = np.asarray(waypoints, dtype=float)
+        top.scatter(wp[:, 0], wp[:, 1], marker="o", s=30, facecolors="none", edgecolors="k", label="waypoints")
+        for k, (x, y) in enumerate(wp[:, :2]):
+            top.annotate(str(k + 1), (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+    top.set_aspect("equal", adjustable="datalim")
+    top.set_xlabel("x [m] (forward at the start)")
+    top.set_ylabel("y [m] (left)")
+    top.set_title(title or "from above")
+    side.set_xlabel("distance flown over ground [m]")
+    side.set_ylabel("altitude z [m] (start 0 m)")
+    side.set_title("from the side")
+    for ax in (top, side):
+        ax.grid(alpha=0.3)
+    if labels or waypoints is not None:
+        top.legend(loc="best", fontsize=8)
+    return finish(fig, path)
+
+
+def write_flight(out_dir: str | os.PathLike, rec: dict, summary: dict, task) -> list[str]:
+    """``path.npz``, ``path.csv``, ``paths.png`` and ``summary.json`` (with provenance) into ``out_dir``,
+    each written atomically; returns the paths written."""
+    from pathlib import Path
+
+    from lifelike_mj.io import write_json, write_npz, write_text
+    from lifelike_mj.provenance import provenance
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    t, pos, att = rec["t_s"], rec["position_m"], rec["attitude_rad"]
+    cols = np.column_stack([t, pos, np.degrees(att), rec["velocity_m_s"]])
+    header = "t_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,vx_m_s,vy_m_s,vz_m_s"
+    csv = header + "\n" + "\n".join(",".join(f"{v:.6g}" for v in row) for row in cols) + "\n"
+    files = [write_npz(out / "path.npz", **rec), write_text(out / "path.csv", csv)]
+    wp = [r[:3] for r in task.rows] if task.kind == "waypoints" else None
+    fig_paths([rec], waypoints=wp, path=out / "paths.png", title=summary.get("task", ""))
+    files += [out / "paths.png", write_json(out / "summary.json", {**summary, "provenance": provenance(**summary)})]
+    return [str(f) for f in files]

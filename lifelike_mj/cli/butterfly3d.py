@@ -1,0 +1,231 @@
+"""``lifelike-mj butterfly fly3d | evolve3d | assess3d``: the butterfly in three dimensions."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+from lifelike_mj.cli.common import add_json, add_overwrite, add_seed, check_outputs, count, emit, num
+from lifelike_mj.errors import UserError
+from lifelike_mj.progress import stage
+
+#: The files of ``fly3d --out``.
+FLY3D_FILES = ("path.npz", "path.csv", "paths.png", "summary.json")
+MAX_DURATION_S = 3600.0
+
+
+def _vector3(text: str) -> tuple[float, float, float]:
+    try:
+        v = tuple(float(x) for x in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected three numbers X,Y,Z in m/s, got {text!r}") from None
+    if len(v) != 3 or not all(math.isfinite(x) and abs(x) <= 50 for x in v):
+        raise argparse.ArgumentTypeError(f"expected three numbers X,Y,Z in m/s, each within +-50, got {text!r}")
+    return v  # type: ignore[return-value]
+
+
+def _task(args):
+    from lifelike_mj.butterfly import evolve3d
+
+    if args.task == "level":
+        return evolve3d.level(args.speed)
+    if args.task == "turn":
+        return evolve3d.turn(args.angle, 2.0, args.speed)
+    return evolve3d.course(args.seed, speed_m_s=args.speed)
+
+
+def cmd_fly3d(args) -> None:
+    import numpy as np
+
+    from lifelike_mj.butterfly.control3d import load_controller
+    from lifelike_mj.butterfly.sim3d import Flight3D
+
+    check_outputs(args, folders={"--out": FLY3D_FILES})
+    ctrl = load_controller(args.controller)
+    flight = Flight3D(controller=ctrl, task=_task(args), wind_m_s=args.wind)
+    with stage(f"3D flight, {args.duration:g} s"):
+        rec = flight.record(duration_s=args.duration, every=12)
+    pos, att = rec["position_m"], rec["attitude_rad"]
+    s = {"controller": ctrl.name or args.controller, "task": flight.task.name, "duration_s": float(rec["t_s"][-1]),
+         "end_m": [float(v) for v in pos[-1]], "distance_m": float(np.linalg.norm(pos[-1, :2] - pos[0, :2])),
+         "altitude_min_m": float(pos[:, 2].min()), "altitude_max_m": float(pos[:, 2].max()),
+         "roll_max_deg": float(np.degrees(np.abs(att[:, 0]).max())),
+         "pitch_range_deg": [float(np.degrees(att[:, 1].min())), float(np.degrees(att[:, 1].max()))],
+         "mean_reward": flight.reward / max(flight.time, 1e-12), "waypoints_passed": flight.waypoints_passed}
+    if args.out:
+        from lifelike_mj.butterfly.figures3d import write_flight
+
+        write_flight(args.out, rec, s, flight.task)
+    human = (f"{s['task']}: {s['distance_m']:.1f} m over ground in {s['duration_s']:.1f} s, altitude in "
+             f"[{s['altitude_min_m']:+.2f}, {s['altitude_max_m']:+.2f}] m, roll within {s['roll_max_deg']:.0f} deg, "
+             f"pitch in [{s['pitch_range_deg'][0]:.0f}, {s['pitch_range_deg'][1]:.0f}] deg")
+    if flight.task.kind == "waypoints":
+        human += f"; {s['waypoints_passed']} of {len(flight.task.rows)} waypoints passed"
+    emit(args, s, human)
+
+
+def cmd_evolve3d(args) -> None:
+    from lifelike_mj.butterfly.control3d import load_controller
+    from lifelike_mj.butterfly.evolve3d import TASK_SETS, evolve
+
+    layers = [10, *args.hidden, 9]
+    start = load_controller(args.start) if args.start else None
+    if start is not None and args.hidden:
+        raise UserError("--hidden does not apply with --start (the network is the start controller's).")
+    out = Path(args.out or f"butterfly3d_{args.optimizer}_{args.tasks}_s{args.seed}.json")
+    res, ctrl = evolve(TASK_SETS[args.tasks](), out, optimizer=args.optimizer, seed=args.seed, layers=layers,
+                       population=args.population, generations=args.generations, duration_s=args.duration,
+                       checkpoint=args.checkpoint, resume=args.resume, progress=not args.quiet,
+                       overwrite=args.overwrite, task_set=args.tasks, start=start, gene_bound=args.gene_bound)
+    if ctrl is None:
+        raise KeyboardInterrupt("stopped before the first generation was evaluated; nothing was written")
+    state = "stopped early (Ctrl-C); best so far" if res.interrupted else "done"
+    emit(args, {"out": str(out), "best_fitness": float(res.best_f), "generations": res.generations,
+                "wall_time_s": float(res.wall_time_s), "interrupted": bool(res.interrupted)},
+         f"{state}: best fitness {res.best_f:.3f} after {res.generations} generations ({res.wall_time_s:.0f} s); "
+         f"controller written to {out}")
+    if res.interrupted:
+        raise KeyboardInterrupt
+
+
+def cmd_assess3d(args) -> None:
+    from lifelike_mj.butterfly.control3d import load_controller
+    from lifelike_mj.butterfly.validate3d import course_check, level_check, turn_check
+
+    ctrl = load_controller(args.controller)
+    with stage("level flight, turns of 90 and 180 deg, courses"):
+        level = level_check(ctrl, args.speed, args.duration)
+        turns = [turn_check(ctrl, a, speed_m_s=args.speed) for a in (90.0, -90.0, 180.0)]
+        courses = [course_check(ctrl, s) for s in args.courses]
+    d = {"controller": ctrl.name or args.controller, "level": level, "turns": turns, "courses": courses}
+    human = (f"level {level['duration_s']:.0f} s at {args.speed:g} m/s: speed [{level['speed_min_m_s']:.2f}, "
+             f"{level['speed_max_m_s']:.2f}] m/s, altitude [{level['altitude_min_m']:+.2f}, "
+             f"{level['altitude_max_m']:+.2f}] m, roll within {level['roll_max_deg']:.0f} deg, pitch "
+             f"[{level['pitch_min_deg']:.0f}, {level['pitch_max_deg']:.0f}] deg; "
+             + "; ".join(f"turn {t['angle_deg']:+.0f} deg in {t['turn_time_s']:.1f} s, held within "
+                         f"{t['held_error_max_deg']:.1f} deg" for t in turns)
+             + "; courses: " + ", ".join(f"seed {c['seed']} {c['passed']}/{c['waypoints']}" for c in courses))
+    emit(args, d, human)
+
+
+def cmd_garden(args) -> None:
+    import numpy as np
+
+    from lifelike_mj.butterfly.control3d import load_controller
+    from lifelike_mj.butterfly.garden import Garden, film_garden
+
+    check_outputs(args, files={"--out": (".mp4", ".gif"), "--paths": (".png",)})
+    ctrl = load_controller(args.controller)
+    garden = Garden(args.n, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_m_s=args.wind)
+    d: dict = {"butterflies": args.n, "seed": args.seed, "controller": ctrl.name or args.controller}
+    if args.out:
+        info = film_garden(args.out, garden, args.duration, args.fps, args.width, args.height, args.camera,
+                           progress=True)
+        d["video"] = info
+    else:
+        with stage(f"{args.n} butterflies, {args.duration:g} s"):
+            garden.step(int(round(args.duration / garden.dt)))
+    passed = garden.state()["waypoints_passed"]
+    d.update({"duration_s": garden.time, "flowers_visited_min": int(passed.min()),
+              "flowers_visited_mean": float(passed.mean()), "flowers_visited_max": int(passed.max())})
+    if args.paths:
+        from lifelike_mj.butterfly.figures3d import fig_paths
+
+        g2 = Garden(args.n, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_m_s=args.wind)
+        recs = [{"position_m": [], "t_s": []} for _ in range(args.n)]
+        for _ in range(int(round(args.duration / 0.02))):
+            g2.step(max(1, int(round(0.02 / g2.dt))))
+            for r, p in zip(recs, g2.state()["position_m"]):
+                r["position_m"].append(p)
+        fig_paths([{"position_m": np.array(r["position_m"])} for r in recs], waypoints=g2.blossoms,
+                  path=args.paths, title=f"{args.n} butterflies, {args.duration:g} s")
+        d["paths"] = args.paths
+    emit(args, d, f"{args.n} butterflies flew {garden.time:.1f} s and visited {passed.min():.0f} to {passed.max():.0f} "
+         f"flowers each" + (f"; video {args.out}" if args.out else "") + (f"; paths {args.paths}" if args.paths else ""))
+
+
+def _seeds(text: str) -> list[int]:
+    from lifelike_mj.cli.common import seeds
+
+    try:
+        return seeds(text)
+    except UserError as exc:
+        raise argparse.ArgumentTypeError(str(exc).rstrip(".")) from None
+
+
+def _hidden(text: str) -> list[int]:
+    if text in ("", "0", "none"):
+        return []
+    try:
+        sizes = [int(v) for v in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected sizes like 8 or 8,8, got {text!r}") from None
+    if not sizes or min(sizes) < 1 or max(sizes) > 256:
+        raise argparse.ArgumentTypeError(f"hidden layer sizes are 1 to 256, got {text!r}")
+    return sizes
+
+
+def add_commands(bf) -> None:
+    """``fly3d``, ``evolve3d`` and ``assess3d`` under ``lifelike-mj butterfly``."""
+    p = bf.add_parser("fly3d", help="fly the 3D butterfly with a 3D controller")
+    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name (steer) or a file")
+    p.add_argument("--task", default="level", choices=("level", "turn", "course"),
+                   help="level flight, a turn (--angle) or a course of 10 waypoints drawn by --seed")
+    p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
+    p.add_argument("--angle", type=num(-180, 180, unit="deg"), default=90.0, help="turn angle, deg, left > 0")
+    add_seed(p)
+    p.add_argument("--wind", type=_vector3, default=(0.0, 0.0, 0.0), help="wind X,Y,Z in m/s (where it blows to)")
+    p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=20.0,
+                   help=f"seconds of flight, at most {MAX_DURATION_S:g}")
+    p.add_argument("--out", help="folder for path.npz/.csv, paths.png (top and side views), summary.json")
+    add_overwrite(p)
+    add_json(p)
+    p.set_defaults(func=cmd_fly3d)
+    p = bf.add_parser("evolve3d", help="evolve a 3D controller (CMA-ES or the paper's GA) on the MuJoCo batch")
+    p.add_argument("--optimizer", default="cmaes", choices=("cmaes", "rcga", "crs2", "esch", "isres"),
+                   help="cmaes (default) or rcga (the paper's GA), or an nlopt method")
+    p.add_argument("--tasks", default="steer", choices=("steer", "cruise"),
+                   help="the task set: steer (level at 1 and 2 m/s, turns of 90 and -180 deg) or cruise (level at 1.5 "
+                        "and 2 m/s, the turns, and two flights in 1 m/s wind with 0.5 m/s gusts)")
+    p.add_argument("--start", default=None, help="a 3D controller to start from (its network; genes are its changes)")
+    p.add_argument("--gene-bound", type=num(0, 10, lo_open=True), default=0.4,
+                   help="bound of each gene (a weight's change from the start), default 0.4")
+    p.add_argument("--hidden", type=_hidden, default=[], help="hidden layer sizes, e.g. 16 (default: none, linear)")
+    p.add_argument("--population", type=count(2, 100_000), default=16, help="population size (default 16)")
+    p.add_argument("--generations", type=count(1, 1_000_000), default=300, help="generations (default 300)")
+    p.add_argument("--duration", type=num(0, 60, lo_open=True, unit="s"), default=4.0,
+                   help="seconds of each training flight (default 4)")
+    add_seed(p)
+    p.add_argument("--checkpoint", default=None, help="checkpoint file (default: OUT.ckpt), written every generation")
+    p.add_argument("--resume", action="store_true", help="continue from the checkpoint")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --out and checkpoint (a new run)")
+    p.add_argument("--out", default=None, help="controller file to write (.json)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_json(p)
+    p.set_defaults(func=cmd_evolve3d)
+    p = bf.add_parser("garden", help="a garden of 3D butterflies visiting flowers, filmed")
+    p.add_argument("--n", type=count(1, 500), default=20, help="butterflies, 1 to 500 (default 20)")
+    p.add_argument("--controller", default="cruise", help="a shipped 3D controller's name or a file")
+    add_seed(p)
+    p.add_argument("--flutter", type=num(0, 1), default=0.1, help="each butterfly's flutter, 0 to 1 (default 0.1)")
+    p.add_argument("--gusts", type=num(0, 10, unit="m/s"), default=0.0, help="gusts' standard deviation, m/s")
+    p.add_argument("--wind", type=_vector3, default=(0.0, 0.0, 0.0), help="mean wind X,Y,Z in m/s")
+    p.add_argument("--duration", type=num(0, 600, lo_open=True, unit="s"), default=10.0, help="seconds of flight")
+    p.add_argument("--out", default=None, help="video file (.mp4 or .gif)")
+    p.add_argument("--camera", default="overview", choices=("overview", "chase"), help="overview (fixed) or chase")
+    p.add_argument("--fps", type=count(1, 240), default=30, help="frames per second")
+    p.add_argument("--width", type=count(16, 1920), default=960, help="frame width, pixels")
+    p.add_argument("--height", type=count(16, 1080), default=540, help="frame height, pixels")
+    p.add_argument("--paths", default=None, help="also a PNG of the paths from above and from the side")
+    add_overwrite(p)
+    add_json(p)
+    p.set_defaults(func=cmd_garden)
+    p = bf.add_parser("assess3d", help="a 3D controller's acceptance numbers: level flight, turns, courses")
+    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name or a file")
+    p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s")
+    p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=60.0,
+                   help="seconds of level flight (default 60)")
+    p.add_argument("--courses", type=_seeds, default=[100, 101, 102], help="course seeds, e.g. 100-104")
+    add_json(p)
+    p.set_defaults(func=cmd_assess3d)
