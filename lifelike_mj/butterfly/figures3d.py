@@ -63,3 +63,49 @@ def write_flight(out_dir: str | os.PathLike, rec: dict, summary: dict, task) -> 
     fig_paths([rec], waypoints=wp, path=out / "paths.png", title=summary.get("task", ""))
     files += [out / "paths.png", write_json(out / "summary.json", {**summary, "provenance": provenance(**summary)})]
     return [str(f) for f in files]
+
+
+def force_breakdown(controller, force_law: str = "strip", speed_m_s: float = 1.5, settle_s: float = 3.0,
+                    beats: int = 2, **flight) -> dict:
+    """The left wing's force in parts (N, world frame) over ``beats`` wing beats of level flight after
+    ``settle_s``: ``t_s``, ``lift_N``, ``drag_N``, ``rotational_N``, ``total_N`` (rows per step, x forward at
+    the start, z up) and ``flap_rad``."""
+    from lifelike_mj.butterfly import evolve3d
+    from lifelike_mj.butterfly.sim3d import Flight3D
+
+    f = Flight3D(controller=controller, task=evolve3d.level(speed_m_s), force_law=force_law, **flight)
+    f.step(int(round(settle_s / f.dt)))
+    n = int(round(beats / f.kinematics.p[0] / f.dt))
+    rows = {"t_s": [], "lift_N": [], "drag_N": [], "rotational_N": [], "total_N": [], "flap_rad": []}
+    for _ in range(n):
+        parts = f.forces()
+        rows["t_s"].append(f.time)
+        rows["lift_N"].append(parts["wing_lift_N"][0])
+        rows["drag_N"].append(parts["wing_drag_N"][0])
+        rows["rotational_N"].append(parts["wing_rotational_N"][0])
+        rows["total_N"].append(parts["wing_force_N"][0])
+        rows["flap_rad"].append(f.state()["joints_rad"][0])
+        f.step(1)
+    return {k: np.array(v) for k, v in rows.items()}
+
+
+def fig_force_breakdown(breakdowns: dict, weight_N: float, path: str | os.PathLike | None = None) -> Figure:
+    """One column per force law (``breakdowns``: law -> :func:`force_breakdown`): the left wing's vertical
+    (top) and forward (bottom) force in its parts, over the flap angle's beats, against the weight's share of
+    one wing."""
+    fig = new_figure(5.5 * len(breakdowns), 6.0)
+    axes = fig.subplots(2, len(breakdowns), squeeze=False, sharex="col")
+    for col, (law, b) in enumerate(breakdowns.items()):
+        t = b["t_s"] - b["t_s"][0]
+        for row, (k, name) in enumerate(((2, "vertical"), (0, "forward"))):
+            ax = axes[row, col]
+            for part, style in (("total_N", "-"), ("lift_N", "--"), ("drag_N", ":"), ("rotational_N", "-.")):
+                ax.plot(t, 1e3 * b[part][:, k], style, lw=1.0, label=part.removesuffix("_N"))
+            if k == 2:
+                ax.axhline(1e3 * weight_N / 2, color="0.5", lw=0.6, label="half the weight")
+                ax.set_title(f"{law}: left wing")
+            ax.set_ylabel(f"{name} force [mN]")
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=7, loc="upper right")
+        axes[1, col].set_xlabel("time [s]")
+    return finish(fig, path)

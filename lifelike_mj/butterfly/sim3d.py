@@ -100,8 +100,8 @@ position.
     def __init__(self, command: KinematicsCommand | None = None, params: ButterflyParams | None = None, *,
                  controller=None, task=None, control_every: int = 1, wind_m_s=None,
                  start_m=(0.0, 0.0, 0.0), force_law: str = "strip", drag_frame: str = "body",
-                 body_areas_m2=None, masses: str = "animal", dt_s: float = 1.0 / 1200.0, n_strips: int = 16,
-                 n_chord: int = 3, drive_hz: float = 50.0, omega_c: float | None = None, assist: str = "none",
+                 body_areas_m2=None, masses: str = "animal", dt_s: float = 1.0 / 1200.0, n_strips: int = 8,
+                 n_chord: int = 2, drive_hz: float = 50.0, omega_c: float | None = None, assist: str = "none",
                  pitch_law: Callable | None = None, _model: mujoco.MjModel | None = None) -> None:
         from lifelike_mj.butterfly import control3d, evolve3d
 

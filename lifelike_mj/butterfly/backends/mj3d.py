@@ -497,7 +497,7 @@ def build_model(params: ButterflyParams | None = None, masses: str = "animal") -
 
 
 
-def panels(params: ButterflyParams, n_strips: int = 16, n_chord: int = 3) -> np.ndarray:
+def panels(params: ButterflyParams, n_strips: int = 8, n_chord: int = 2) -> np.ndarray:
     """``(n, 3)``: chord position (m, + towards the leading edge), span position (m) and area (m^2) of
     each panel of one wing: the planform-2 triangle (Oe 2010 eq. 3, chord ``W r / L`` at span ``r``)
     cut into ``n_strips`` strips (three Gauss points each) and each strip into ``n_chord`` Gauss-Legendre
@@ -527,7 +527,7 @@ def driven_dofs(m: mujoco.MjModel, assist: str = "none") -> tuple[np.ndarray, np
 
 def setup_data(m: mujoco.MjModel, kinematics: Kinematics, params: ButterflyParams | None = None, *,
                force_law: str = "strip", air_m_s=(0.0, 0.0, 0.0), body_areas_m2=None, drag_frame: str = "body",
-               assist: str = "none", drive_hz: float = 50.0, n_strips: int = 16, n_chord: int = 3) -> mujoco.MjData:
+               assist: str = "none", drive_hz: float = 50.0, n_strips: int = 8, n_chord: int = 2) -> mujoco.MjData:
     """A fresh ``MjData`` of the 3D model, its userdata filled for the callback; the wings and abdomen at
     the kinematics' angles and rates, the body at rest at the origin, level."""
     p = params or ButterflyParams()

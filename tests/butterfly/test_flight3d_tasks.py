@@ -1,0 +1,42 @@
+"""The shipped 3D controllers do what issue 15 asks, measured here (the long versions: `butterfly assess3d`)."""
+
+import pytest
+
+from lifelike_mj.butterfly import control3d as c3
+from lifelike_mj.butterfly.validate3d import course_check, kinematics_check, level_check, turn_check
+from lifelike_mj.paths import shipped_names
+
+SHIPPED = shipped_names("butterfly3d")
+
+
+def test_the_controllers_are_shipped_with_their_provenance():
+    assert {"steer", "cruise"} <= set(SHIPPED)
+    for name in SHIPPED:
+        prov = c3.load_controller(name).provenance
+        assert prov["evolution_wall_time_s"] > 0 and prov["generations_done"] > 0
+        assert prov["problem"]["problem"] == "butterfly3d-flight" and "machine" in prov
+
+
+@pytest.mark.parametrize("name", ["steer", "cruise"])
+def test_level_flight_holds_altitude_upright(name):
+    r = level_check(name, 2.0 if name == "steer" else 1.5, duration_s=20.0)
+    assert r["altitude_within_0_3_m"] and r["roll_max_deg"] < 60 and -30 < r["pitch_min_deg"] < r["pitch_max_deg"] < 60
+    assert r["speed_within_10_percent"], r
+
+
+@pytest.mark.parametrize("angle", [90.0, 180.0])
+def test_turns_reach_and_hold_the_new_heading(angle):
+    r = turn_check("cruise", angle, hold_s=6.0)
+    assert r["held_within_10_deg"] and r["turn_time_s"] < 3.0, r
+
+
+def test_a_course_never_trained_on_is_flown_through_every_waypoint():
+    r = course_check("cruise", seed=100, max_s=40.0)
+    assert r["passed"] == 10 and r["all_within_radius"], r
+
+
+def test_the_flight_looks_like_dudleys_butterflies():
+    """Dudley 1990 (37 species): about 11 Hz, about 103 deg of stroke, faster than 1 m/s."""
+    r = kinematics_check("cruise", 1.5, settle_s=3.0, window_s=3.0)
+    assert 8.0 < r["flap_frequency_hz"] < 14.0 and 80.0 < r["stroke_amplitude_deg"] < 130.0
+    assert r["speed_m_s"] > 1.0

@@ -1,0 +1,45 @@
+"""The garden: many 3D butterflies on their own courses among the flowers, drawn in one scene."""
+
+import numpy as np
+import pytest
+
+from lifelike_mj.butterfly import control3d as c3
+from lifelike_mj.butterfly import evolve3d as e3
+from lifelike_mj.butterfly.garden import Garden, course_among, flowers
+from lifelike_mj.butterfly.sim3d import Flight3D
+from lifelike_mj.errors import UserError
+
+
+def test_flowers_and_courses_are_drawn_by_seed():
+    a, b = flowers(3), flowers(3)
+    np.testing.assert_array_equal(a, b)
+    assert not np.array_equal(a, flowers(4))
+    gaps = np.linalg.norm(a[:, None, :2] - a[None, :, :2], axis=2) + np.eye(len(a)) * 9
+    assert gaps.min() >= 1.2
+    course = course_among(a, 7)
+    assert len(course) == 40 and np.all(np.linalg.norm(np.diff(course, axis=0), axis=1) > 0)  # never twice in a row
+
+
+def test_each_garden_butterfly_flies_what_its_own_flight_flies():
+    """The garden's threaded batch gives every butterfly the flight a Flight3D on the same task gives it."""
+    ctl = c3.load_controller("cruise")
+    g = Garden(3, ctl, seed=2, flutter=0.1, gust_m_s=0.3)
+    starts = [d.qpos[:7].copy() for d in g._datas]
+    g.step(240)
+    g.sync()
+    state = g.state()
+    for i in range(3):
+        f = Flight3D(controller=ctl, task=g.tasks[i], n_strips=8, n_chord=2)
+        f.data.qpos[:7] = starts[i]
+        f.step(240)
+        np.testing.assert_array_equal(f.state()["position_m"], state["position_m"][i])
+        # and the scene shows it where it is
+        body = g.model.body(f"b{i}_butterfly").id
+        np.testing.assert_allclose(g.data.xpos[body], state["position_m"][i], atol=1e-12)
+
+
+def test_bad_garden_arguments_are_one_sentence():
+    with pytest.raises(UserError, match="number of butterflies"):
+        Garden(0, c3.Controller3D([10, 9], e3.pd_prior([10, 9])))
+    with pytest.raises(UserError, match="flutter"):
+        Garden(2, c3.Controller3D([10, 9], e3.pd_prior([10, 9])), flutter=3.0)
