@@ -368,7 +368,7 @@ def controller_from_dict(data: object, name: str = "") -> Controller3D:
     from lifelike_mj.schema import check_header, check_keys, number_list
 
     where = f"3D controller {name}" if name else "3D controller"
-    d = check_header(data, FORMAT, where)
+    d = check_header(data, FORMAT, f"file {name}" if name else "the data", kind="3D controller file")
     check_keys(d, ("format", "version", "layers", "weights", "base", "scale", "every", "omega_c_rad_s", "provenance"),
                where, required=("layers", "weights"))
     base = d.get("base")

@@ -136,7 +136,7 @@ CASES = [
     (["butterfly", "fly3d", "--wind", "1,2"], "three numbers", {}),
     (["butterfly", "fly3d", "--wind", "1,nan,0"], "three numbers", {}),
     (["butterfly", "fly3d", "--task", "loop"], "invalid choice", {}),
-    (["butterfly", "fly3d", "--out", "o"], "already exists", {"o/summary.json": "x"}),
+    (["butterfly", "fly3d", "--out", "o"], "already holds", {"o/summary.json": "x"}),
     (["butterfly", "evolve3d", "--tasks", "dance"], "invalid choice", {}),
     (["butterfly", "evolve3d", "--hidden", "0,x"], "--hidden", {}),
     (["butterfly", "evolve3d", "--start", "cruise", "--hidden", "8"], "--hidden does not apply", {}),

@@ -38,6 +38,7 @@ callback is tested against.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import mujoco
@@ -352,9 +353,17 @@ def _passive_kernel(m, d, off):
                 out[O_HOLD + r - 5] = tau[r]
 
 
-_PASSIVE = mjabi.compiled_passive(_passive_kernel, "butterfly3d")
-#: The compiled passive callback (a ctypes function pointer MuJoCo accepts).
-COMPILED_PASSIVE = _PASSIVE.ctypes
+@functools.lru_cache(maxsize=1)
+def _compiled_passive():
+    return mjabi.compiled_passive(_passive_kernel, "butterfly3d")
+
+
+def __getattr__(name: str):
+    # COMPILED_PASSIVE, the compiled passive callback (a ctypes function pointer MuJoCo accepts), is made on
+    # first use: importing this module (to read a controller file, say) compiles nothing
+    if name == "COMPILED_PASSIVE":
+        return _compiled_passive().ctypes
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def python_passive(m: mujoco.MjModel, d: mujoco.MjData) -> None:
