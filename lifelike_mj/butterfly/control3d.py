@@ -44,7 +44,7 @@ ALTITUDE_CLIP_M = 1.0
 INPUT_SCALE = np.array([1.0, 1.0, 1.0, 10.0, 10.0, 10.0, 1.0, 1.0, 1.0, 0.5])
 
 # task array: kind, then either a schedule (rows of t_start, heading, altitude, speed) or waypoints
-TASK_SCHEDULE, TASK_WAYPOINTS = 0, 1
+TASK_SCHEDULE, TASK_WAYPOINTS, TASK_TARGET = 0, 1, 2
 #: Task header: kind, rows, pass radius (m), cruise speed (m/s), mean wind (3, m/s), gusts' standard deviation
 #: (m/s) and correlation time (s), flutter's standard deviation (action units) and correlation time (s), the
 #: seed of both; then 4 numbers per row.
@@ -158,8 +158,26 @@ def command(base, scale, u, target):
 def reference(task, t, pos, rec):
     """The reference (heading rad, altitude m, speed m/s) of ``task`` at time ``t`` and position ``pos``;
     advances the waypoint counter ``rec[R_PASSED]`` when the current waypoint is within the pass radius,
-    keeping the closest approach to each waypoint in ``rec[R_WP + i]``."""
+    keeping the closest approach to each waypoint (while it is the one aimed at) in ``rec[R_WP + i]``. A moving
+    target is aimed at where it is now, at the cruise speed or, when close, the target's speed plus the
+    distance per second (at least 1 m/s); ``rec[R_PASSED]`` then counts the steps spent within the radius and
+    ``rec[R_WP]``, ``rec[R_WP + 1]`` hold the closest and the current distance."""
     rows = int(task[T_ROWS])
+    if int(task[T_KIND]) == TASK_TARGET:
+        # a moving target: on a circle (centre, radius; rate, phase) bobbing by the vertical amplitude
+        b = T_ROW0
+        w, ph, amp = task[b + 4], task[b + 5], task[b + 6]
+        tx = task[b] + task[b + 3] * math.cos(w * t + ph)
+        ty = task[b + 1] + task[b + 3] * math.sin(w * t + ph)
+        tz = task[b + 2] + amp * math.sin(2.0 * w * t)
+        dx, dy, dz = tx - pos[0], ty - pos[1], tz - pos[2]
+        dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+        rec[R_WP] = min(rec[R_WP], dist)
+        rec[R_WP + 1] = dist  # the distance now
+        if dist < task[T_RADIUS]:
+            rec[R_PASSED] += 1.0  # steps spent within the radius
+        v_target = abs(w) * task[b + 3]
+        return math.atan2(dy, dx), tz, min(task[T_SPEED], max(1.0, v_target + dist))
     if int(task[T_KIND]) == TASK_SCHEDULE:
         r = 0
         while r + 1 < rows and task[T_ROW0 + 4 * (r + 1)] <= t:

@@ -28,7 +28,8 @@ from lifelike_mj.errors import UserError
 class Task3D:
     """A task: ``kind="schedule"`` with rows ``(t_start_s, heading_rad, altitude_m, speed_m_s)`` (the
     reference from each row's time on; the first row's time is 0), or ``kind="waypoints"`` with rows
-    ``(x, y, z)`` in m, visited in order at ``speed_m_s``, each passed when within ``radius_m``.
+    ``(x, y, z)`` in m, visited in order at ``speed_m_s``, each passed when within ``radius_m``, or
+    ``kind="target"``, a moving target (:func:`moving_target`).
 
     The weather: a mean wind ``wind_m_s`` (world frame, m/s, where it blows to) plus gusts, a first-order
     Gauss-Markov (Ornstein-Uhlenbeck) process on each axis with standard deviation ``gust_m_s`` and
@@ -49,9 +50,9 @@ class Task3D:
     seed: int = 0
 
     def __post_init__(self) -> None:
-        if self.kind not in ("schedule", "waypoints"):
-            raise UserError(f"a task is a schedule or waypoints, got {self.kind!r}.")
-        width = 4 if self.kind == "schedule" else 3
+        if self.kind not in ("schedule", "waypoints", "target"):
+            raise UserError(f"a task is a schedule, waypoints or a target, got {self.kind!r}.")
+        width = 3 if self.kind == "waypoints" else 4
         if not self.rows or any(len(r) != width for r in self.rows):
             raise UserError(f"a {self.kind} task needs rows of {width} numbers.")
         for r in self.rows:
@@ -80,7 +81,7 @@ class Task3D:
         """The compiled loop's task array (:data:`~lifelike_mj.butterfly.control3d.T_KIND` ...), padded to
         ``max_rows`` rows."""
         out = np.zeros(c3.T_ROW0 + 4 * max_rows)
-        out[c3.T_KIND] = c3.TASK_SCHEDULE if self.kind == "schedule" else c3.TASK_WAYPOINTS
+        out[c3.T_KIND] = {"schedule": c3.TASK_SCHEDULE, "waypoints": c3.TASK_WAYPOINTS, "target": c3.TASK_TARGET}[self.kind]
         out[c3.T_ROWS] = len(self.rows)
         out[c3.T_RADIUS] = self.radius_m
         out[c3.T_SPEED] = self.speed_m_s
@@ -117,6 +118,16 @@ def course(seed: int, n: int = 10, spacing_m: float = 1.5, altitude_span_m: floa
         pts.append(tuple(float(v) for v in p))
     return Task3D("waypoints", tuple(pts), radius_m=radius_m, speed_m_s=speed_m_s, name=f"course seed {seed}",
                   seed=seed)
+
+
+def moving_target(centre_m=(3.0, 0.0, 0.0), radius_m: float = 2.0, speed_m_s: float = 0.5, bob_m: float = 0.2,
+                  cruise_m_s: float = 1.5, phase_rad: float = 0.0) -> Task3D:
+    """A target moving at ``speed_m_s`` round a circle of ``radius_m`` about ``centre_m`` (counter-clockwise
+    seen from above), bobbing ``bob_m`` up and down twice a lap; the butterfly flies at ``cruise_m_s`` towards
+    where it is now (slower when close)."""
+    w = speed_m_s / checks.positive("radius_m", radius_m, "m")
+    return Task3D("target", (tuple(float(v) for v in centre_m) + (float(radius_m),), (w, phase_rad, bob_m, 0.0)),
+                  radius_m=0.3, speed_m_s=cruise_m_s, name=f"moving target {speed_m_s:g} m/s")
 
 
 def new_record(n: int, max_rows: int) -> np.ndarray:

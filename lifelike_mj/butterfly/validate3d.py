@@ -186,3 +186,28 @@ def kinematics_check(controller, speed_m_s: float = 1.5, settle_s: float = 5.0, 
             "body_pitch_swing_deg": float(np.degrees(pitch_swing)), "bobbing_m": bob,
             "vertical_force_coefficient": float(f.params.mass_kg * f.params.gravity / (0.5 * f.params.rho * area * tip**2)),
             "beats": len(beats)}
+
+
+def target_check(controller, duration_s: float = 40.0, catch_s: float = 10.0, **target) -> dict:
+    """Follow a moving target (:func:`~lifelike_mj.butterfly.evolve3d.moving_target`) for ``duration_s``; report
+    when it first came within the task's 0.3 m, and the distance's median and 90th percentile after ``catch_s``."""
+    from lifelike_mj.butterfly import evolve3d
+    from lifelike_mj.butterfly.control3d import R_WP
+    from lifelike_mj.butterfly.sim3d import Flight3D
+
+    task = evolve3d.moving_target(**target)
+    f = Flight3D(controller=controller, task=task)
+    dist, times = [], []
+    first = None
+    while f.time < duration_s - 1e-9:
+        f.step(12)
+        d = float(f._rec[R_WP + 1])
+        dist.append(d)
+        times.append(f.time)
+        if first is None and d < task.radius_m:
+            first = f.time
+    dist_a, t_a = np.array(dist), np.array(times)
+    late = dist_a[t_a >= catch_s]
+    return {"target_speed_m_s": target.get("speed_m_s", 0.5), "first_within_0_3_m_s": first,
+            "distance_median_m": float(np.median(late)), "distance_p90_m": float(np.percentile(late, 90)),
+            "closest_m": float(dist_a.min())}

@@ -29,10 +29,12 @@ def _task(args):
     from lifelike_mj.butterfly import evolve3d
 
     if args.task == "level":
-        return evolve3d.level(args.speed)
-    if args.task == "turn":
-        return evolve3d.turn(args.angle, 2.0, args.speed)
-    return evolve3d.course(args.seed, speed_m_s=args.speed)
+        task = evolve3d.level(args.speed)
+    elif args.task == "turn":
+        task = evolve3d.turn(args.angle, 2.0, args.speed)
+    else:
+        task = evolve3d.course(args.seed, speed_m_s=args.speed)
+    return task.with_weather(args.wind, gust_m_s=args.gusts, flutter=args.flutter, seed=args.seed)
 
 
 def cmd_fly3d(args) -> None:
@@ -43,7 +45,7 @@ def cmd_fly3d(args) -> None:
 
     check_outputs(args, folders={"--out": FLY3D_FILES})
     ctrl = load_controller(args.controller)
-    flight = Flight3D(controller=ctrl, task=_task(args), wind_m_s=args.wind)
+    flight = Flight3D(controller=ctrl, task=_task(args))
     with stage(f"3D flight, {args.duration:g} s"):
         rec = flight.record(duration_s=args.duration, every=12)
     pos, att = rec["position_m"], rec["attitude_rad"]
@@ -169,13 +171,16 @@ def _hidden(text: str) -> list[int]:
 def add_commands(bf) -> None:
     """``fly3d``, ``evolve3d`` and ``assess3d`` under ``lifelike-mj butterfly``."""
     p = bf.add_parser("fly3d", help="fly the 3D butterfly with a 3D controller")
-    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name (steer) or a file")
+    p.add_argument("--controller", default="cruise", help="a shipped 3D controller's name (cruise, steer) or a file")
     p.add_argument("--task", default="level", choices=("level", "turn", "course"),
                    help="level flight, a turn (--angle) or a course of 10 waypoints drawn by --seed")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
     p.add_argument("--angle", type=num(-180, 180, unit="deg"), default=90.0, help="turn angle, deg, left > 0")
     add_seed(p)
     p.add_argument("--wind", type=_vector3, default=(0.0, 0.0, 0.0), help="wind X,Y,Z in m/s (where it blows to)")
+    p.add_argument("--gusts", type=num(0, 10, unit="m/s"), default=0.0,
+                   help="gusts' standard deviation on each axis, m/s (correlation time 1 s; drawn from --seed)")
+    p.add_argument("--flutter", type=num(0, 1), default=0.0, help="the butterfly's flutter, 0 to 1 (drawn from --seed)")
     p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=20.0,
                    help=f"seconds of flight, at most {MAX_DURATION_S:g}")
     p.add_argument("--out", help="folder for path.npz/.csv, paths.png (top and side views), summary.json")
@@ -222,7 +227,7 @@ def add_commands(bf) -> None:
     add_json(p)
     p.set_defaults(func=cmd_garden)
     p = bf.add_parser("assess3d", help="a 3D controller's acceptance numbers: level flight, turns, courses")
-    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name or a file")
+    p.add_argument("--controller", default="cruise", help="a shipped 3D controller's name or a file")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s")
     p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=60.0,
                    help="seconds of level flight (default 60)")

@@ -175,3 +175,16 @@ def test_a_gusty_flight_is_the_same_for_the_same_seed_and_feels_the_gusts():
     assert not np.array_equal(runs[0][0], runs[2][0])
     airs = runs[0][1]
     assert np.abs(airs.mean(axis=0)[0] - 1.0) < 0.5 and airs.std(axis=0).min() > 0.0
+
+
+def test_a_moving_target_is_aimed_at_where_it_is_now():
+    task = e3.moving_target(centre_m=(3.0, 0.0, 0.0), radius_m=2.0, speed_m_s=0.5, bob_m=0.0, cruise_m_s=1.5)
+    arr = task.as_array(2)
+    rec = e3.new_record(1, 2)[0]
+    t = math.pi  # a quarter of the way round at 0.25 rad/s: the target is at (3 + 2 cos(pi/4), 2 sin(pi/4), 0)
+    h, z, v = c3.reference(arr, t, np.zeros(3), rec)
+    tx, ty = 3.0 + 2.0 * math.cos(0.25 * t), 2.0 * math.sin(0.25 * t)
+    assert h == pytest.approx(math.atan2(ty, tx)) and z == 0.0 and v == 1.5  # far: the cruise speed
+    assert rec[c3.R_WP + 1] == pytest.approx(math.hypot(tx, ty)) and rec[c3.R_PASSED] == 0
+    _, _, v = c3.reference(arr, t, np.array([tx - 0.2, ty, 0.0]), rec)  # close: slower, and counted
+    assert v == pytest.approx(1.0) and rec[c3.R_PASSED] == 1
