@@ -171,7 +171,7 @@ def _hidden(text: str) -> list[int]:
 def add_commands(bf) -> None:
     """``fly3d``, ``evolve3d`` and ``assess3d`` under ``lifelike-mj butterfly``."""
     p = bf.add_parser("fly3d", help="fly the 3D butterfly with a 3D controller")
-    p.add_argument("--controller", default="cruise", help="a shipped 3D controller's name (cruise, steer) or a file")
+    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name (steer, cruise) or a file")
     p.add_argument("--task", default="level", choices=("level", "turn", "course"),
                    help="level flight, a turn (--angle) or a course of 10 waypoints drawn by --seed")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
@@ -211,7 +211,7 @@ def add_commands(bf) -> None:
     p.set_defaults(func=cmd_evolve3d)
     p = bf.add_parser("garden", help="a garden of 3D butterflies visiting flowers, filmed")
     p.add_argument("--n", type=count(1, 500), default=20, help="butterflies, 1 to 500 (default 20)")
-    p.add_argument("--controller", default="cruise", help="a shipped 3D controller's name or a file")
+    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name or a file")
     add_seed(p)
     p.add_argument("--flutter", type=num(0, 1), default=0.1, help="each butterfly's flutter, 0 to 1 (default 0.1)")
     p.add_argument("--gusts", type=num(0, 10, unit="m/s"), default=0.0, help="gusts' standard deviation, m/s")
@@ -227,7 +227,7 @@ def add_commands(bf) -> None:
     add_json(p)
     p.set_defaults(func=cmd_garden)
     p = bf.add_parser("assess3d", help="a 3D controller's acceptance numbers: level flight, turns, courses")
-    p.add_argument("--controller", default="cruise", help="a shipped 3D controller's name or a file")
+    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name or a file")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s")
     p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=60.0,
                    help="seconds of level flight (default 60)")

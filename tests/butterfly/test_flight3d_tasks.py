@@ -25,18 +25,20 @@ def test_level_flight_holds_altitude_upright(name):
 
 
 @pytest.mark.parametrize("angle", [90.0, 180.0])
-def test_turns_reach_and_hold_the_new_heading(angle):
-    r = turn_check("cruise", angle, hold_s=6.0)
+@pytest.mark.parametrize("name", ["steer", "cruise"])
+def test_turns_reach_and_hold_the_new_heading(name, angle):
+    r = turn_check(name, angle, hold_s=6.0)
     assert r["held_within_10_deg"] and r["turn_time_s"] < 3.0, r
 
 
-def test_a_course_never_trained_on_is_flown_through_every_waypoint():
-    r = course_check("cruise", seed=100, max_s=40.0)
+@pytest.mark.parametrize("seed", [100, 103])
+def test_a_course_never_trained_on_is_flown_through_every_waypoint(seed):
+    r = course_check("steer", seed=seed, max_s=40.0)
     assert r["passed"] == 10 and r["all_within_radius"], r
 
 
 def test_the_flight_looks_like_dudleys_butterflies():
     """Dudley 1990 (37 species): about 11 Hz, about 103 deg of stroke, faster than 1 m/s."""
-    r = kinematics_check("cruise", 1.5, settle_s=3.0, window_s=3.0)
+    r = kinematics_check("steer", 1.5, settle_s=3.0, window_s=3.0)
     assert 8.0 < r["flap_frequency_hz"] < 14.0 and 80.0 < r["stroke_amplitude_deg"] < 130.0
     assert r["speed_m_s"] > 1.0
