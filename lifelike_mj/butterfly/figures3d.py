@@ -14,7 +14,7 @@ from lifelike_mj.render.plot import finish, new_figure
 
 
 def fig_paths(paths: list[dict], labels: list[str] | None = None, waypoints=None,
-              path: str | os.PathLike | None = None, title: str = "") -> Figure:
+              path: str | os.PathLike | None = None, title: str = "", waypoint_label: str = "waypoints") -> Figure:
     """Top view (x, y; m) and side view (distance flown over ground, altitude; m) of one or more recorded 3D
     flights (:meth:`~lifelike_mj.butterfly.sim3d.Flight3D.record`), with the task's waypoints if given."""
     fig = new_figure(12.0, 4.8)
@@ -27,8 +27,8 @@ def fig_paths(paths: list[dict], labels: list[str] | None = None, waypoints=None
         side.plot(s, pos[:, 2], lw=0.9, label=label)
     if waypoints is not None and len(waypoints):
         wp = np.asarray(waypoints, dtype=float)
-        top.scatter(wp[:, 0], wp[:, 1], marker="o", s=30, facecolors="none", edgecolors="k", label="waypoints")
-        for k, (x, y) in enumerate(wp[:, :2]):
+        top.scatter(wp[:, 0], wp[:, 1], marker="o", s=30, facecolors="none", edgecolors="k", label=waypoint_label)
+        for k, (x, y) in enumerate(wp[:, :2] if waypoint_label == "waypoints" else []):
             top.annotate(str(k + 1), (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
     top.set_aspect("equal", adjustable="datalim")
     top.set_xlabel("x [m] (forward at the start)")

@@ -141,7 +141,7 @@ def cmd_garden(args) -> None:
             for r, p in zip(recs, g2.state()["position_m"]):
                 r["position_m"].append(p)
         fig_paths([{"position_m": np.array(r["position_m"])} for r in recs], waypoints=g2.blossoms,
-                  path=args.paths, title=f"{args.n} butterflies, {args.duration:g} s")
+                  path=args.paths, title=f"{args.n} butterflies, {args.duration:g} s", waypoint_label="flowers")
         d["paths"] = args.paths
     emit(args, d, f"{args.n} butterflies flew {garden.time:.1f} s and visited {passed.min():.0f} to {passed.max():.0f} "
          f"flowers each" + (f"; video {args.out}" if args.out else "") + (f"; paths {args.paths}" if args.paths else ""))
