@@ -245,6 +245,10 @@ TASK_SETS = {
     "cruise": lambda: (level(1.5), level(2.0), turn(90.0, 1.5, 1.5), turn(-180.0, 1.5, 1.5, 0.3),
                        level(1.5).with_weather((0.0, 1.0, 0.0), gust_m_s=0.5, seed=1),
                        turn(-90.0, 1.5, 1.5).with_weather((-1.0, 0.0, 0.0), gust_m_s=0.5, seed=2)),
+    "wind": lambda: (course(1).with_weather((1.0, 0.0, 0.0), gust_m_s=0.5, seed=1),
+                     course(2).with_weather((0.0, -1.0, 0.0), gust_m_s=0.5, seed=2),
+                     course(3).with_weather((-1.0, 0.0, 0.0), gust_m_s=0.5, seed=3),
+                     course(4)),
 }
 
 

@@ -190,9 +190,10 @@ def add_commands(bf) -> None:
     p = bf.add_parser("evolve3d", help="evolve a 3D controller (CMA-ES or the paper's GA) on the MuJoCo batch")
     p.add_argument("--optimizer", default="cmaes", choices=("cmaes", "rcga", "crs2", "esch", "isres"),
                    help="cmaes (default) or rcga (the paper's GA), or an nlopt method")
-    p.add_argument("--tasks", default="steer", choices=("steer", "cruise"),
-                   help="the task set: steer (level at 1 and 2 m/s, turns of 90 and -180 deg) or cruise (level at 1.5 "
-                        "and 2 m/s, the turns, and two flights in 1 m/s wind with 0.5 m/s gusts)")
+    p.add_argument("--tasks", default="steer", choices=("steer", "cruise", "wind"),
+                   help="the task set: steer (level at 1 and 2 m/s, turns of 90 and -180 deg), cruise (level at 1.5 "
+                        "and 2 m/s, the turns, and two flights in 1 m/s wind with 0.5 m/s gusts) or wind (courses "
+                        "1-3 in 1 m/s wind with 0.5 m/s gusts, course 4 in still air)")
     p.add_argument("--start", default=None, help="a 3D controller to start from (its network; genes are its changes)")
     p.add_argument("--gene-bound", type=num(0, 10, lo_open=True), default=0.4,
                    help="bound of each gene (a weight's change from the start), default 0.4")
