@@ -43,3 +43,17 @@ def test_bad_garden_arguments_are_one_sentence():
         Garden(0, c3.Controller3D([10, 9], e3.pd_prior([10, 9])))
     with pytest.raises(UserError, match="flutter"):
         Garden(2, c3.Controller3D([10, 9], e3.pd_prior([10, 9])), flutter=3.0)
+
+
+def test_the_garden_films_and_its_frames_move(tmp_path):
+    from PIL import Image, ImageSequence
+
+    from lifelike_mj.butterfly.garden import film_garden
+
+    g = Garden(4, "steer", seed=1)
+    info = film_garden(tmp_path / "g.gif", g, duration_s=0.3, fps=10, width=160, height=90, camera_name="chase")
+    assert info["frames"] == 3
+    frames = [np.asarray(f.convert("RGB"), dtype=float) for f in ImageSequence.Iterator(Image.open(tmp_path / "g.gif"))]
+    assert len(frames) == 3 and np.abs(frames[0] - frames[-1]).mean() > 0.5  # the scene changes as it flies
+    with pytest.raises(UserError, match="overview or chase"):
+        film_garden(tmp_path / "h.gif", g, camera_name="top")
