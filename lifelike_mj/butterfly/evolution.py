@@ -262,19 +262,11 @@ def evolve_controller(problem: PitchProblem, optimizer: str, seed: int, out: str
     """
     from lifelike_mj import __version__
     from lifelike_mj.evolve import make_evaluator, optimize
-    from lifelike_mj.evolve.checkpoint import check_checkpoint_path
-    from lifelike_mj.io import exclusive, write_json
-    from lifelike_mj.paths import check_output_file, check_writable
+    from lifelike_mj.evolve.checkpoint import guarded_run_files
+    from lifelike_mj.io import write_json
 
     out = Path(out)
-    ckpt = Path(checkpoint) if checkpoint else out.with_name(out.name + ".ckpt")
-    if ckpt.absolute().resolve() == out.absolute().resolve():
-        raise UserError(f"the checkpoint and the controller file are the same file ({out}); give another --checkpoint.")
-    check_output_file(out, "--out", suffixes=(".json",), overwrite=True)
-    check_writable(ckpt, "checkpoint")
-    with exclusive(out, "--out"), exclusive(ckpt, "checkpoint"):
-        check_output_file(out, "--out", suffixes=(".json",), overwrite=overwrite or resume)
-        check_checkpoint_path(ckpt, resume=resume, overwrite=overwrite)
+    with guarded_run_files(out, checkpoint, resume=resume, overwrite=overwrite) as ckpt:
         with make_evaluator(problem, executor=executor, workers=workers, ray_address=ray_address) as ev:
             res = optimize(problem, optimizer, seed=seed, population=population, generations=generations,
                            evaluations=evaluations, evaluator=ev, checkpoint=ckpt, resume=resume, progress=progress,

@@ -273,10 +273,9 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     are then changes of its weights and ``layers`` is ignored), recorded in the provenance."""
     from lifelike_mj import provenance as _prov
     from lifelike_mj.evolve import optimize
-    from lifelike_mj.evolve.checkpoint import check_checkpoint_path
-    from lifelike_mj.io import exclusive, write_json
+    from lifelike_mj.evolve.checkpoint import guarded_run_files
+    from lifelike_mj.io import write_json
     from lifelike_mj.machine import machine_info
-    from lifelike_mj.paths import check_output_file, check_writable
 
     if tasks is None:
         task_set = "steer"
@@ -289,14 +288,7 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
         template = c3.Controller3D(layers, pd_prior(layers) if len(layers) >= 2 and layers[0] == c3.N_OBS else [])
     problem = FlightProblem3D(tuple(tasks), template, duration_s=duration_s, gene_bound=gene_bound)
     out = Path(out)
-    ckpt = Path(checkpoint) if checkpoint else out.with_name(out.name + ".ckpt")
-    if ckpt.absolute().resolve() == out.absolute().resolve():
-        raise UserError(f"the checkpoint and the controller file are the same file ({out}); give another checkpoint.")
-    check_output_file(out, "--out", suffixes=(".json",), overwrite=True)
-    check_writable(ckpt, "checkpoint")
-    with exclusive(out, "--out"), exclusive(ckpt, "checkpoint"):
-        check_output_file(out, "--out", suffixes=(".json",), overwrite=overwrite or resume)
-        check_checkpoint_path(ckpt, resume=resume, overwrite=overwrite)
+    with guarded_run_files(out, checkpoint, resume=resume, overwrite=overwrite) as ckpt:
         res = optimize(problem, optimizer, seed=seed, population=population, generations=generations,
                        checkpoint=ckpt, resume=resume, progress=progress, overwrite=overwrite,
                        on_generation=on_generation)

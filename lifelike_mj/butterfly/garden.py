@@ -126,6 +126,8 @@ class Garden(StepCounter):
         self._blocks = [int(self._model.jnt_qposadr[self._model.joint(f"b{i}_root").id]) for i in range(self.n)]
         self._task_arr = np.array([t.as_array(COURSE_LENGTH) for t in self.tasks])
         self._weights = np.ascontiguousarray(np.tile(self.controller.weights, (self.n, 1)))
+        #: Set to a list to collect the butterflies' positions (``(n, 3)``, m) at every :meth:`sync`.
+        self.track: list[np.ndarray] | None = None
         self.reset()
 
     @property
@@ -175,9 +177,11 @@ class Garden(StepCounter):
                            f"({self.dt:g} s) or the wind.")
 
     def sync(self) -> None:
-        """Pose the drawing scene at the butterflies' current states."""
+        """Pose the drawing scene at the butterflies' current states (and add them to :attr:`track`)."""
         for q0, d in zip(self._blocks, self._datas):
             self._data.qpos[q0 : q0 + d.qpos.size] = d.qpos
+        if self.track is not None:
+            self.track.append(np.array([d.qpos[0:3] for d in self._datas]))
         mujoco.mj_kinematics(self._model, self._data)
         mujoco.mj_comPos(self._model, self._data)
         mujoco.mj_camlight(self._model, self._data)  # the cameras and lights follow the bodies

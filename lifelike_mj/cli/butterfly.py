@@ -12,6 +12,7 @@ from lifelike_mj.cli.common import (
     add_executor,
     add_json,
     add_overwrite,
+    add_run_files,
     add_seed,
     check_executor,
     check_outputs,
@@ -309,11 +310,7 @@ def add_commands(sub) -> None:
     p.add_argument("--inputs", default=None, choices=("relative", "ground", "both"),
                    help="velocity inputs: relative (air), ground, or both (default: relative; robust task: both)")
     add_executor(p)
-    p.add_argument("--checkpoint", default=None, help="checkpoint file (default: OUT.ckpt), written every generation")
-    p.add_argument("--resume", action="store_true", help="continue from the checkpoint")
-    p.add_argument("--overwrite", action="store_true", help="replace an existing --out and checkpoint (a new run)")
-    p.add_argument("--out", default=None, help="controller file to write (.json; default butterfly_OPT_TASK_sSEED.json)")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_run_files(p, "controller file to write (.json; default butterfly_OPT_TASK_sSEED.json)")
     add_json(p)
     add_physics(p)
     p.set_defaults(func=cmd_evolve)

@@ -6,7 +6,7 @@ import argparse
 import math
 from pathlib import Path
 
-from lifelike_mj.cli.common import add_json, add_overwrite, add_seed, check_outputs, count, emit, num
+from lifelike_mj.cli.common import add_json, add_overwrite, add_run_files, add_seed, check_outputs, count, emit, num
 from lifelike_mj.errors import UserError
 from lifelike_mj.progress import stage
 
@@ -121,26 +121,27 @@ def cmd_garden(args) -> None:
     ctrl = load_controller(args.controller)
     garden = Garden(args.n, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_m_s=args.wind)
     d: dict = {"butterflies": args.n, "seed": args.seed, "controller": ctrl.name or args.controller}
+    if args.paths:
+        garden.track = []  # the positions at every frame, or every 0.02 s without a video
     if args.out:
         info = film_garden(args.out, garden, args.duration, args.fps, args.width, args.height, args.camera,
                            progress=True)
         d["video"] = info
     else:
+        every = max(1, int(round(0.02 / garden.dt))) if args.paths else int(round(args.duration / garden.dt))
         with stage(f"{args.n} butterflies, {args.duration:g} s"):
-            garden.step(int(round(args.duration / garden.dt)))
+            garden.sync()
+            for _ in range(int(round(args.duration / garden.dt)) // every):
+                garden.step(every)
+                garden.sync()
     passed = garden.state()["waypoints_passed"]
     d.update({"duration_s": garden.time, "flowers_visited_min": int(passed.min()),
               "flowers_visited_mean": float(passed.mean()), "flowers_visited_max": int(passed.max())})
     if args.paths:
         from lifelike_mj.butterfly.figures3d import fig_paths
 
-        g2 = Garden(args.n, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_m_s=args.wind)
-        recs = [{"position_m": [], "t_s": []} for _ in range(args.n)]
-        for _ in range(int(round(args.duration / 0.02))):
-            g2.step(max(1, int(round(0.02 / g2.dt))))
-            for r, p in zip(recs, g2.state()["position_m"]):
-                r["position_m"].append(p)
-        fig_paths([{"position_m": np.array(r["position_m"])} for r in recs], waypoints=g2.blossoms,
+        track = np.array(garden.track)
+        fig_paths([{"position_m": track[:, i]} for i in range(args.n)], waypoints=garden.blossoms,
                   path=args.paths, title=f"{args.n} butterflies, {args.duration:g} s", waypoint_label="flowers")
         d["paths"] = args.paths
     emit(args, d, f"{args.n} butterflies flew {garden.time:.1f} s and visited {passed.min():.0f} to {passed.max():.0f} "
@@ -203,11 +204,7 @@ def add_commands(bf) -> None:
     p.add_argument("--duration", type=num(0, 60, lo_open=True, unit="s"), default=4.0,
                    help="seconds of each training flight (default 4)")
     add_seed(p)
-    p.add_argument("--checkpoint", default=None, help="checkpoint file (default: OUT.ckpt), written every generation")
-    p.add_argument("--resume", action="store_true", help="continue from the checkpoint")
-    p.add_argument("--overwrite", action="store_true", help="replace an existing --out and checkpoint (a new run)")
-    p.add_argument("--out", default=None, help="controller file to write (.json)")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_run_files(p, "controller file to write (.json)")
     add_json(p)
     p.set_defaults(func=cmd_evolve3d)
     p = bf.add_parser("garden", help="a garden of 3D butterflies visiting flowers, filmed")

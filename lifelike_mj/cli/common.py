@@ -102,6 +102,15 @@ def add_seed(p: argparse.ArgumentParser, default: int = 0) -> None:
                    help="random seed, 0 to 2^32-1: the same seed gives the same result")
 
 
+def add_run_files(p: argparse.ArgumentParser, out_help: str) -> None:
+    """``--checkpoint``, ``--resume``, ``--overwrite``, ``--out`` and ``--quiet`` of an evolution."""
+    p.add_argument("--checkpoint", default=None, help="checkpoint file (default: OUT.ckpt), written every generation")
+    p.add_argument("--resume", action="store_true", help="continue from the checkpoint")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --out and checkpoint (a new run)")
+    p.add_argument("--out", default=None, help=out_help)
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
 def seeds(text: str) -> list[int]:
     """``0-4`` or ``0,3,7`` as a list of seeds."""
     try:

@@ -32,11 +32,13 @@ Version 1 files (lifelike-mj 0.2 and earlier) were pickles; they are refused, no
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
 import time
 import zipfile
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -148,6 +150,29 @@ def check_checkpoint_path(path: str | Path, *, resume: bool, overwrite: bool) ->
     from lifelike_mj.paths import check_writable
 
     check_writable(path, what="checkpoint")
+
+
+@contextlib.contextmanager
+def guarded_run_files(out: str | Path, checkpoint: str | Path | None, *, resume: bool,
+                      overwrite: bool) -> Iterator[Path]:
+    """The files of an evolution that writes its result to ``out`` (``.json``) and checkpoints every
+    generation (``checkpoint``, default ``out`` + ``.ckpt``; yielded). Nothing is lost: before any work, an
+    existing ``out`` or checkpoint is refused unless ``resume`` or ``overwrite``, a checkpoint equal to
+    ``out`` is refused, and both files are locked for the whole block, so a second run on the same files
+    stops at once with a sentence."""
+    from lifelike_mj.io import exclusive
+    from lifelike_mj.paths import check_output_file, check_writable
+
+    out = Path(out)
+    ckpt = Path(checkpoint) if checkpoint else out.with_name(out.name + ".ckpt")
+    if ckpt.absolute().resolve() == out.absolute().resolve():
+        raise UserError(f"the checkpoint and the controller file are the same file ({out}); give another --checkpoint.")
+    check_output_file(out, "--out", suffixes=(".json",), overwrite=True)
+    check_writable(ckpt, "checkpoint")
+    with exclusive(out, "--out"), exclusive(ckpt, "checkpoint"):
+        check_output_file(out, "--out", suffixes=(".json",), overwrite=overwrite or resume)
+        check_checkpoint_path(ckpt, resume=resume, overwrite=overwrite)
+        yield ckpt
 
 
 def load_checkpoint(path: str | Path) -> dict[str, Any]:
