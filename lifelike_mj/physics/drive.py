@@ -34,39 +34,43 @@ _O_QFRC = mjabi.O_QFRC
 
 
 @njit(cache=True)
-def _torques(M, c, driven, free, a_star, out):
-    """``out[r]``: the torque on ``driven[r]`` (module docstring); ``M_bb`` factored by Cholesky (it is
-    the free body's inertia seen through the joints: symmetric positive definite)."""
+def _torques(M, c, driven, free, a_star, out, scratch):
+    """``out[r]``: the torque on ``driven[r]`` (module docstring), as
+    ``tau_j = M_jj a* + c_j - M_jb z`` with ``z = M_bb^-1 (M_bj a* + c_b)``: one solve, ``M_bb`` factored by
+    Cholesky (it is the free body's inertia seen through the joints: symmetric positive definite).
+    ``scratch``: at least ``nb * nb + 2 * nb`` floats (``nb = len(free)``); nothing is allocated."""
     nb, k = len(free), len(driven)
-    L = np.zeros((nb, nb))
+    L = scratch[: nb * nb]
+    z = scratch[nb * nb : nb * nb + nb]
+    y = scratch[nb * nb + nb : nb * nb + 2 * nb]
     for i in range(nb):
-        for j in range(i + 1):
-            s = M[free[i], free[j]]
-            for p in range(j):
-                s -= L[i, p] * L[j, p]
-            L[i, j] = math.sqrt(s) if i == j else s / L[j, j]
-    x = np.empty((nb, k + 1))  # M_bb^-1 [M_bj | c_b]
-    y = np.empty(nb)
-    for col in range(k + 1):
-        for i in range(nb):
-            s = M[free[i], driven[col]] if col < k else c[free[i]]
-            for p in range(i):
-                s -= L[i, p] * y[p]
-            y[i] = s / L[i, i]
-        for i in range(nb - 1, -1, -1):
-            s = y[i]
-            for p in range(i + 1, nb):
-                s -= L[p, i] * x[p, col]
-            x[i, col] = s / L[i, i]
-    for r in range(k):
-        t = c[driven[r]]
-        for p in range(nb):
-            t -= M[driven[r], free[p]] * x[p, k]
+        fi = free[i]
+        s = c[fi]
         for q in range(k):
-            s = M[driven[r], driven[q]]
-            for p in range(nb):
-                s -= M[driven[r], free[p]] * x[p, q]
-            t += s * a_star[q]
+            s += M[fi, driven[q]] * a_star[q]
+        z[i] = s
+        for j in range(i + 1):
+            s = M[fi, free[j]]
+            for p in range(j):
+                s -= L[i * nb + p] * L[j * nb + p]
+            L[i * nb + j] = math.sqrt(s) if i == j else s / L[j * nb + j]
+    for i in range(nb):  # L y = rhs
+        s = z[i]
+        for p in range(i):
+            s -= L[i * nb + p] * y[p]
+        y[i] = s / L[i * nb + i]
+    for i in range(nb - 1, -1, -1):  # L^T z = y
+        s = y[i]
+        for p in range(i + 1, nb):
+            s -= L[p * nb + i] * z[p]
+        z[i] = s / L[i * nb + i]
+    for r in range(k):
+        dr = driven[r]
+        t = c[dr]
+        for q in range(k):
+            t += M[dr, driven[q]] * a_star[q]
+        for p in range(nb):
+            t -= M[dr, free[p]] * z[p]
         out[r] = t
 
 
@@ -78,19 +82,19 @@ def prescribed_torques(M: np.ndarray, c: np.ndarray, driven: np.ndarray, a_star:
     free = np.setdiff1d(np.arange(M.shape[0]), driven).astype(np.int64)
     out = np.empty(len(driven))
     _torques(np.ascontiguousarray(M, dtype=np.float64), np.ascontiguousarray(c, dtype=np.float64), driven, free,
-             np.ascontiguousarray(a_star, dtype=np.float64), out)
+             np.ascontiguousarray(a_star, dtype=np.float64), out, np.empty(len(free) * (len(free) + 2)))
     return out
 
 
 @njit(cache=True)
-def native_torques(mptr, dptr, off, nv, driven, free, a_star, M, c, out):
+def native_torques(mptr, dptr, off, nv, driven, free, a_star, M, c, out, scratch):
     """:func:`prescribed_torques` from inside a compiled passive callback: ``M`` from ``mj_fullM``,
     ``c`` from ``mj_rne`` less what ``qfrc_passive`` holds so far (the air's forces added before the
-    call count as applied). ``M`` (``nv * nv``) and ``c`` (``nv``) are scratch; ``off``: the mjData
-    offsets (:func:`lifelike_mj.physics.mjabi.offsets_tuple`)."""
+    call count as applied). ``M`` (``nv * nv``), ``c`` (``nv``) and ``scratch`` (``nb * (nb + 2)``, ``nb``
+    the free dofs) are scratch; ``off``: the mjData offsets (:func:`lifelike_mj.physics.mjabi.offsets_tuple`)."""
     _mj_fullM(_vp(mptr), _vp(dptr), _vp(M.ctypes.data))
     _mj_rne(_vp(mptr), _vp(dptr), np.int32(0), _vp(c.ctypes.data))
     qfrc = _f64(_ptr_at(dptr + off[_O_QFRC]), nv)
     for i in range(nv):
         c[i] -= qfrc[i]
-    _torques(M.reshape((nv, nv)), c, driven, free, a_star, out)
+    _torques(M.reshape((nv, nv)), c, driven, free, a_star, out, scratch)

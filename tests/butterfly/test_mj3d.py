@@ -39,7 +39,7 @@ def _random_state(m, law, assist, seed=1):
     return d, k
 
 
-@pytest.mark.parametrize("law", ["strip", "quasi_steady", "tip", "none"])
+@pytest.mark.parametrize("law", ["strip", "quasi_steady", "tip", "none", "exact"])
 @pytest.mark.parametrize("assist", ["none", "hold"])
 def test_the_compiled_callback_equals_its_python_twin(model, law, assist):
     d, _ = _random_state(model, law, assist)
@@ -66,13 +66,15 @@ def test_the_driven_joints_move_exactly_as_the_kinematics_say(model, law):
     np.testing.assert_allclose(d.qacc[driven], want, rtol=1e-9, atol=1e-6)
 
 
-def test_one_strip_law_wing_at_rest_but_flapping_gives_the_closed_forms_of_eq_4_and_6(model):
+@pytest.mark.parametrize("law", ["strip", "exact"])
+def test_one_strip_law_wing_at_rest_but_flapping_gives_the_closed_forms_of_eq_4_and_6(model, law):
     """A wing turning at omega about its flap hinge on a body at rest: every panel's normal speed is
-    omega r, so the panels must add up to planform 2's closed forms (Oe 2010 eq. 4 and 6)."""
+    omega r, so the panels (or the exact integral) must add up to planform 2's closed forms (Oe 2010 eq. 4
+    and 6)."""
     p = ButterflyParams()
     pan = mj3d.panels(p)
     assert pan[:, 2].sum() == pytest.approx(0.5 * p.width_m * p.span_m, rel=1e-12)
-    d = mj3d.setup_data(model, Kinematics(), p, force_law="strip")
+    d = mj3d.setup_data(model, Kinematics(), p, force_law=law)
     d.userdata[mj3d.U_DRIVE] = 0.0
     d.qvel[:] = 0.0
     q, driven, _ = mj3d.driven_dofs(model)
@@ -227,6 +229,57 @@ def test_the_rotational_force_of_a_pitching_wing_is_sane_and_dickinsons():
     integral = (p.width_m / p.span_m) ** 2 * p.span_m ** 3 / 3.0
     want = math.pi * 0.25 * p.rho * U * w * integral
     np.testing.assert_allclose(out[12:15], [0.0, 0.0, want], rtol=1e-9)
+
+
+def _midpoint_panels(p, n):
+    """``n x n`` midpoint panels of the wing (chord position, span position, area), as :func:`mj3d.panels`."""
+    r = (np.arange(n) + 0.5) / n * p.span_m
+    g = (np.arange(n) + 0.5) / n * 2.0 - 1.0
+    chord = p.width_m * r / p.span_m
+    xc = 0.5 * chord[:, None] * g[None, :]
+    area = np.repeat(chord * p.span_m / n / n, n)
+    return np.stack([xc.ravel(), np.repeat(r, n), area], axis=1)
+
+
+def test_the_exact_integral_of_eq_1_is_the_limit_of_ever_more_panels(model):
+    """Eq. 1 integrated exactly over the wing: the panel law converges to it (states where the normal speed
+    changes sign on the wing, so the cut along v_n = 0 is used), and a cheap triangle check of the formula."""
+    from lifelike_mj.physics.fluid import triangle_sq_abs
+
+    out = np.zeros(3)
+    triangle_sq_abs(0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0, out)  # s = 1: the area and its first moments
+    np.testing.assert_allclose(out, [0.5, 1 / 6, 1 / 6], rtol=1e-14)
+    triangle_sq_abs(0.0, 0.0, 1.0, 0.0, 0.0, 1.0, -1.0, 1.0, -1.0, out)  # s = 2x - 1 - 0 y... cut at x = 1/2
+    x = (np.arange(400_000) + 0.5) / 400_000  # int_0^1 (1 - x) (2x - 1)|2x - 1| dx and its x moment
+    f = (1 - x) * (2 * x - 1) * np.abs(2 * x - 1)
+    np.testing.assert_allclose(out[:2], [f.mean(), (x * f).mean()], rtol=1e-6, atol=1e-12)
+    # a wing whose normal speed changes sign across it (where the panels' Gauss rules stop being exact)
+    p = ButterflyParams()
+    rng = np.random.default_rng(5)
+    errors = {}
+    for trial in range(4):
+        q = rng.normal(size=4)
+        R = np.empty(9)
+        mujoco.mju_quat2Mat(R, q / np.linalg.norm(q))
+        R = R.reshape(3, 3)
+        s0 = rng.uniform(0.3, 1.0)
+        # omega about the chord makes the speed fall along the span to -2 s0 at the tip; about the span, vary
+        # it along the chord
+        omega = R @ np.array([-3.0 * s0 / p.span_m, rng.normal(0, 40.0), rng.normal(0, 5.0)])
+        lin = R @ np.array([rng.normal(), rng.normal(), s0])
+        side = 1.0 if trial % 2 == 0 else -1.0
+        exact = np.zeros(15)
+        mj3d.wing_exact(side, R, lin, omega, p.rho, p.cd, p.span_m, p.width_m / p.span_m, exact)
+        for n in (10, 40, 160):
+            got = np.zeros(15)
+            pan = _midpoint_panels(p, n).ravel()
+            mj3d.wing_panels(2, pan, len(pan) // 3, side, R, lin, omega, p.rho, p.cd, p.width_m / p.span_m, got)
+            err = max(np.abs(got[:3] - exact[:3]).max() / np.abs(exact[:3]).max(),
+                      np.abs(got[3:6] - exact[3:6]).max() / np.abs(exact[3:6]).max())
+            errors.setdefault(n, []).append(err)
+    worst = {k: max(v) for k, v in errors.items()}
+    # the midpoint rule's error falls as 1/n^2 (16-fold per 4-fold n; a little less where v_n |v_n| kinks)
+    assert worst[160] < 1e-4 and worst[160] < worst[40] / 8 < worst[10] / 64, worst
 
 
 def test_the_normal_law_split_into_lift_and_drag_adds_up():

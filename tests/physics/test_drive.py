@@ -75,5 +75,5 @@ def test_the_compiled_drive_reads_mujoco_itself_and_gives_the_same_torques(model
     want = prescribed_torques(M, d.qfrc_bias - d.qfrc_passive, dofs, a_star)
     got = np.empty(len(dofs))
     native_torques(model._address, d._address, mjabi.offsets_tuple(), model.nv, dofs, free, a_star,
-                   np.empty(model.nv * model.nv), np.empty(model.nv), got)
+                   np.empty(model.nv * model.nv), np.empty(model.nv), got, np.empty(len(free) * (len(free) + 2)))
     np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-15)
