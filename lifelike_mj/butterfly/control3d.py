@@ -9,7 +9,10 @@ points at the next waypoint). The network never sees where it is, only how far i
 Observation (:data:`OBS_NAMES`; SI units, in the heading frame: forward, left, up):
 roll, pitch, heading error (reference less yaw, wrapped to ``(-pi, pi]``), the thorax's angular
 velocity (roll, pitch, yaw rates in its own axes), forward-speed error, sideways speed, climb rate and
-altitude error (clipped to +-1 m), all ground-relative.
+altitude error (clipped to +-1 m). A controller's ``inputs`` say what the forward and sideways speeds are
+measured against: ``"ground"`` (the shipped ``steer`` and ``cruise``) or ``"air"`` (the air around the
+butterfly, wind and gusts included, as a butterfly's antennae sense it; the speed reference is then an air
+speed). The climb rate and the altitude are always the ground's.
 
 Action (:data:`ACTION_NAMES`): nine numbers ``u`` in ``(-1, 1)`` (the network's last layer through
 ``tanh``), each scaled by its entry of ``scale`` (rad; Hz for the frequency) and added to the base
@@ -46,10 +49,10 @@ INPUT_SCALE = np.array([1.0, 1.0, 1.0, 10.0, 10.0, 10.0, 1.0, 1.0, 1.0, 0.5])
 # task array: kind, then either a schedule (rows of t_start, heading, altitude, speed) or waypoints
 TASK_SCHEDULE, TASK_WAYPOINTS, TASK_TARGET = 0, 1, 2
 #: Task header: kind, rows, pass radius (m), cruise speed (m/s), mean wind (3, m/s), gusts' standard deviation
-#: (m/s) and correlation time (s), flutter's standard deviation (action units) and correlation time (s), the
-#: seed of both; then 4 numbers per row.
+#: (m/s, horizontal) and correlation time (s), flutter's standard deviation (action units) and correlation time
+#: (s), the seed of both, the vertical gusts' standard deviation (m/s); then 4 numbers per row.
 T_KIND, T_ROWS, T_RADIUS, T_SPEED, T_WIND = 0, 1, 2, 3, 4
-T_GUST, T_GUST_TAU, T_FLUTTER, T_FLUTTER_TAU, T_SEED, T_ROW0 = 7, 8, 9, 10, 11, 12
+T_GUST, T_GUST_TAU, T_FLUTTER, T_FLUTTER_TAU, T_SEED, T_GUST_W, T_ROW0 = 7, 8, 9, 10, 11, 12, 13
 
 # per-copy run record (float64): fitness, steps flown, diverged step, waypoints passed, tumble step, the gust
 # (3, m/s) and the flutter (one per action) now, then the closest approach to each waypoint
@@ -84,19 +87,22 @@ def attitude(q):
 
 
 @njit(cache=True)
-def observe(qpos, qvel, heading, altitude, speed, obs):
+def observe(qpos, qvel, heading, altitude, speed, air, obs):
     """The observation (module docstring) of the free body whose root is at ``qpos[0:7]``, ``qvel[0:6]``,
-    against the reference ``heading`` (rad), ``altitude`` (m) and forward ``speed`` (m/s)."""
+    against the reference ``heading`` (rad), ``altitude`` (m) and forward ``speed`` (m/s). The forward and
+    sideways speeds are taken relative to the horizontal velocity ``air[0:2]`` (m/s): zeros for speeds over
+    the ground, the wind for speeds through the air."""
     roll, pitch, yaw = attitude(qpos[3:7])
     c, s = math.cos(yaw), math.sin(yaw)
+    vx, vy = qvel[0] - air[0], qvel[1] - air[1]
     obs[0] = roll
     obs[1] = pitch
     obs[2] = wrap(heading - yaw)
     obs[3] = qvel[3]
     obs[4] = -qvel[4]  # nose up positive (the body's y axis points left)
     obs[5] = qvel[5]
-    obs[6] = c * qvel[0] + s * qvel[1] - speed
-    obs[7] = -s * qvel[0] + c * qvel[1]
+    obs[6] = c * vx + s * vy - speed
+    obs[7] = -s * vx + c * vy
     obs[8] = qvel[2]
     obs[9] = max(-ALTITUDE_CLIP_M, min(ALTITUDE_CLIP_M, qpos[2] - altitude))
 
@@ -240,12 +246,13 @@ def reward(obs):
 
 @njit(cache=True)
 def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, base, scale, task, rec, path, path_every,
-              tumble_rad):
+              tumble_rad, air_inputs):
     """Fly one butterfly ``n_steps`` steps from its current state: every ``every`` steps the network turns
     the observation into a new command; after each ``mj_step`` the kinematics advance exactly in the
     userdata. ``rec``: the run record (``R_*``); ``path``: rows of (t, x, y, z, roll, pitch, yaw) every
     ``path_every`` steps (none when 0). A roll or pitch beyond ``tumble_rad`` (a tumble) or a runaway
-    ends the flight (recorded in ``rec``). Without weights the command in the userdata stays."""
+    ends the flight (recorded in ``rec``). Without weights the command in the userdata stays. ``air_inputs``:
+    the network's speeds are through the air (the controller's ``inputs == "air"``), else over the ground."""
     ud = _f64(_ptr_at(dptr + off[_O_UD]), mj3d.N_USERDATA)
     qpos = _f64(_ptr_at(dptr + off[_O_QPOS]), nq)
     qvel = _f64(_ptr_at(dptr + off[_O_QVEL]), nv)
@@ -260,13 +267,21 @@ def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, base
     dp = np.empty(N_PARAMS)
     ddp = np.empty(N_PARAMS)
     w_c = ud[mj3d.U_OMEGA_C]
+    ground = np.zeros(3)
     n_path = 0
     for _ in range(n_steps):
         if rec[R_DIVERGED] >= 0 or rec[R_TUMBLED] >= 0:
             return
         step = int(rec[R_STEPS])
+        seed = int(task[T_SEED])
+        if task[T_GUST] > 0.0 or task[T_GUST_W] > 0.0:
+            for i in range(3):
+                sigma = task[T_GUST] if i < 2 else task[T_GUST_W]
+                rec[R_GUST + i] = ou_step(rec[R_GUST + i], sigma, task[T_GUST_TAU], dt, normal(seed, step, i))
+        for i in range(3):
+            ud[mj3d.U_AIR + i] = task[T_WIND + i] + rec[R_GUST + i]
         heading, altitude, speed = reference(task, time[0], qpos[0:3], rec)
-        observe(qpos, qvel, heading, altitude, speed, obs)
+        observe(qpos, qvel, heading, altitude, speed, ud[mj3d.U_AIR : mj3d.U_AIR + 3] if air_inputs else ground, obs)
         if path_every > 0 and step % path_every == 0 and n_path < path.shape[0]:
             path[n_path, 0] = time[0]
             for i in range(3):
@@ -279,12 +294,6 @@ def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, base
         if abs(obs[0]) > tumble_rad or abs(obs[1]) > tumble_rad:
             rec[R_TUMBLED] = step
             return
-        seed = int(task[T_SEED])
-        if task[T_GUST] > 0.0:
-            for i in range(3):
-                rec[R_GUST + i] = ou_step(rec[R_GUST + i], task[T_GUST], task[T_GUST_TAU], dt, normal(seed, step, i))
-        for i in range(3):
-            ud[mj3d.U_AIR + i] = task[T_WIND + i] + rec[R_GUST + i]
         if step % every == 0 and len(weights) > 0:
             network(layers, weights, obs, u, scratch)
             if task[T_FLUTTER] > 0.0:
@@ -309,18 +318,21 @@ def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, base
 
 
 @njit(cache=True, parallel=True)
-def fly_batch(mptr, dptrs, off, nq, nv, n_steps, dt, every, layers, weights, base, scale, tasks, recs, tumble_rad):
+def fly_batch(mptr, dptrs, off, nq, nv, n_steps, dt, every, layers, weights, base, scale, tasks, recs, tumble_rad,
+              air_inputs):
     """:func:`fly_steps` for many butterflies at once (one ``mjData`` each, ``weights[i]`` and
     ``tasks[i]`` per copy), threads over the copies; no paths are recorded."""
     none = np.empty((0, 7))
     for i in prange(len(dptrs)):
         fly_steps(mptr, dptrs[i], off, nq, nv, n_steps, dt, every, layers, weights[i], base, scale, tasks[i], recs[i],
-                  none, 0, tumble_rad)
+                  none, 0, tumble_rad, air_inputs)
 
 
 # ---- controller files ------------------------------------------------------------------------
 
 FORMAT = "lifelike-mj/butterfly3d-controller"
+#: What a controller's forward and sideways speeds are measured against (module docstring).
+INPUTS = ("ground", "air")
 #: Default ``scale`` of the actions (rad; Hz for the frequency).
 DEFAULT_SCALE = {"offset_sym": 0.3, "offset_asym": 0.3, "amplitude_sym": 0.3, "amplitude_asym": 0.3, "feather_sym": 0.5,
                  "feather_asym": 0.3, "feather_amplitude": 0.3, "abdomen_mean": 0.8, "frequency": 3.0}
@@ -336,11 +348,13 @@ def default_base():
 
 class Controller3D:
     """A 3D controller: a network from the observation to the action (module docstring), the base command
-    and the actions' scales, how often it runs (``every`` steps) and how fast the kinematics follow
-    (``omega_c_rad_s``), with its provenance. Plain data: :meth:`to_dict` / :func:`controller_from_dict`."""
+    and the actions' scales, how often it runs (``every`` steps), how fast the kinematics follow
+    (``omega_c_rad_s``) and what its speeds are measured against (``inputs``: ``"ground"`` or ``"air"``), with
+    its provenance. Plain data: :meth:`to_dict` / :func:`controller_from_dict`."""
 
     def __init__(self, layers, weights, base=None, scale: dict | None = None, every: int = 1,
-                 omega_c_rad_s: float = 2.0 * math.pi * 10.0, provenance: dict | None = None, name: str = "") -> None:
+                 omega_c_rad_s: float = 2.0 * math.pi * 10.0, provenance: dict | None = None, name: str = "",
+                 inputs: str = "ground") -> None:
         from lifelike_mj import checks
         from lifelike_mj.butterfly.kinematics3d import KinematicsCommand
         from lifelike_mj.errors import UserError
@@ -364,6 +378,9 @@ class Controller3D:
         self.scale = np.array([checks.number(f"scale of {a}", scale[a], 0.0, math.pi) for a in ACTION_NAMES])
         self.every = checks.whole("every", every, 1)
         self.omega_c_rad_s = checks.positive("omega_c_rad_s", omega_c_rad_s, "rad/s")
+        if inputs not in INPUTS:
+            raise UserError(f"{where}: inputs are {' or '.join(repr(v) for v in INPUTS)}, got {inputs!r}.")
+        self.inputs = inputs
         self.provenance = dict(provenance or {})
 
     def to_dict(self) -> dict:
@@ -372,12 +389,17 @@ class Controller3D:
         return {"format": FORMAT, "version": 1, "layers": [int(v) for v in self.layers],
                 "weights": [float(v) for v in self.weights], "base": asdict(self.base),
                 "scale": dict(zip(ACTION_NAMES, (float(v) for v in self.scale))), "every": self.every,
-                "omega_c_rad_s": self.omega_c_rad_s, "provenance": self.provenance}
+                "omega_c_rad_s": self.omega_c_rad_s, "inputs": self.inputs, "provenance": self.provenance}
 
-    def with_weights(self, weights) -> Controller3D:
-        """The same controller with other weights."""
+    @property
+    def air_inputs(self) -> bool:
+        """Whether the network's speeds are through the air (the compiled loop's flag)."""
+        return self.inputs == "air"
+
+    def with_weights(self, weights, inputs: str | None = None) -> Controller3D:
+        """The same controller with other weights (and, given ``inputs``, other inputs)."""
         return Controller3D(self.layers, weights, self.base, dict(zip(ACTION_NAMES, self.scale)), self.every,
-                            self.omega_c_rad_s, self.provenance, self.name)
+                            self.omega_c_rad_s, self.provenance, self.name, inputs or self.inputs)
 
 
 def controller_from_dict(data: object, name: str = "") -> Controller3D:
@@ -387,7 +409,8 @@ def controller_from_dict(data: object, name: str = "") -> Controller3D:
 
     where = f"3D controller {name}" if name else "3D controller"
     d = check_header(data, FORMAT, f"file {name}" if name else "the data", kind="3D controller file")
-    check_keys(d, ("format", "version", "layers", "weights", "base", "scale", "every", "omega_c_rad_s", "provenance"),
+    check_keys(d, ("format", "version", "layers", "weights", "base", "scale", "every", "omega_c_rad_s", "inputs",
+                   "provenance"),
                where, required=("layers", "weights"))
     base = d.get("base")
     if base is not None:
@@ -399,7 +422,7 @@ def controller_from_dict(data: object, name: str = "") -> Controller3D:
         base = KinematicsCommand(**{k: float(v) for k, v in base.items()})
     return Controller3D(d["layers"] if isinstance(d["layers"], list) else [],
                         number_list(d["weights"], "weights", where), base, d.get("scale"), d.get("every", 1),
-                        d.get("omega_c_rad_s", 2.0 * math.pi * 10.0), d.get("provenance"), name)
+                        d.get("omega_c_rad_s", 2.0 * math.pi * 10.0), d.get("provenance"), name, d.get("inputs", "ground"))
 
 
 def load_controller(name_or_path) -> Controller3D:

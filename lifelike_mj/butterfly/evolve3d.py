@@ -32,8 +32,10 @@ class Task3D:
     ``kind="target"``, a moving target (:func:`moving_target`).
 
     The weather: a mean wind ``wind_m_s`` (world frame, m/s, where it blows to) plus gusts, a first-order
-    Gauss-Markov (Ornstein-Uhlenbeck) process on each axis with standard deviation ``gust_m_s`` and
-    correlation time ``gust_tau_s``, starting from calm. ``flutter``: the butterfly's own irregularity, the
+    Gauss-Markov (Ornstein-Uhlenbeck) process on each axis with standard deviation ``gust_m_s`` (the two
+    horizontal axes) and ``gust_vertical_m_s`` (the vertical; ``None``: the same as ``gust_m_s``) and
+    correlation time ``gust_tau_s``, starting from calm. Near the ground the vertical gusts are weaker:
+    :data:`DRYDEN_VERTICAL_RATIO`. ``flutter``: the butterfly's own irregularity, the
     same process added to each of the controller's actions (standard deviation ``flutter`` in action units,
     where 1 is the action's full scale; correlation time ``flutter_tau_s``). Both are drawn from ``seed``."""
 
@@ -48,6 +50,7 @@ class Task3D:
     flutter: float = 0.0
     flutter_tau_s: float = 0.2
     seed: int = 0
+    gust_vertical_m_s: float | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in ("schedule", "waypoints", "target"):
@@ -65,17 +68,26 @@ class Task3D:
         object.__setattr__(self, "wind_m_s", checks.vector("wind_m_s", self.wind_m_s, 3, "m/s"))
         checks.number("gust_m_s", self.gust_m_s, 0.0, 10.0, unit="m/s")
         checks.positive("gust_tau_s", self.gust_tau_s, "s")
+        if self.gust_vertical_m_s is not None:
+            checks.number("gust_vertical_m_s", self.gust_vertical_m_s, 0.0, 10.0, unit="m/s")
         checks.number("flutter", self.flutter, 0.0, 1.0)
         checks.positive("flutter_tau_s", self.flutter_tau_s, "s")
         checks.whole("seed", self.seed, 0, 2**32 - 1)
 
     def with_weather(self, wind_m_s=(0.0, 0.0, 0.0), gust_m_s: float = 0.0, gust_tau_s: float = 1.0,
-                     flutter: float = 0.0, flutter_tau_s: float = 0.2, seed: int | None = None) -> Task3D:
+                     flutter: float = 0.0, flutter_tau_s: float = 0.2, seed: int | None = None,
+                     gust_vertical_m_s: float | None = None) -> Task3D:
         """The same task in other weather (and flutter); the seed defaults to the task's."""
         from dataclasses import replace
 
         return replace(self, wind_m_s=tuple(wind_m_s), gust_m_s=gust_m_s, gust_tau_s=gust_tau_s, flutter=flutter,
-                       flutter_tau_s=flutter_tau_s, seed=self.seed if seed is None else seed)
+                       flutter_tau_s=flutter_tau_s, seed=self.seed if seed is None else seed,
+                       gust_vertical_m_s=gust_vertical_m_s)
+
+    @property
+    def vertical_gust_m_s(self) -> float:
+        """The vertical gusts' standard deviation (m/s)."""
+        return self.gust_m_s if self.gust_vertical_m_s is None else self.gust_vertical_m_s
 
     def as_array(self, max_rows: int) -> np.ndarray:
         """The compiled loop's task array (:data:`~lifelike_mj.butterfly.control3d.T_KIND` ...), padded to
@@ -86,11 +98,17 @@ class Task3D:
         out[c3.T_RADIUS] = self.radius_m
         out[c3.T_SPEED] = self.speed_m_s
         out[c3.T_WIND : c3.T_WIND + 3] = self.wind_m_s
-        out[c3.T_GUST], out[c3.T_GUST_TAU] = self.gust_m_s, self.gust_tau_s
+        out[c3.T_GUST], out[c3.T_GUST_TAU], out[c3.T_GUST_W] = self.gust_m_s, self.gust_tau_s, self.vertical_gust_m_s
         out[c3.T_FLUTTER], out[c3.T_FLUTTER_TAU], out[c3.T_SEED] = self.flutter, self.flutter_tau_s, self.seed
         for i, r in enumerate(self.rows):
             out[c3.T_ROW0 + 4 * i : c3.T_ROW0 + 4 * i + len(r)] = r
         return out
+
+
+#: The vertical gusts' standard deviation over the horizontal ones near the ground: the low-altitude Dryden
+#: model (MIL-F-8785C; MIL-HDBK-1797) gives ``sigma_w / sigma_u = (0.177 + 0.000823 h)^0.4`` with ``h`` in
+#: feet, 0.50 at 1 m.
+DRYDEN_VERTICAL_RATIO = 0.5
 
 
 def level(speed_m_s: float = 1.5, heading_rad: float = 0.0, altitude_m: float = 0.0) -> Task3D:
@@ -152,6 +170,7 @@ class FlightProblem3D:
     params: ButterflyParams = field(default_factory=ButterflyParams)
     n_strips: int = 8
     n_chord: int = 2
+    force_law: str = "exact"
     prior: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
@@ -189,7 +208,8 @@ class FlightProblem3D:
         t = self.template.to_dict()
         return {"problem": "butterfly3d-flight", "tasks": [asdict(k) for k in self.tasks], "duration_s": self.duration_s,
                 "dt_s": self.dt_s, "gene_bound": self.gene_bound, "params": asdict(self.params),
-                "n_strips": self.n_strips, "n_chord": self.n_chord, "layers": t["layers"], "base": t["base"],
+                "force_law": self.force_law, "n_strips": self.n_strips, "n_chord": self.n_chord, "layers": t["layers"],
+                "base": t["base"],
                 "scale": t["scale"], "every": t["every"], "omega_c_rad_s": t["omega_c_rad_s"],
                 "prior_sha256": hashlib.sha256(np.asarray(self.prior).tobytes()).hexdigest()}
 
@@ -223,14 +243,14 @@ class FlightProblem3D:
         max_rows = max(len(t.rows) for t in self.tasks)
         tasks = np.tile(np.array([t.as_array(max_rows) for t in self.tasks]), (len(W), 1))
         ctl = self.template
-        datas = [mj3d.setup_data(m, Kinematics(ctl.base, ctl.omega_c_rad_s), self.params, n_strips=self.n_strips,
-                                 n_chord=self.n_chord) for _ in range(n)]
+        datas = [mj3d.setup_data(m, Kinematics(ctl.base, ctl.omega_c_rad_s), self.params, force_law=self.force_law,
+                                 n_strips=self.n_strips, n_chord=self.n_chord) for _ in range(n)]
         ptrs = np.array([d._address for d in datas], dtype=np.int64)
         recs = new_record(n, max_rows)
         with passive_callback(mj3d.COMPILED_PASSIVE), watching():
             c3.fly_batch(m._address, ptrs, mjabi.offsets_tuple(), m.nq, m.nv, int(round(self.duration_s / self.dt_s)),
                          self.dt_s, ctl.every, ctl.layers, np.ascontiguousarray(np.repeat(W, k, axis=0)),
-                         ctl.base.as_array(), ctl.scale, tasks, recs, c3.TUMBLE_RAD)
+                         ctl.base.as_array(), ctl.scale, tasks, recs, c3.TUMBLE_RAD, ctl.air_inputs)
         return recs.reshape(len(W), k, -1)
 
     def evaluate(self, X: np.ndarray) -> np.ndarray:
@@ -239,16 +259,21 @@ class FlightProblem3D:
         return recs[:, :, c3.R_FIT].mean(axis=1) / self.duration_s
 
 
+#: The gusts of the ``wind`` task set: 0.5 m/s (horizontal), half that vertically (:data:`DRYDEN_VERTICAL_RATIO`).
+_GUSTS = {"gust_m_s": 0.5, "gust_vertical_m_s": 0.5 * DRYDEN_VERTICAL_RATIO}
+
 #: The task sets the shipped controllers are evolved on (``evolve3d --tasks``).
 TASK_SETS = {
     "steer": lambda: (level(1.0), level(2.0), turn(90.0, 1.5, 1.5), turn(-180.0, 1.5, 1.5, 0.3)),
     "cruise": lambda: (level(1.5), level(2.0), turn(90.0, 1.5, 1.5), turn(-180.0, 1.5, 1.5, 0.3),
                        level(1.5).with_weather((0.0, 1.0, 0.0), gust_m_s=0.5, seed=1),
                        turn(-90.0, 1.5, 1.5).with_weather((-1.0, 0.0, 0.0), gust_m_s=0.5, seed=2)),
-    "wind": lambda: (course(1).with_weather((1.0, 0.0, 0.0), gust_m_s=0.5, seed=1),
-                     course(2).with_weather((0.0, -1.0, 0.0), gust_m_s=0.5, seed=2),
-                     course(3).with_weather((-1.0, 0.0, 0.0), gust_m_s=0.5, seed=3),
-                     course(4)),
+    "wind": lambda: (course(1).with_weather((1.0, 0.0, 0.0), **_GUSTS, seed=1),
+                     course(2).with_weather((0.0, -1.0, 0.0), **_GUSTS, seed=2),
+                     course(3).with_weather((-1.0, 0.0, 0.0), **_GUSTS, seed=3),
+                     course(4).with_weather((0.0, 1.0, 0.0), **_GUSTS, seed=4),
+                     course(5), turn(-180.0, 1.5, 1.5, 0.3),
+                     level(1.5).with_weather((0.7, 0.7, 0.0), **_GUSTS, seed=6)),
 }
 
 
@@ -265,12 +290,14 @@ def pd_prior(layers) -> np.ndarray:
 def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str = "cmaes", seed: int = 0,
            layers=(10, 9), population: int | None = 16, generations: int = 300, duration_s: float = 4.0,
            gene_bound: float = 0.4, checkpoint: str | Path | None = None, resume: bool = False, progress: bool = True,
-           overwrite: bool = False, task_set: str = "custom", on_generation=None, start: c3.Controller3D | None = None):
+           overwrite: bool = False, task_set: str = "custom", on_generation=None, start: c3.Controller3D | None = None,
+           inputs: str | None = None):
     """Evolve a 3D controller on ``tasks`` (default: the ``steer`` set) with ``optimizer`` and write it to
     ``out`` with its provenance (the problem, the optimiser, the budget, the time it took, the fitness
     history). Returns ``(result, controller)``; nothing is overwritten unasked (the checks and locks of the
     planar ``butterfly evolve``). ``start``: a controller to start from (its network, base and scales; the genes
-    are then changes of its weights and ``layers`` is ignored), recorded in the provenance."""
+    are then changes of its weights and ``layers`` is ignored), recorded in the provenance. ``inputs``: what the
+    network's speeds are measured against (``"ground"`` or ``"air"``; default: the start's, else the ground)."""
     from lifelike_mj import provenance as _prov
     from lifelike_mj.evolve import optimize
     from lifelike_mj.evolve.checkpoint import guarded_run_files
@@ -283,9 +310,12 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     if start is not None:
         template = start
         layers = [int(v) for v in start.layers]
+        if inputs is not None:
+            template = start.with_weights(start.weights, inputs=inputs)
     else:
         layers = [int(v) for v in layers]
-        template = c3.Controller3D(layers, pd_prior(layers) if len(layers) >= 2 and layers[0] == c3.N_OBS else [])
+        template = c3.Controller3D(layers, pd_prior(layers) if len(layers) >= 2 and layers[0] == c3.N_OBS else [],
+                                   inputs=inputs or "ground")
     problem = FlightProblem3D(tuple(tasks), template, duration_s=duration_s, gene_bound=gene_bound)
     out = Path(out)
     with guarded_run_files(out, checkpoint, resume=resume, overwrite=overwrite) as ckpt:

@@ -100,13 +100,14 @@ class Garden(StepCounter):
     """``n`` 3D butterflies in a garden of ``n_flowers`` flowers drawn by ``seed`` (module docstring).
 
     ``controller``: a 3D controller (name, path or :class:`~lifelike_mj.butterfly.control3d.Controller3D`);
-    ``flutter``, ``gust_m_s``, ``wind_m_s``: each butterfly's flutter and the weather
+    ``flutter``, ``gust_m_s``, ``gust_vertical_m_s``, ``wind_m_s``: each butterfly's flutter and the weather
     (:class:`~lifelike_mj.butterfly.evolve3d.Task3D`); ``speed_m_s``: the cruise speed; ``dt_s`` the time step.
     """
 
     def __init__(self, n: int = 20, controller="steer", *, seed: int = 0, n_flowers: int = 10, size_m: float = 6.0,
                  speed_m_s: float = 1.5, flutter: float = 0.1, gust_m_s: float = 0.0, wind_m_s=(0.0, 0.0, 0.0),
-                 dt_s: float = 1.0 / 1200.0, n_strips: int = 8, n_chord: int = 2) -> None:
+                 gust_vertical_m_s: float | None = None, dt_s: float = 1.0 / 1200.0, n_strips: int = 8, n_chord: int = 2,
+                 force_law: str = "exact") -> None:
         self.n = checks.whole("the number of butterflies", n, 1, 500)
         self.controller = controller if isinstance(controller, c3.Controller3D) else c3.load_controller(controller)
         self.seed = checks.whole("seed", seed, 0, 2**32 - 1)
@@ -116,11 +117,12 @@ class Garden(StepCounter):
         self.tasks = [e3.Task3D("waypoints", tuple(tuple(float(v) for v in p)
                                                    for p in course_among(self.blossoms, self.seed * 1000 + i)),
                                 speed_m_s=checks.positive("speed_m_s", speed_m_s, "m/s"), name=f"butterfly {i}",
-                                wind_m_s=tuple(wind_m_s), gust_m_s=gust_m_s, flutter=flutter,
+                                wind_m_s=tuple(wind_m_s), gust_m_s=gust_m_s, gust_vertical_m_s=gust_vertical_m_s,
+                                flutter=flutter,
                                 seed=(self.seed * 1000 + i) % 2**32) for i in range(self.n)]
         self._phys = mj3d.build_model()
         self._phys.opt.timestep = self.dt
-        self._n_strips, self._n_chord = n_strips, n_chord
+        self._n_strips, self._n_chord, self._force_law = n_strips, n_chord, force_law
         self._model = scene_model(self.n, self.blossoms, self.size_m)
         self._data = mujoco.MjData(self._model)
         self._blocks = [int(self._model.jnt_qposadr[self._model.joint(f"b{i}_root").id]) for i in range(self.n)]
@@ -147,8 +149,8 @@ class Garden(StepCounter):
         ctl = self.controller
         self._datas = []
         for task in self.tasks:
-            d = mj3d.setup_data(self._phys, Kinematics(ctl.base, ctl.omega_c_rad_s), n_strips=self._n_strips,
-                                n_chord=self._n_chord)
+            d = mj3d.setup_data(self._phys, Kinematics(ctl.base, ctl.omega_c_rad_s), force_law=self._force_law,
+                                n_strips=self._n_strips, n_chord=self._n_chord)
             a = rng.uniform(0, 2 * math.pi)
             start = np.array([0.6 * self.size_m * math.cos(a), 0.6 * self.size_m * math.sin(a), rng.uniform(-0.2, 0.2)])
             first = np.array(task.rows[0])
@@ -167,7 +169,8 @@ class Garden(StepCounter):
         m, ctl = self._phys, self.controller
         with passive_callback(mj3d.COMPILED_PASSIVE), watching():
             c3.fly_batch(m._address, self._ptrs, mjabi.offsets_tuple(), m.nq, m.nv, n, self.dt, ctl.every, ctl.layers,
-                         self._weights, ctl.base.as_array(), ctl.scale, self._task_arr, self._recs, math.inf)
+                         self._weights, ctl.base.as_array(), ctl.scale, self._task_arr, self._recs, math.inf,
+                         ctl.air_inputs)
         self._k += n
         bad = np.nonzero(self._recs[:, c3.R_DIVERGED] >= 0)[0]
         if len(bad):

@@ -86,12 +86,13 @@ class Flight3D(StepCounter):
     (:class:`~lifelike_mj.butterfly.evolve3d.Task3D`; default level flight at 1.5 m/s), or any callable
     ``controller(flight) -> KinematicsCommand | None`` run from Python before every ``control_every``-th
     step. ``wind_m_s``: the mean wind (world frame, m/s, where it blows to), replacing the task's (gusts and
-flutter are the task's: :class:`~lifelike_mj.butterfly.evolve3d.Task3D`); ``start_m``: the thorax's start
-position.
-    Model options: ``force_law`` (``strip``: eq. 1 on wing panels; ``tip``: the paper's tip-speed formula;
-    ``none``), ``drag_frame`` (``body`` or ``world``), ``body_areas_m2`` (the body's drag areas along x, y,
-    z; default the paper's ``A_b`` on every axis), ``masses`` (``animal`` or ``paper``), ``n_strips`` and
-    ``n_chord`` (panels per wing), ``drive_hz`` (the joints' tracking bandwidth), ``omega_c`` (rad/s, how
+    flutter are the task's: :class:`~lifelike_mj.butterfly.evolve3d.Task3D`); ``start_m``: the thorax's start
+    position.
+    Model options: ``force_law`` (``exact``: eq. 1 integrated exactly over each wing; ``strip``: eq. 1 on wing
+    panels; ``quasi_steady``: blade elements on the panels; ``tip``: the paper's tip-speed formula; ``none``),
+    ``drag_frame`` (``body`` or ``world``), ``body_areas_m2`` (the body's drag areas along x, y, z; default the
+    paper's ``A_b`` on every axis), ``masses`` (``animal`` or ``paper``), ``n_strips`` and ``n_chord`` (panels
+    per wing, for the panel laws), ``drive_hz`` (the joints' tracking bandwidth), ``omega_c`` (rad/s, how
     fast the kinematics follow a command; default the controller's, else one wing beat).
     ``assist="hold"`` holds the attitude at ``pitch_law(flight)`` (rad, nose up), set once per step, roll
     and yaw 0: the reduction check to the planar model, not free flight.
@@ -99,7 +100,7 @@ position.
 
     def __init__(self, command: KinematicsCommand | None = None, params: ButterflyParams | None = None, *,
                  controller=None, task=None, control_every: int = 1, wind_m_s=None,
-                 start_m=(0.0, 0.0, 0.0), force_law: str = "strip", drag_frame: str = "body",
+                 start_m=(0.0, 0.0, 0.0), force_law: str = "exact", drag_frame: str = "body",
                  body_areas_m2=None, masses: str = "animal", dt_s: float = 1.0 / 1200.0, n_strips: int = 8,
                  n_chord: int = 2, drive_hz: float = 50.0, omega_c: float | None = None, assist: str = "none",
                  pitch_law: Callable | None = None, _model: mujoco.MjModel | None = None) -> None:
@@ -154,6 +155,7 @@ position.
         self._weights = net.weights if net else np.zeros(0)
         self._scale = net.scale if net else np.zeros(9)
         self._every = net.every if net else 1
+        self._air_inputs = bool(net and net.air_inputs)
         self._base = (net.base if net else self.command).as_array()
         self.reset()
 
@@ -209,7 +211,7 @@ position.
         m, d = self._model, self._data
         control3d.fly_steps(m._address, d._address, mjabi.offsets_tuple(), m.nq, m.nv, n, self.dt, self._every,
                             self._layers, self._weights, self._base, self._scale, self._task, self._rec, _NO_PATH, 0,
-                            math.inf)
+                            math.inf, self._air_inputs)
 
     def step(self, n: int = 1) -> None:
         """Advance ``n`` time steps (a Python controller, if any, before every ``control_every``-th). An unstable

@@ -135,14 +135,19 @@ def turn_check(controller, angle_deg: float, at_s: float = 2.0, hold_s: float = 
             "altitude_min_m": float(pos[:, 2].min()), "altitude_max_m": float(pos[:, 2].max())}
 
 
-def course_check(controller, seed: int, n: int = 10, max_s: float = 60.0, **flight) -> dict:
+def course_check(controller, seed: int, n: int = 10, max_s: float = 60.0, weather: dict | None = None,
+                 **flight) -> dict:
     """Fly ``controller`` along the course of ``n`` waypoints drawn by ``seed``
     (:func:`~lifelike_mj.butterfly.evolve3d.course`) for at most ``max_s``; report the waypoints passed (in
-    order, within the course's 0.3 m) and the closest approach to each (m)."""
+    order, within the course's 0.3 m) and the closest approach to each (m). ``weather``: the wind, gusts and
+    flutter (:meth:`~lifelike_mj.butterfly.evolve3d.Task3D.with_weather`'s arguments; the seed defaults to
+    the course's)."""
     from lifelike_mj.butterfly import evolve3d
     from lifelike_mj.butterfly.sim3d import Flight3D
 
     task = evolve3d.course(seed, n)
+    if weather:
+        task = task.with_weather(**weather)
     f = Flight3D(controller=controller, task=task, **flight)
     while f.time < max_s and f.waypoints_passed < n:
         f.step(120)
@@ -153,7 +158,7 @@ def course_check(controller, seed: int, n: int = 10, max_s: float = 60.0, **flig
 
 
 def kinematics_check(controller, speed_m_s: float = 1.5, settle_s: float = 5.0, window_s: float = 5.0,
-                     force_law: str = "strip", **flight) -> dict:
+                     force_law: str = "exact", **flight) -> dict:
     """The measures of free flight Dudley 1990 reports, from a level flight of ``controller`` at ``speed_m_s``
     (after ``settle_s``, over ``window_s``): the flap frequency (Hz) and stroke amplitude (deg, the angle the
     wing sweeps from top to bottom), the speed over ground (m/s), the advance ratio ``J = U / (2 Phi f R)``

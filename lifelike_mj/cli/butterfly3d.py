@@ -34,7 +34,8 @@ def _task(args):
         task = evolve3d.turn(args.angle, 2.0, args.speed)
     else:
         task = evolve3d.course(args.seed, speed_m_s=args.speed)
-    return task.with_weather(args.wind, gust_m_s=args.gusts, flutter=args.flutter, seed=args.seed)
+    return task.with_weather(args.wind, gust_m_s=args.gusts, flutter=args.flutter, seed=args.seed,
+                             gust_vertical_m_s=args.vertical_gusts)
 
 
 def cmd_fly3d(args) -> None:
@@ -79,7 +80,8 @@ def cmd_evolve3d(args) -> None:
     res, ctrl = evolve(TASK_SETS[args.tasks](), out, optimizer=args.optimizer, seed=args.seed, layers=layers,
                        population=args.population, generations=args.generations, duration_s=args.duration,
                        checkpoint=args.checkpoint, resume=args.resume, progress=not args.quiet,
-                       overwrite=args.overwrite, task_set=args.tasks, start=start, gene_bound=args.gene_bound)
+                       overwrite=args.overwrite, task_set=args.tasks, start=start, gene_bound=args.gene_bound,
+                       inputs=args.inputs)
     if ctrl is None:
         raise KeyboardInterrupt("stopped before the first generation was evaluated; nothing was written")
     state = "stopped early (Ctrl-C); best so far" if res.interrupted else "done"
@@ -99,8 +101,10 @@ def cmd_assess3d(args) -> None:
     with stage("level flight, turns of 90 and 180 deg, courses"):
         level = level_check(ctrl, args.speed, args.duration)
         turns = [turn_check(ctrl, a, speed_m_s=args.speed) for a in (90.0, -90.0, 180.0)]
-        courses = [course_check(ctrl, s) for s in args.courses]
-    d = {"controller": ctrl.name or args.controller, "level": level, "turns": turns, "courses": courses}
+        weather = {"wind_m_s": args.wind, "gust_m_s": args.gusts, "gust_vertical_m_s": args.vertical_gusts}
+        courses = [course_check(ctrl, s, weather=weather) for s in args.courses]
+    d = {"controller": ctrl.name or args.controller, "level": level, "turns": turns, "courses": courses,
+         "course_weather": weather}
     human = (f"level {level['duration_s']:.0f} s at {args.speed:g} m/s: speed [{level['speed_min_m_s']:.2f}, "
              f"{level['speed_max_m_s']:.2f}] m/s, altitude [{level['altitude_min_m']:+.2f}, "
              f"{level['altitude_max_m']:+.2f}] m, roll within {level['roll_max_deg']:.0f} deg, pitch "
@@ -119,7 +123,8 @@ def cmd_garden(args) -> None:
 
     check_outputs(args, files={"--out": (".mp4", ".gif"), "--paths": (".png",)})
     ctrl = load_controller(args.controller)
-    garden = Garden(args.n, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_m_s=args.wind)
+    garden = Garden(args.n, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_m_s=args.wind,
+                    gust_vertical_m_s=args.vertical_gusts)
     d: dict = {"butterflies": args.n, "seed": args.seed, "controller": ctrl.name or args.controller}
     if args.paths:
         garden.track = []  # the positions at every frame, or every 0.02 s without a video
@@ -146,6 +151,16 @@ def cmd_garden(args) -> None:
         d["paths"] = args.paths
     emit(args, d, f"{args.n} butterflies flew {garden.time:.1f} s and visited {passed.min():.0f} to {passed.max():.0f} "
          f"flowers each" + (f"; video {args.out}" if args.out else "") + (f"; paths {args.paths}" if args.paths else ""))
+
+
+def _add_weather(p, what: str, seed: str) -> None:
+    p.add_argument("--wind", type=_vector3, default=(0.0, 0.0, 0.0),
+                   help=what + "mean wind X,Y,Z in m/s (where it blows to)")
+    p.add_argument("--gusts", type=num(0, 10, unit="m/s"), default=0.0,
+                   help=what + f"gusts' standard deviation, m/s (horizontal; correlation time 1 s; drawn from {seed})")
+    p.add_argument("--vertical-gusts", type=num(0, 10, unit="m/s"), default=None,
+                   help="the vertical gusts' standard deviation, m/s (default: as --gusts; near the ground the "
+                        "Dryden model gives half)")
 
 
 def _seeds(text: str) -> list[int]:
@@ -178,9 +193,7 @@ def add_commands(bf) -> None:
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
     p.add_argument("--angle", type=num(-180, 180, unit="deg"), default=90.0, help="turn angle, deg, left > 0")
     add_seed(p)
-    p.add_argument("--wind", type=_vector3, default=(0.0, 0.0, 0.0), help="wind X,Y,Z in m/s (where it blows to)")
-    p.add_argument("--gusts", type=num(0, 10, unit="m/s"), default=0.0,
-                   help="gusts' standard deviation on each axis, m/s (correlation time 1 s; drawn from --seed)")
+    _add_weather(p, "", "--seed")
     p.add_argument("--flutter", type=num(0, 1), default=0.0, help="the butterfly's flutter, 0 to 1 (drawn from --seed)")
     p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=20.0,
                    help=f"seconds of flight, at most {MAX_DURATION_S:g}")
@@ -194,7 +207,10 @@ def add_commands(bf) -> None:
     p.add_argument("--tasks", default="steer", choices=("steer", "cruise", "wind"),
                    help="the task set: steer (level at 1 and 2 m/s, turns of 90 and -180 deg), cruise (level at 1.5 "
                         "and 2 m/s, the turns, and two flights in 1 m/s wind with 0.5 m/s gusts) or wind (courses "
-                        "1-3 in 1 m/s wind with 0.5 m/s gusts, course 4 in still air)")
+                        "1-4 in 1 m/s wind from four sides with gusts of 0.5 m/s, 0.25 m/s vertically, course 5 and "
+                        "the -180 deg turn in still air, level flight in wind)")
+    p.add_argument("--inputs", default=None, choices=("ground", "air"),
+                   help="the network's speeds over the ground or through the air (default: the start's, else ground)")
     p.add_argument("--start", default=None, help="a 3D controller to start from (its network; genes are its changes)")
     p.add_argument("--gene-bound", type=num(0, 10, lo_open=True), default=0.4,
                    help="bound of each gene (a weight's change from the start), default 0.4")
@@ -212,8 +228,7 @@ def add_commands(bf) -> None:
     p.add_argument("--controller", default="steer", help="a shipped 3D controller's name or a file")
     add_seed(p)
     p.add_argument("--flutter", type=num(0, 1), default=0.1, help="each butterfly's flutter, 0 to 1 (default 0.1)")
-    p.add_argument("--gusts", type=num(0, 10, unit="m/s"), default=0.0, help="gusts' standard deviation, m/s")
-    p.add_argument("--wind", type=_vector3, default=(0.0, 0.0, 0.0), help="mean wind X,Y,Z in m/s")
+    _add_weather(p, "", "each butterfly's seed")
     p.add_argument("--duration", type=num(0, 600, lo_open=True, unit="s"), default=10.0, help="seconds of flight")
     p.add_argument("--out", default=None, help="video file (.mp4 or .gif)")
     p.add_argument("--camera", default="overview", choices=("overview", "chase"), help="overview (fixed) or chase")
@@ -230,5 +245,6 @@ def add_commands(bf) -> None:
     p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=60.0,
                    help="seconds of level flight (default 60)")
     p.add_argument("--courses", type=_seeds, default=[100, 101, 102], help="course seeds, e.g. 100-104")
+    _add_weather(p, "the courses' ", "each course's seed")
     add_json(p)
     p.set_defaults(func=cmd_assess3d)

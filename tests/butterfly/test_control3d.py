@@ -43,11 +43,29 @@ def test_the_observation_is_relative_to_the_reference():
     qvel[0:3] = (2.0 * math.cos(math.radians(30)), 2.0 * math.sin(math.radians(30)), -0.3)
     qvel[3:6] = (1.0, -2.0, 3.0)
     obs = np.empty(c3.N_OBS)
-    c3.observe(qpos, qvel, math.radians(90), 0.1, 1.5, obs)
+    c3.observe(qpos, qvel, math.radians(90), 0.1, 1.5, np.zeros(3), obs)
     want = [0.1, 0.2, math.radians(60), 1.0, 2.0, 3.0, 0.5, 0.0, -0.3, 0.3]
     np.testing.assert_allclose(obs, want, atol=1e-12)
-    c3.observe(qpos, qvel, math.radians(90), -5.0, 1.5, obs)
+    c3.observe(qpos, qvel, math.radians(90), -5.0, 1.5, np.zeros(3), obs)
     assert obs[9] == c3.ALTITUDE_CLIP_M
+    # through the air: a wind of 1 m/s from behind and 0.5 m/s from the right (heading 30 deg), and a rising
+    # gust the climb rate ignores (the altitude is the ground's)
+    c, s = math.cos(math.radians(30)), math.sin(math.radians(30))
+    wind = np.array([1.0 * c - 0.5 * -s, 1.0 * s - 0.5 * c, 0.4])
+    c3.observe(qpos, qvel, math.radians(90), 0.1, 1.5, wind, obs)
+    np.testing.assert_allclose(obs, [0.1, 0.2, math.radians(60), 1.0, 2.0, 3.0, -0.5, 0.5, -0.3, 0.3], atol=1e-12)
+
+
+def test_air_inputs_fly_as_ground_inputs_in_still_air_and_differently_in_wind():
+    ctl = c3.load_controller("steer")
+    air = ctl.with_weights(ctl.weights, inputs="air")
+    assert air.air_inputs and not ctl.air_inputs and air.to_dict()["inputs"] == "air"
+    calm, windy = e3.course(100), e3.course(100).with_weather((0.0, 1.0, 0.0))
+    f = [Flight3D(controller=c, task=t, n_strips=4, n_chord=1) for t in (calm, windy) for c in (ctl, air)]
+    for x in f:
+        x.step(600)
+    np.testing.assert_array_equal(f[0].data.qpos, f[1].data.qpos)
+    assert np.abs(f[2].data.qpos[:3] - f[3].data.qpos[:3]).max() > 0.01
 
 
 def test_a_linear_network_is_tanh_of_the_scaled_inputs_and_the_command_maps_each_action():
@@ -84,6 +102,9 @@ def test_a_controller_file_round_trips_and_bad_ones_are_one_sentence(tmp_path):
         c3.controller_from_dict(dict(good, weights=[0.0] * 84))
     with pytest.raises(UserError, match="unknown key 'wieghts'"):
         c3.controller_from_dict(dict(good, wieghts=good["weights"]))
+    with pytest.raises(UserError, match="inputs are 'ground' or 'air', got 'sky'"):
+        c3.controller_from_dict(dict(good, inputs="sky"))
+    assert c3.controller_from_dict({k: v for k, v in good.items() if k != "inputs"}).inputs == "ground"
     with pytest.raises(UserError, match="unknown action 'yaw'"):
         c3.controller_from_dict(dict(good, scale={"yaw": 0.1}))
     with pytest.raises(UserError, match="base has an unknown key 'flap_hz'"):
@@ -157,6 +178,24 @@ def test_gusts_are_a_gauss_markov_process_of_the_stated_deviation_and_time():
     assert xs.std() == pytest.approx(sigma, rel=0.1)
     lag = int(tau / dt)
     assert np.corrcoef(xs[:-lag], xs[lag:])[0, 1] == pytest.approx(math.exp(-1.0), abs=0.08)
+
+
+def test_vertical_gusts_have_their_own_deviation():
+    task = e3.level(1.5).with_weather((1.0, 0.0, 0.0), gust_m_s=0.5, seed=2,
+                                      gust_vertical_m_s=0.5 * e3.DRYDEN_VERTICAL_RATIO)
+    assert task.vertical_gust_m_s == 0.25 and e3.level(1.5).with_weather(gust_m_s=0.4).vertical_gust_m_s == 0.4
+    f = Flight3D(controller=None, task=task.with_weather((1.0, 0.0, 0.0), 0.5, gust_tau_s=0.05, seed=2,
+                                                        gust_vertical_m_s=0.25), n_strips=2, n_chord=1)
+    airs = []
+    for _ in range(2400):  # 20 s, sampled every 10 steps; the gusts decorrelate in 60 steps
+        f.step(10)
+        airs.append(f.data.userdata[mj3d.U_AIR : mj3d.U_AIR + 3].copy())
+    airs = np.array(airs)
+    sd = airs.std(axis=0)
+    assert sd[0] == pytest.approx(0.5, rel=0.1) and sd[1] == pytest.approx(0.5, rel=0.1)
+    assert sd[2] == pytest.approx(0.25, rel=0.1) and airs.mean(axis=0)[0] == pytest.approx(1.0, abs=0.1)  # 3 standard errors
+    with pytest.raises(UserError, match="gust_vertical_m_s"):
+        e3.level(1.5).with_weather(gust_m_s=0.5, gust_vertical_m_s=-1.0)
 
 
 def test_a_gusty_flight_is_the_same_for_the_same_seed_and_feels_the_gusts():

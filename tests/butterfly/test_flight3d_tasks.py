@@ -3,6 +3,7 @@
 import pytest
 
 from lifelike_mj.butterfly import control3d as c3
+from lifelike_mj.butterfly.evolve3d import DRYDEN_VERTICAL_RATIO
 from lifelike_mj.butterfly.validate3d import course_check, kinematics_check, level_check, turn_check
 from lifelike_mj.paths import shipped_names
 
@@ -10,14 +11,14 @@ SHIPPED = shipped_names("butterfly3d")
 
 
 def test_the_controllers_are_shipped_with_their_provenance():
-    assert {"steer", "cruise"} <= set(SHIPPED)
+    assert {"steer", "cruise", "wind"} <= set(SHIPPED)
     for name in SHIPPED:
         prov = c3.load_controller(name).provenance
         assert prov["evolution_wall_time_s"] > 0 and prov["generations_done"] > 0
         assert prov["problem"]["problem"] == "butterfly3d-flight" and "machine" in prov
 
 
-@pytest.mark.parametrize("name", ["steer", "cruise"])
+@pytest.mark.parametrize("name", ["steer", "cruise", "wind"])
 def test_level_flight_holds_altitude_upright(name):
     r = level_check(name, 2.0 if name == "steer" else 1.5, duration_s=20.0)
     assert r["altitude_within_0_3_m"] and r["roll_max_deg"] < 60 and -30 < r["pitch_min_deg"] < r["pitch_max_deg"] < 60
@@ -35,6 +36,19 @@ def test_turns_reach_and_hold_the_new_heading(name, angle):
 def test_a_course_never_trained_on_is_flown_through_every_waypoint(seed):
     r = course_check("steer", seed=seed, max_s=40.0)
     assert r["passed"] == 10 and r["all_within_radius"], r
+
+
+#: Gusty wind: a mean of 1 m/s and gusts of standard deviation 0.5 m/s (within +-1 m/s 95 % of the time), half that
+#: vertically as the low-altitude Dryden model has it.
+GUSTY = {"gust_m_s": 0.5, "gust_vertical_m_s": 0.5 * DRYDEN_VERTICAL_RATIO}
+
+
+@pytest.mark.parametrize("seed,wind", [(101, (1.0, 0.0, 0.0)), (105, (0.0, -1.0, 0.0))])
+def test_the_wind_controller_holds_a_course_never_trained_on_in_gusty_wind(seed, wind):
+    r = course_check("wind", seed=seed, weather={"wind_m_s": wind, **GUSTY})
+    assert r["passed"] == 10 and r["all_within_radius"], r
+    # steer, which measures its speed over the ground, loses the same course
+    assert course_check("steer", seed=seed, max_s=30.0, weather={"wind_m_s": wind, **GUSTY})["passed"] < 10
 
 
 def test_the_flight_looks_like_dudleys_butterflies():
