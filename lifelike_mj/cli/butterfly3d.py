@@ -52,6 +52,7 @@ def cmd_fly3d(args) -> None:
     pos, att = rec["position_m"], rec["attitude_rad"]
     s = {"controller": ctrl.name or args.controller, "task": flight.task.name, "duration_s": float(rec["t_s"][-1]),
          "end_m": [float(v) for v in pos[-1]], "distance_m": float(np.linalg.norm(pos[-1, :2] - pos[0, :2])),
+         "path_length_m": float(np.linalg.norm(np.diff(pos[:, :2], axis=0), axis=1).sum()),
          "altitude_min_m": float(pos[:, 2].min()), "altitude_max_m": float(pos[:, 2].max()),
          "roll_max_deg": float(np.degrees(np.abs(att[:, 0]).max())),
          "pitch_range_deg": [float(np.degrees(att[:, 1].min())), float(np.degrees(att[:, 1].max()))],
@@ -60,7 +61,8 @@ def cmd_fly3d(args) -> None:
         from lifelike_mj.butterfly.figures3d import write_flight
 
         write_flight(args.out, rec, s, flight.task)
-    human = (f"{s['task']}: {s['distance_m']:.1f} m over ground in {s['duration_s']:.1f} s, altitude in "
+    human = (f"{s['task']}: {s['path_length_m']:.1f} m flown over ground in {s['duration_s']:.1f} s, ending "
+             f"{s['distance_m']:.1f} m from the start, altitude in "
              f"[{s['altitude_min_m']:+.2f}, {s['altitude_max_m']:+.2f}] m, roll within {s['roll_max_deg']:.0f} deg, "
              f"pitch in [{s['pitch_range_deg'][0]:.0f}, {s['pitch_range_deg'][1]:.0f}] deg")
     if flight.task.kind == "waypoints":
@@ -187,7 +189,7 @@ def _hidden(text: str) -> list[int]:
 def add_commands(bf) -> None:
     """``fly3d``, ``evolve3d`` and ``assess3d`` under ``lifelike-mj butterfly``."""
     p = bf.add_parser("fly3d", help="fly the 3D butterfly with a 3D controller")
-    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name (steer, cruise) or a file")
+    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name (steer, cruise, wind) or a file")
     p.add_argument("--task", default="level", choices=("level", "turn", "course"),
                    help="level flight, a turn (--angle) or a course of 10 waypoints drawn by --seed")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")

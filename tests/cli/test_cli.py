@@ -41,6 +41,16 @@ def test_fly_json_and_out(capsys, tmp_path):
     assert not list(tmp_path.glob(".*"))  # no temporary files left behind
 
 
+def test_fly3d_in_gusty_wind_json_and_out(capsys, tmp_path):
+    code, out, _ = run(capsys, "butterfly", "fly3d", "--controller", "wind", "--task", "course", "--seed", "101",
+                       "--wind", "1,0,0", "--gusts", "0.5", "--vertical-gusts", "0.25", "--duration", "3", "--json",
+                       "--out", str(tmp_path / "f"))
+    assert code == 0
+    s = json.loads(out)
+    assert s["controller"] == "wind" and 0.0 < s["distance_m"] <= s["path_length_m"] and s["waypoints_passed"] >= 1
+    assert {p.name for p in (tmp_path / "f").iterdir()} >= {"paths.png", "path.csv", "summary.json"}
+
+
 def test_fly_mujoco_backend(capsys):
     code, out, _ = run(capsys, "butterfly", "fly", "--controller", "simple_rule", "--backend", "mujoco",
                        "--duration", "2", "--json")
