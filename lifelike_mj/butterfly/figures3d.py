@@ -69,7 +69,8 @@ def force_breakdown(controller, force_law: str = "strip", speed_m_s: float = 1.5
                     beats: int = 2, **flight) -> dict:
     """The left wing's force in parts (N, world frame) over ``beats`` wing beats of level flight after
     ``settle_s``: ``t_s``, ``lift_N``, ``drag_N``, ``rotational_N``, ``total_N`` (rows per step, x forward at
-    the start, z up) and ``flap_rad``."""
+    the start, z up) and ``flap_rad``. The default law is eq. 1 on panels, which splits the force panel by
+    panel (the exact law splits it by the flow at the wing's centroid)."""
     from lifelike_mj.butterfly import evolve3d
     from lifelike_mj.butterfly.sim3d import Flight3D
 

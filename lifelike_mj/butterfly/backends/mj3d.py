@@ -669,8 +669,9 @@ def load_kinematics(d: mujoco.MjData, kinematics: Kinematics) -> None:
 def forces(d: mujoco.MjData) -> dict[str, np.ndarray]:
     """The forces of the callback's last call (N, N m; world frame): each wing's air force and its
     moment about the wing's hinge (rows left, right), the body drag, the drive's five joint torques
-    and the attitude hold's three torques (zero unless held); and each wing's force in parts (panel laws
-    only): translational lift (across each panel's flow), drag (along it) and the rotational force."""
+    and the attitude hold's three torques (zero unless held); and each wing's force in parts: translational
+    lift (across each panel's flow), drag (along it) and the rotational force. The exact law splits its
+    force by the flow at the wing's centroid; the tip-speed law reports no parts."""
     o = d.userdata[U_OUT : U_OUT + N_OUT]
     return {"wing_force_N": o[O_WING_FORCE : O_WING_FORCE + 6].reshape(2, 3).copy(),
             "wing_moment_N_m": o[O_WING_MOMENT : O_WING_MOMENT + 6].reshape(2, 3).copy(),
