@@ -49,13 +49,15 @@ def shipped_names(creature: str) -> list[str]:
 
 def resolve(creature: str, name_or_path: str | Path, what: str) -> Path:
     """The file that ``name_or_path`` means: a path (anything ending in ``.json`` or that exists) or
-    the name of a file shipped in ``controllers/<creature>/``. ``what`` names the kind of file in
-    the :class:`UserError` raised when there is no such file ("boids preset")."""
+    the name of a file shipped in ``controllers/<creature>/``. A folder is never a file, so a folder that
+    happens to have a shipped file's name (``wind/`` in the working folder) does not hide it. ``what`` names
+    the kind of file in the :class:`UserError` raised when there is no such file ("boids preset")."""
     text = str(name_or_path)
     path = Path(text)
-    if text.endswith(".json") or path.exists():
+    shipped = controllers_dir() / creature / f"{text}.json"
+    if text.endswith(".json") or (path.exists() and not (path.is_dir() and shipped.is_file())):
         return existing_file(path, what)
-    path = controllers_dir() / creature / f"{text}.json"
+    path = shipped
     if not path.is_file():
         raise UserError(f"unknown {what} {text!r}; shipped: {', '.join(shipped_names(creature))} "
                         "(or give the path of a JSON file).")

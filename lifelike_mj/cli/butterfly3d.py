@@ -64,7 +64,7 @@ def cmd_fly3d(args) -> None:
     human = (f"{s['task']}: {s['path_length_m']:.1f} m flown over ground in {s['duration_s']:.1f} s, ending "
              f"{s['distance_m']:.1f} m from the start, altitude in "
              f"[{s['altitude_min_m']:+.2f}, {s['altitude_max_m']:+.2f}] m, roll within {s['roll_max_deg']:.0f} deg, "
-             f"pitch in [{s['pitch_range_deg'][0]:.0f}, {s['pitch_range_deg'][1]:.0f}] deg")
+             f"pitch in [{round(s['pitch_range_deg'][0])}, {round(s['pitch_range_deg'][1])}] deg")
     if flight.task.kind == "waypoints":
         human += f"; {s['waypoints_passed']} of {len(flight.task.rows)} waypoints passed"
     emit(args, s, human)
@@ -110,7 +110,7 @@ def cmd_assess3d(args) -> None:
     human = (f"level {level['duration_s']:.0f} s at {args.speed:g} m/s: speed [{level['speed_min_m_s']:.2f}, "
              f"{level['speed_max_m_s']:.2f}] m/s, altitude [{level['altitude_min_m']:+.2f}, "
              f"{level['altitude_max_m']:+.2f}] m, roll within {level['roll_max_deg']:.0f} deg, pitch "
-             f"[{level['pitch_min_deg']:.0f}, {level['pitch_max_deg']:.0f}] deg; "
+             f"[{round(level['pitch_min_deg'])}, {round(level['pitch_max_deg'])}] deg; "
              + "; ".join(f"turn {t['angle_deg']:+.0f} deg in {t['turn_time_s']:.1f} s, held within "
                          f"{t['held_error_max_deg']:.1f} deg" for t in turns)
              + "; courses: " + ", ".join(f"seed {c['seed']} {c['passed']}/{c['waypoints']}" for c in courses))

@@ -227,3 +227,12 @@ def test_a_moving_target_is_aimed_at_where_it_is_now():
     assert rec[c3.R_WP + 1] == pytest.approx(math.hypot(tx, ty)) and rec[c3.R_PASSED] == 0
     _, _, v = c3.reference(arr, t, np.array([tx - 0.2, ty, 0.0]), rec)  # close: slower, and counted
     assert v == pytest.approx(1.0) and rec[c3.R_PASSED] == 1
+
+
+def test_a_folder_named_like_a_shipped_controller_does_not_hide_it(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "wind").mkdir()
+    assert c3.load_controller("wind").inputs == "air"  # the shipped file, not the folder
+    (tmp_path / "mine").mkdir()
+    with pytest.raises(UserError, match="is a folder"):
+        c3.load_controller("mine")
