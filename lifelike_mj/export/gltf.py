@@ -193,10 +193,20 @@ def _xyzw(q_wxyz) -> list[float]:
     return [float(q_wxyz[1]), float(q_wxyz[2]), float(q_wxyz[3]), float(q_wxyz[0])]
 
 
-def build_gltf(poses: Poses, name: str = "lifelike-mj run") -> g.GLTF2:
-    """The glTF document (module docstring) of ``poses``; :func:`write_gltf` writes it."""
+def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | None = None) -> g.GLTF2:
+    """The glTF document (module docstring) of ``poses``; :func:`write_gltf` writes it. The asset's
+    ``extras`` hold the provenance: the versions, the command, the time and ``parameters`` (what made the
+    run), with the frames' count, rate and times."""
+    from lifelike_mj import __version__
+    from lifelike_mj.io import strict
+    from lifelike_mj.provenance import provenance
+
     m = poses.model
-    gl = g.GLTF2(asset=g.Asset(version="2.0", generator="lifelike-mj"))
+    fps = (poses.n_frames - 1) / (poses.t_s[-1] - poses.t_s[0]) if poses.t_s[-1] > poses.t_s[0] else 0.0
+    prov = provenance(**(parameters or {}))
+    prov["frames"] = {"count": poses.n_frames, "per_s": float(fps), "start_s": float(poses.t_s[0]),
+                      "end_s": float(poses.t_s[-1]), "bodies": len(poses.body_ids)}
+    gl = g.GLTF2(asset=g.Asset(version="2.0", generator=f"lifelike-mj {__version__}", extras=strict(prov)))
     gl.scenes = [g.Scene(name=name, nodes=[0])]
     gl.scene = 0
     root = g.Node(name="lifelike-mj", rotation=list(Z_UP_TO_Y_UP), children=[])
@@ -261,13 +271,14 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run") -> g.GLTF2:
     return gl
 
 
-def write_gltf(poses: Poses, path: str | Path, name: str = "lifelike-mj run") -> Path:
+def write_gltf(poses: Poses, path: str | Path, name: str = "lifelike-mj run", parameters: dict | None = None) -> Path:
     """Write ``poses`` as animated glTF 2.0: binary (``.glb``) or JSON with the buffer inside (``.gltf``),
-    atomically. Returns the path."""
+    atomically, with the provenance (:func:`build_gltf`; ``parameters``: what made the run). Returns the
+    path."""
     path = Path(path)
     if path.suffix.lower() not in (".glb", ".gltf"):
         raise UserError(f"a glTF file ends in .glb or .gltf, got {path.name!r}.")
-    gl = build_gltf(poses, name)
+    gl = build_gltf(poses, name, parameters)
     with atomic_path(path) as tmp:
         if path.suffix.lower() == ".glb":
             gl.save_binary(str(tmp))

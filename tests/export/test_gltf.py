@@ -86,7 +86,10 @@ def test_the_file_read_back_puts_every_geom_where_the_simulation_had_it(flight, 
 
 def test_shapes_are_shared_and_bad_names_refused(flight, tmp_path):
     f, poses = flight
-    gl = pygltflib.GLTF2().load(str(write_gltf(poses, tmp_path / "a.glb")))
+    gl = pygltflib.GLTF2().load(str(write_gltf(poses, tmp_path / "a.glb", parameters={"controller": "steer"})))
+    prov = gl.asset.extras  # every output records the version, the command and every parameter
+    assert prov["versions"]["lifelike-mj"] and prov["command"] and prov["parameters"] == {"controller": "steer"}
+    assert prov["frames"]["count"] == 31 and prov["frames"]["per_s"] == pytest.approx(30.0, rel=1e-3)
     geoms = [n for n in gl.nodes if n.mesh is not None]
     assert len(gl.meshes) <= len(geoms)
     for mesh in gl.meshes:
