@@ -19,7 +19,6 @@ way), atomically.
 
 from __future__ import annotations
 
-import base64
 import math
 from pathlib import Path
 
@@ -27,16 +26,18 @@ import mujoco
 import numpy as np
 import pygltflib as g
 
+from lifelike_mj import __version__
 from lifelike_mj.errors import UserError
 from lifelike_mj.export.poses import Poses, drawn_geoms, geom_rgba
-from lifelike_mj.io import atomic_path
+from lifelike_mj.io import atomic_path, strict
+from lifelike_mj.provenance import provenance
 
 #: The root's rotation (glTF x, y, z, w): -90 deg about X takes MuJoCo's Z-up to glTF's Y-up.
 Z_UP_TO_Y_UP = (-math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5))
 #: Size (m, half-width) of a plane whose MJCF size is 0 (infinite).
 INFINITE_PLANE_HALF_M = 5.0
 _SEGMENTS = 16  # around a sphere, capsule or cylinder
-_RINGS = 8  # from pole to pole of a sphere
+_RINGS = 8  # from pole to pole of a sphere (even: a capsule's equator is a ring)
 
 
 # ---- shapes -------------------------------------------------------------------------------------
@@ -85,17 +86,16 @@ def _grid_tris(rows: int, cols: int) -> np.ndarray:
 
 def _capsule(r: float, h: float):
     """A capsule along z: radius ``r``, cylinder half-length ``h`` (smooth)."""
-    rings = _RINGS if _RINGS % 2 == 0 else _RINGS + 1
-    th = np.linspace(0.0, math.pi, rings + 1)
-    th = np.concatenate([th[: rings // 2 + 1], th[rings // 2 :]])  # the equator twice: the cylinder between
+    th = np.linspace(0.0, math.pi, _RINGS + 1)
+    th = np.concatenate([th[: _RINGS // 2 + 1], th[_RINGS // 2 :]])  # the equator twice: the cylinder between
     ph = np.linspace(0.0, 2.0 * math.pi, _SEGMENTS + 1)
     T, P = np.meshgrid(th, ph, indexing="ij")
     unit = np.stack([np.sin(T) * np.cos(P), np.sin(T) * np.sin(P), np.cos(T)], axis=-1)
     shift = np.zeros_like(unit)
-    shift[: rings // 2 + 1, :, 2] = h
-    shift[rings // 2 + 1 :, :, 2] = -h
+    shift[: _RINGS // 2 + 1, :, 2] = h
+    shift[_RINGS // 2 + 1 :, :, 2] = -h
     pos = (r * unit + shift).reshape(-1, 3)
-    return pos, unit.reshape(-1, 3), _grid_tris(rings + 1, _SEGMENTS)
+    return pos, unit.reshape(-1, 3), _grid_tris(_RINGS + 1, _SEGMENTS)
 
 
 def _cylinder(r: float, h: float):
@@ -197,10 +197,6 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
     """The glTF document (module docstring) of ``poses``; :func:`write_gltf` writes it. The asset's
     ``extras`` hold the provenance: the versions, the command, the time and ``parameters`` (what made the
     run), with the frames' count, rate and times."""
-    from lifelike_mj import __version__
-    from lifelike_mj.io import strict
-    from lifelike_mj.provenance import provenance
-
     m = poses.model
     fps = (poses.n_frames - 1) / (poses.t_s[-1] - poses.t_s[0]) if poses.t_s[-1] > poses.t_s[0] else 0.0
     prov = provenance(**(parameters or {}))
@@ -283,8 +279,6 @@ def write_gltf(poses: Poses, path: str | Path, name: str = "lifelike-mj run", pa
         if path.suffix.lower() == ".glb":
             gl.save_binary(str(tmp))
         else:
-            blob = gl.binary_blob()
-            gl.buffers[0].uri = "data:application/octet-stream;base64," + base64.b64encode(blob).decode("ascii")
-            gl._glb_data = None
+            gl.convert_buffers(g.BufferFormat.DATAURI)  # the buffer inside the JSON, base64
             gl.save_json(str(tmp))
     return path
