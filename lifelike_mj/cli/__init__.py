@@ -4,7 +4,8 @@
 :mod:`~lifelike_mj.cli.fish`, :mod:`~lifelike_mj.cli.boids`); the shared verbs ``view``,
 ``render``, ``reproduce`` and ``bench`` take the creature as their first word and then only that
 creature's options. Each creature module provides ``add_commands``, ``add_view_args``/``view``,
-``add_render_args``/``render``, ``add_reproduce_args``/``reproduce`` and ``add_bench_args``/``bench``;
+``add_render_args``/``render``, ``add_reproduce_args``/``reproduce``, ``add_bench_args``/``bench`` and
+``add_export_args``/``export_poses`` (:mod:`lifelike_mj.cli.export`; the 3D butterfly exports as ``butterfly3d``);
 the commands call the creatures' library functions, so the command line and Python do the same thing.
 
 Every error a user can cause ends in one sentence on stderr and exit status 2; imports are lazy so
@@ -73,6 +74,9 @@ def build_parser() -> Parser:
     _verb(sub, "view", "open the MuJoCo viewer on a live simulation", "add_view_args")
     _verb(sub, "render", "render a video offscreen", "add_render_args", _render_options)
     _verb(sub, "bench", "speed benchmark", "add_bench_args", _bench_options)
+    from lifelike_mj.cli.export import add_export_verb
+
+    add_export_verb(sub)
     p = sub.add_parser("reproduce", help="run a paper's experiments and write a report")
     per = p.add_subparsers(dest="what", required=True, parser_class=Parser, metavar="CREATURE")
     for c in (*CREATURES, "all"):

@@ -212,3 +212,26 @@ def bench(args) -> tuple[dict, str]:
     r = b.run(repeats=min(args.repeats, 3), max_n=args.max_n, mesa_python=args.mesa_python)
     return r, (f"n = 300: {r['agent_steps_per_s_n300']:.3g} agent-steps/s; scaling exponent "
                f"{r.get('scaling_exponent', float('nan')):.2f}; x{r.get('mesa_ratio', float('nan')):.0f} Mesa")
+
+
+def add_export_args(p: argparse.ArgumentParser) -> None:
+    from lifelike_mj.boids.render import DEFAULT_STEPS_PER_FRAME
+
+    _add_boids(p)
+    p.add_argument("--start", type=count(0, MAX_STEPS), default=0, help="steps run before the exported window starts")
+    p.add_argument("--steps", type=count(1, MAX_STEPS), default=3000, help="steps exported")
+    p.add_argument("--steps-per-frame", type=count(1, 1000), default=DEFAULT_STEPS_PER_FRAME,
+                   help="steps between keyframes")
+    p.add_argument("--fps", type=count(1, 240), default=30, help="keyframes per second of playback")
+
+
+def export_poses(args):
+    from lifelike_mj.boids.sim import Flock
+    from lifelike_mj.cli.export import parameters_of, run_window
+
+    _check_size(args.n, args.start + args.steps)
+    if args.steps < args.steps_per_frame:
+        raise UserError(f"--steps {args.steps} is fewer than one frame of --steps-per-frame {args.steps_per_frame}.")
+    flock = Flock(_params(args), args.n, args.seed)
+    return (run_window(flock, args.start, args.steps, 1.0 / args.steps_per_frame,
+                       1.0 / (args.steps_per_frame * args.fps), unit="steps"), parameters_of(args))

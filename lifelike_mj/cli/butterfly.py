@@ -408,3 +408,19 @@ def bench(args) -> tuple[dict, str]:
              f"x{r['paper_speedup_vs_naive']:.0f}); MuJoCo bare {r['mujoco_bare_us_per_step']:.2f} us/step, with "
              f"callback+controller {r['mujoco_us_per_step']:.2f} us/step (+{100 * r['mujoco_callback_overhead']:.0f} %)")
     return r, human
+
+
+def add_export_args(p: argparse.ArgumentParser) -> None:
+    from lifelike_mj.cli.export import add_window
+
+    _add_scene(p)
+    add_window(p, MAX_VIDEO_S, 3.0)
+
+
+def export_poses(args):
+    from lifelike_mj.butterfly import Flight
+    from lifelike_mj.cli.export import parameters_of, run_window
+
+    flight = Flight(_controller(args), params(args), _condition(args), backend="mujoco", config=args.config,
+                    force_mode=args.force_mode)
+    return run_window(flight, args.start, args.duration, args.fps), parameters_of(args)

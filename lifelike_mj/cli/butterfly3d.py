@@ -250,3 +250,39 @@ def add_commands(bf) -> None:
     _add_weather(p, "the courses' ", "each course's seed")
     add_json(p)
     p.set_defaults(func=cmd_assess3d)
+
+
+HELP = "the butterfly in three dimensions: one on a task, or a garden of them"
+
+
+def add_export_args(p: argparse.ArgumentParser) -> None:
+    from lifelike_mj.cli.export import add_window
+
+    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name (steer, cruise, wind) or a file")
+    p.add_argument("--task", default="course", choices=("level", "turn", "course"),
+                   help="level flight, a turn (--angle) or a course of 10 waypoints drawn by --seed")
+    p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
+    p.add_argument("--angle", type=num(-180, 180, unit="deg"), default=90.0, help="turn angle, deg, left > 0")
+    p.add_argument("--garden", type=count(0, 500), default=0,
+                   help="a garden of this many butterflies visiting flowers instead of one on --task (0: one)")
+    add_seed(p)
+    _add_weather(p, "", "--seed")
+    p.add_argument("--flutter", type=num(0, 1), default=0.0, help="the butterfly's flutter, 0 to 1 (drawn from --seed)")
+    add_window(p, MAX_DURATION_S, 5.0)
+
+
+def export_poses(args):
+    from lifelike_mj.butterfly.control3d import load_controller
+    from lifelike_mj.cli.export import parameters_of, run_window
+
+    ctrl = load_controller(args.controller)
+    if args.garden:
+        from lifelike_mj.butterfly.garden import Garden
+
+        sim = Garden(args.garden, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_m_s=args.wind,
+                     gust_vertical_m_s=args.vertical_gusts)
+    else:
+        from lifelike_mj.butterfly.sim3d import Flight3D
+
+        sim = Flight3D(controller=ctrl, task=_task(args))
+    return run_window(sim, args.start, args.duration, args.fps), parameters_of(args)

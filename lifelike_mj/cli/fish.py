@@ -147,3 +147,18 @@ def bench(args) -> tuple[dict, str]:
     human = (f"10 fish x{r['ten']['realtime_factor']:.0f} real time, 1,000 fish "
              f"x{r['thousand']['realtime_factor']:.2f}, render {rend.get('fps', float('nan')):.0f} fps at 640x480")
     return r, human
+
+
+def add_export_args(p: argparse.ArgumentParser) -> None:
+    from lifelike_mj.cli.export import add_window
+
+    _add_fish(p)
+    add_window(p, MAX_DURATION_S, 10.0)
+
+
+def export_poses(args):
+    from lifelike_mj.cli.export import parameters_of, run_window
+    from lifelike_mj.fish.sim import Tank
+
+    tank = Tank(_preset(args), args.fish, args.seed, _tank(args))
+    return run_window(tank, args.start, args.duration, args.fps), parameters_of(args)

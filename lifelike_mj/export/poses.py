@@ -58,13 +58,16 @@ def animated_bodies(model: mujoco.MjModel) -> np.ndarray:
     return bodies[bodies > 0]
 
 
-def record_poses(stepper, duration_s: float, fps: float = 30.0) -> Poses:
-    """Fly ``stepper`` on for ``duration_s`` seconds from where it is, sampling its drawn bodies' poses
-    ``fps`` times a second (the first frame is the state now). Each frame lies on the nearest whole step;
-    its time is that step's. ``stepper``: anything in the stepper shape (``model``, ``data``, ``step``,
-    ``sync``, ``dt``, ``time``)."""
+def record_poses(stepper, duration_s: float, fps: float = 30.0, time_scale: float = 1.0) -> Poses:
+    """Run ``stepper`` on for ``duration_s`` of its time from where it is, sampling its drawn bodies' poses
+    ``fps`` times per unit of its time (the first frame is the state now). Each frame lies on the nearest
+    whole step; its time is that step's, times ``time_scale``: the seconds of playback per unit of the
+    stepper's time (1 for the creatures that live in seconds; a flock's time is counted in steps, so
+    ``time_scale = 1 / (steps per frame x frames per second)`` plays it at a frame rate). ``stepper``: anything
+    in the stepper shape (``model``, ``data``, ``step``, ``sync``, ``dt``, ``time``)."""
     fps = checks.positive("fps", fps, "frames/s")
     duration_s = checks.positive("duration_s", duration_s, "s")
+    time_scale = checks.positive("time_scale", time_scale, "s per unit")
     dt = float(stepper.dt)
     n_frames = int(np.floor(duration_s * fps + 1e-9)) + 1
     if n_frames < 2:
@@ -94,4 +97,4 @@ def record_poses(stepper, duration_s: float, fps: float = 30.0) -> Poses:
         q[k, flip] *= -1.0
     m = stepper.model
     names = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(b)) or f"body{int(b)}" for b in bodies]
-    return Poses(m, bodies, names, np.array(times), np.array(pos), q)
+    return Poses(m, bodies, names, np.array(times) * time_scale, np.array(pos), q)

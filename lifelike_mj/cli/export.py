@@ -1,0 +1,104 @@
+"""``lifelike-mj export CREATURE ... --format glb|gltf|usd|html --out FILE``: a run's motion as a file.
+
+The creatures are ``butterfly`` (the planar flight of the paper), ``butterfly3d`` (one 3D butterfly on a
+task, or a garden of them), ``fish`` (a tank) and ``boids`` (a flock). Each creature module gives
+``add_export_args`` (its scene's options and its time window) and ``export_poses(args)``, which runs the
+simulation and returns the sampled poses and the parameters that made them; this module checks the output
+before any work and writes the file (:mod:`lifelike_mj.export`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+from lifelike_mj.cli.common import Parser, add_json, add_overwrite, count, emit
+from lifelike_mj.errors import UserError
+
+#: The creatures that export, in the order of the help.
+EXPORTERS = ("butterfly", "butterfly3d", "fish", "boids")
+
+
+def _module(name: str):
+    import importlib
+
+    return importlib.import_module(f"lifelike_mj.cli.{name}")
+
+
+def add_export_verb(sub) -> None:
+    """The ``export`` verb with one sub-command per creature."""
+    from lifelike_mj.export import FORMATS
+
+    p = sub.add_parser("export", help="write a run's motion as glTF (glb, gltf), USD or a web page")
+    per = p.add_subparsers(dest="what", required=True, parser_class=Parser, metavar="CREATURE")
+    for c in EXPORTERS:
+        mod = _module(c)
+        q = per.add_parser(c, help=mod.HELP)
+        mod.add_export_args(q)
+        q.add_argument("--out", required=True, help="the file: " + ", ".join(s for v in FORMATS.values() for s in v))
+        q.add_argument("--format", default=None, choices=tuple(FORMATS),
+                       help="glb, gltf, usd or html (default: from the file's ending)")
+        q.add_argument("--rotations", default="short", choices=("short", "float"),
+                       help="glTF and web keyframes' rotations: 16-bit (within 6e-5 rad, half the bytes) or 32-bit")
+        add_overwrite(q)
+        add_json(q)
+        q.set_defaults(func=cmd_export)
+
+
+def add_window(p: argparse.ArgumentParser, max_s: float, default_s: float) -> None:
+    """``--start``, ``--duration`` (s) and ``--fps`` of a creature that lives in seconds."""
+    from lifelike_mj.cli.common import num
+
+    p.add_argument("--start", type=num(0, max_s, unit="s"), default=0.0,
+                   help="seconds simulated before the exported window starts")
+    p.add_argument("--duration", type=num(0, max_s, lo_open=True, unit="s"), default=default_s,
+                   help=f"seconds exported, at most {max_s:g}")
+    p.add_argument("--fps", type=count(1, 240), default=30, help="keyframes per second, 1 to 240")
+
+
+def cmd_export(args) -> None:
+    from lifelike_mj.export import format_of, write_poses
+    from lifelike_mj.paths import check_output_file
+
+    fmt = format_of(args.out, args.format)
+    check_output_file(args.out, "--out", overwrite=args.overwrite)
+    mod = _module(args.what)
+    t0 = time.perf_counter()
+    poses, parameters = mod.export_poses(args)
+    t_sim = time.perf_counter() - t0
+    parameters = {"creature": args.what, **parameters, "format": fmt, "rotations": args.rotations}
+    path = write_poses(poses, args.out, fmt, name=f"lifelike-mj {args.what}", parameters=parameters,
+                       rotations=args.rotations)
+    t_write = time.perf_counter() - t0 - t_sim
+    size = path.stat().st_size
+    info = {"out": str(path), "format": fmt, "bytes": size, "frames": poses.n_frames, "bodies": len(poses.body_ids),
+            "span_s": float(poses.t_s[-1] - poses.t_s[0]), "simulate_s": t_sim, "write_s": t_write}
+    emit(args, info, f"wrote {poses.n_frames} frames of {len(poses.body_ids)} bodies ({size / 1e6:.2f} MB) to {path} "
+         f"in {t_sim + t_write:.1f} s")
+
+
+def check_window(start: float, duration: float, limit: float, unit: str = "s") -> None:
+    """The window ends within ``limit``."""
+    if start + duration > limit:
+        raise UserError(f"--start plus --duration is {start + duration:g} {unit}, more than the {limit:g} {unit} "
+                        "that can be exported.")
+
+
+def parameters_of(args: argparse.Namespace) -> dict:
+    """The creature's options as given (what made the run), for the file's provenance."""
+    skip = {"func", "out", "format", "overwrite", "json", "command", "what", "rotations"}
+    return {k: (list(v) if isinstance(v, tuple) else v) for k, v in vars(args).items() if k not in skip}
+
+
+def run_window(stepper, start: float, duration: float, per_unit: float, time_scale: float = 1.0, unit: str = "s"):
+    """Simulate ``start`` units of the stepper's time unrecorded, then record ``duration`` of them with
+    ``per_unit`` frames per unit (:func:`~lifelike_mj.export.poses.record_poses`; ``time_scale``: seconds
+    of playback per unit)."""
+    from lifelike_mj.export.poses import record_poses
+    from lifelike_mj.progress import stage
+
+    skip = int(round(start / stepper.dt))
+    with stage(f"simulating {start + duration:g} {unit}"):
+        if skip:
+            stepper.step(skip)
+        return record_poses(stepper, duration, per_unit, time_scale)

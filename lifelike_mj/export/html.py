@@ -1,0 +1,157 @@
+"""One self-contained web page that plays a run: the animated glTF (:mod:`lifelike_mj.export.gltf`) inside it
+as base64, drawn by Google's ``<model-viewer>`` (vendored in ``web/``, with three.js inside; licences
+beside it), with play/pause, a time scrub and the time. It needs no network and no server: open the file.
+
+Controls: drag to orbit, scroll to zoom, the button or the space bar to play and pause, the slider to
+scrub, and the camera: ``follow`` (a single creature: the view moves with it) or ``whole run`` (every body
+at every frame in view; :mod:`lifelike_mj.export.cameras`). The page's ``<script id="provenance">`` holds
+what made the run (strict JSON), as the glTF's ``asset.extras`` do.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+import math
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from lifelike_mj.errors import UserError
+from lifelike_mj.export.cameras import FOV_DEG, framing
+from lifelike_mj.export.gltf import build_gltf
+from lifelike_mj.export.poses import Poses
+from lifelike_mj.io import atomic_path
+
+#: The vendored viewer (npm ``@google/model-viewer``, its UMD build), inlined into each page.
+VIEWER_JS = "model-viewer-umd.min.js"
+
+_PAGE = """<!doctype html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<meta name="generator" content="{generator}">
+<title>{title}</title>
+<style>
+  html, body {{ margin: 0; height: 100%; background: #f4f4f0; font: 14px system-ui, sans-serif; color: #222; }}
+  model-viewer {{ width: 100%; height: calc(100% - 48px); --poster-color: transparent; }}
+  #bar {{ display: flex; align-items: center; gap: 12px; height: 48px; padding: 0 12px; box-sizing: border-box; }}
+  #scrub {{ flex: 1; }}
+  #time {{ font-variant-numeric: tabular-nums; min-width: 9em; text-align: right; }}
+  button {{ min-width: 5em; }}
+</style>
+<script>{viewer}</script>
+</head>
+<body>
+<model-viewer id="run" src="data:model/gltf-binary;base64,{glb}" alt="{title}" camera-controls autoplay
+  animation-name="{animation}" environment-image="neutral" shadow-intensity="0" interaction-prompt="none"
+  field-of-view="{fov}deg" camera-orbit="{theta}deg {phi}deg {radius}m" camera-target="{target}"
+  min-camera-orbit="auto auto 0.001m" max-camera-orbit="auto auto {far}m" min-field-of-view="1deg" max-field-of-view="120deg"
+  interpolation-decay="30"></model-viewer>
+<div id="bar">
+  <button id="play" type="button" title="play or pause (space)">Pause</button>
+  <select id="view" aria-label="camera"{single}>
+    <option value="follow">follow</option>
+    <option value="overview">whole run</option>
+  </select>
+  <input id="scrub" type="range" min="0" max="{duration}" step="any" value="0" aria-label="time">
+  <span id="time">0.00 / {duration:.2f} s</span>
+</div>
+<script type="application/json" id="provenance">{provenance}</script>
+<script type="application/json" id="framing">{framing}</script>
+<script>
+  const run = document.getElementById("run"), play = document.getElementById("play");
+  const scrub = document.getElementById("scrub"), time = document.getElementById("time");
+  const view = document.getElementById("view"), frame = JSON.parse(document.getElementById("framing").textContent);
+  let dragging = false;
+  function target(t) {{  // the followed body's place at time t (s), between its keyframes
+    const p = frame.follow_path, n = p.length, u = Math.min(Math.max(t / frame.span_s, 0), 1) * (n - 1);
+    const k = Math.min(Math.floor(u), n - 2), w = u - k;
+    return [0, 1, 2].map((i) => p[k][i] + w * (p[k + 1][i] - p[k][i]));
+  }}
+  function aim() {{
+    if (view.value === "follow" && frame.follow_path) {{
+      const [x, y, z] = target(run.currentTime);
+      run.cameraTarget = `${{x}}m ${{y}}m ${{z}}m`;
+    }}
+  }}
+  view.addEventListener("change", () => {{
+    if (view.value === "follow") {{
+      run.cameraOrbit = `${{frame.theta}}deg ${{frame.phi}}deg ${{frame.follow_m}}m`;
+    }} else {{
+      run.cameraTarget = frame.centre.map((v) => v + "m").join(" ");
+      run.cameraOrbit = `${{frame.theta}}deg ${{frame.phi}}deg ${{frame.overview_m}}m`;
+    }}
+    aim();
+    run.jumpCameraToGoal();
+  }});
+  if (!frame.follow_path) view.value = "overview";
+  function toggle() {{ if (run.paused) run.play(); else run.pause(); }}
+  play.addEventListener("click", toggle);
+  document.addEventListener("keydown", (e) => {{ if (e.code === "Space") {{ e.preventDefault(); toggle(); }} }});
+  run.addEventListener("play", () => {{ play.textContent = "Pause"; }});
+  run.addEventListener("pause", () => {{ play.textContent = "Play"; }});
+  run.addEventListener("load", () => {{ scrub.max = run.duration; document.body.dataset.loaded = "yes"; }});
+  scrub.addEventListener("pointerdown", () => {{ dragging = true; }});
+  scrub.addEventListener("pointerup", () => {{ dragging = false; }});
+  scrub.addEventListener("input", () => {{ run.currentTime = Number(scrub.value); }});
+  (function tick() {{
+    if (!dragging) scrub.value = run.currentTime;
+    aim();
+    time.textContent = run.currentTime.toFixed(2) + " / " + (run.duration || {duration}).toFixed(2) + " s";
+    requestAnimationFrame(tick);
+  }})();
+</script>
+</body>
+</html>
+"""
+
+
+def viewer_js() -> str:
+    """The vendored ``<model-viewer>`` script (module docstring)."""
+    return resources.files("lifelike_mj.export").joinpath("web", VIEWER_JS).read_text(encoding="utf-8")
+
+
+def _inline(text: str) -> str:
+    """Text safe inside a ``<script>`` element (no ``</script`` or ``<!--`` can end it early)."""
+    return text.replace("</", "<\\/").replace("<!--", "<\\!--")
+
+
+def build_html(poses: Poses, name: str = "lifelike-mj run", parameters: dict | None = None,
+               rotations: str = "short") -> str:
+    """The page (module docstring) of ``poses`` as text; :func:`write_html` writes it."""
+    gl = build_gltf(poses, name, parameters, rotations)
+    f = framing(poses)
+    y_up = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])  # MuJoCo's Z-up to glTF's Y-up
+    d = y_up @ f.direction  # model-viewer's orbit: theta about +Y from +Z, phi from +Y
+    theta, phi = math.degrees(math.atan2(d[0], d[2])), math.degrees(math.acos(max(-1.0, min(1.0, d[1]))))
+    follow = f.follow is not None
+    centre = y_up @ f.centre_m
+    frame = {"theta": round(theta, 3), "phi": round(phi, 3), "overview_m": f.overview_m, "follow_m": f.follow_m,
+             "centre": [float(v) for v in centre], "span_s": float(poses.t_s[-1] - poses.t_s[0]),
+             "follow_path": (np.round(poses.position_m[:, f.follow] @ y_up.T, 5).tolist() if follow else None)}
+    glb = b"".join(gl.save_to_bytes())
+    prov = json.dumps(gl.asset.extras, allow_nan=False)
+    return _PAGE.format(generator=html.escape(gl.asset.generator), title=html.escape(name),
+                        viewer=_inline(viewer_js()), glb=base64.b64encode(glb).decode("ascii"),
+                        animation=html.escape(gl.animations[0].name if gl.animations else ""),
+                        duration=float(poses.t_s[-1] - poses.t_s[0]), provenance=_inline(prov),
+                        framing=_inline(json.dumps(frame, allow_nan=False)), fov=FOV_DEG, theta=frame["theta"],
+                        phi=frame["phi"], radius=f.follow_m if follow else f.overview_m,
+                        target=" ".join(f"{v}m" for v in ((y_up @ poses.position_m[0, f.follow]) if follow else centre)),
+                        far=10.0 * f.overview_m, single="" if follow else " hidden")
+
+
+def write_html(poses: Poses, path: str | Path, name: str = "lifelike-mj run", parameters: dict | None = None,
+               rotations: str = "short") -> Path:
+    """Write the page of ``poses`` (module docstring) to ``path`` (``.html``), atomically. Returns the path."""
+    path = Path(path)
+    if path.suffix.lower() != ".html":
+        raise UserError(f"a web page ends in .html, got {path.name!r}.")
+    text = build_html(poses, name, parameters, rotations)
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return path

@@ -1,0 +1,164 @@
+"""Animated USD (``.usda`` text, ``.usdc``/``.usd`` binary) of recorded body poses, written with ``usd-core``
+(the ``usd`` extra: ``pip install "lifelike-mj[usd]"``).
+
+Layout of the stage (Z up, metres, as MuJoCo's world; ``timeCodesPerSecond`` is the frame rate and time code
+``k`` is frame ``k``):
+
+* ``/World``: one ``Xform`` per exported body, animated (``xformOp:translate`` and ``xformOp:orient``
+  time samples at every frame, 32-bit floats; a body that never moves holds one still value), and the
+  world body's drawn geoms as still meshes;
+* under each body, one ``Mesh`` per drawn geom at its place in the body;
+* ``/Shapes`` (a class, not drawn): one mesh per distinct shape, which the geoms reference, so a flock of
+  hundreds stores one bird; ``/Looks``: one ``UsdPreviewSurface`` material per colour.
+
+The provenance (versions, command, time, parameters, the frames' count, rate and span) is the root layer's
+``customLayerData["lifelike_mj"]``, as strict JSON text.
+
+MuJoCo ships its own exporter (``mujoco.usd``). It is not used here: it writes a folder (``frames/frame_N``
+and ``assets/``) rather than the file asked for, animates every geom of the rendering scene rather than
+the bodies, and updates them one by one in Python; on this project's 2-core machine it took 1.5 s per
+frame for a flock of 300 (50 min for 2,001 frames), where this writer takes seconds.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from lifelike_mj.errors import UserError
+from lifelike_mj.export.poses import Poses, drawn_geoms, geom_rgba
+from lifelike_mj.export.shapes import geom_shape, shape_key
+from lifelike_mj.io import atomic_path, strict
+from lifelike_mj.provenance import provenance
+
+
+def _pxr():
+    try:
+        from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade, Vt
+    except ImportError:
+        raise UserError('USD export needs usd-core: pip install "lifelike-mj[usd]" (or pip install usd-core).') from None
+    return Gf, Sdf, Usd, UsdGeom, UsdShade, Vt
+
+
+def _ident(text: str, used: set[str]) -> str:
+    """A valid, unused prim name for ``text`` (MJCF names may hold ``/`` and other characters USD refuses)."""
+    from pxr import Tf
+
+    base = Tf.MakeValidIdentifier(text) or "_"
+    name, k = base, 1
+    while name in used:
+        k += 1
+        name = f"{base}_{k}"
+    used.add(name)
+    return name
+
+
+def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | None = None):
+    """The USD stage (module docstring) of ``poses``, in memory; :func:`write_usd` writes it."""
+    Gf, Sdf, Usd, UsdGeom, UsdShade, Vt = _pxr()
+    m = poses.model
+    n = poses.n_frames
+    span = float(poses.t_s[-1] - poses.t_s[0])
+    fps = (n - 1) / span if span > 0 else 1.0
+    stage = Usd.Stage.CreateInMemory()
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
+    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+    stage.SetTimeCodesPerSecond(fps)
+    stage.SetFramesPerSecond(fps)
+    stage.SetStartTimeCode(0)
+    stage.SetEndTimeCode(n - 1)
+    prov = provenance(**(parameters or {}))
+    prov["frames"] = {"count": n, "per_s": float(fps), "start_s": float(poses.t_s[0]), "end_s": float(poses.t_s[-1]),
+                      "bodies": len(poses.body_ids)}
+    stage.GetRootLayer().customLayerData = {"lifelike_mj": json.dumps(strict(prov), allow_nan=False)}
+    world = UsdGeom.Xform.Define(stage, "/World")
+    stage.SetDefaultPrim(world.GetPrim())
+    world.GetPrim().SetDocumentation(name)
+    shapes = stage.CreateClassPrim("/Shapes")
+    UsdGeom.Scope.Define(stage, "/Looks")
+    rgba = geom_rgba(m)
+    meshes: dict[tuple, str] = {}
+    looks: dict[tuple, UsdShade.Material] = {}
+
+    def shape_of(geom: int) -> str:
+        key = shape_key(m, geom)
+        if key not in meshes:
+            pos, nrm, tri = geom_shape(m, geom)
+            path = shapes.GetPath().AppendChild(f"shape{len(meshes)}")
+            mesh = UsdGeom.Mesh.Define(stage, path)
+            mesh.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(pos.astype(np.float32)))
+            mesh.CreateNormalsAttr(Vt.Vec3fArray.FromNumpy(nrm.astype(np.float32)))
+            mesh.SetNormalsInterpolation(UsdGeom.Tokens.vertex)
+            mesh.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(len(tri), 3, dtype=np.int32)))
+            mesh.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(tri.reshape(-1).astype(np.int32)))
+            mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+            mesh.CreateDoubleSidedAttr(True)
+            meshes[key] = str(path)
+        return meshes[key]
+
+    def look_of(geom: int):
+        colour = tuple(np.round(rgba[geom], 6).tolist())
+        if colour not in looks:
+            mat = UsdShade.Material.Define(stage, f"/Looks/look{len(looks)}")
+            shader = UsdShade.Shader.Define(stage, mat.GetPath().AppendChild("surface"))
+            shader.CreateIdAttr("UsdPreviewSurface")
+            shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(Gf.Vec3f(*colour[:3]))
+            shader.CreateInput("opacity", Sdf.ValueTypeNames.Float).Set(float(colour[3]))
+            shader.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(0.8)
+            mat.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")
+            looks[colour] = mat
+        return looks[colour]
+
+    def still(parent: Sdf.Path, geom: int, used: set[str]) -> None:
+        gname = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, geom) or f"geom{geom}"
+        prim = stage.DefinePrim(parent.AppendChild(_ident(gname, used)))
+        prim.GetReferences().AddInternalReference(shape_of(geom))
+        prim.SetCustomDataByKey("mujoco_geom", gname)
+        xf = UsdGeom.Xformable(prim)
+        xf.AddTranslateOp().Set(Gf.Vec3d(*map(float, m.geom_pos[geom])))
+        w, x, y, z = map(float, m.geom_quat[geom])
+        xf.AddOrientOp(UsdGeom.XformOp.PrecisionDouble).Set(Gf.Quatd(w, x, y, z))
+        UsdShade.MaterialBindingAPI.Apply(prim).Bind(look_of(geom))
+
+    drawn = drawn_geoms(m)
+    used: set[str] = set()
+    for geom in drawn[m.geom_bodyid[drawn] == 0]:
+        still(world.GetPath(), int(geom), used)
+    ops = []
+    for body, bname in zip(poses.body_ids, poses.body_names):
+        xf = UsdGeom.Xform.Define(stage, world.GetPath().AppendChild(_ident(bname, used)))
+        xf.GetPrim().SetCustomDataByKey("mujoco_body", bname)
+        ops.append((xf.AddTranslateOp(UsdGeom.XformOp.PrecisionFloat), xf.AddOrientOp(UsdGeom.XformOp.PrecisionFloat)))
+        inner: set[str] = set()
+        for geom in drawn[m.geom_bodyid[drawn] == body]:
+            still(xf.GetPath(), int(geom), inner)
+    pos = poses.position_m.astype(np.float32).astype(float)  # the values the file holds
+    quat = poses.quat_wxyz.astype(np.float32).astype(float)
+    with Sdf.ChangeBlock():  # the prims exist: only values change from here
+        for b, (translate, orient) in enumerate(ops):
+            p, q = pos[:, b], quat[:, b]
+            if np.all(p == p[0]) and np.all(q == q[0]):  # still over the whole run: one value, no samples
+                translate.Set(Gf.Vec3f(*p[0]))
+                orient.Set(Gf.Quatf(*q[0]))
+                continue
+            for k in range(n):
+                code = Usd.TimeCode(k)
+                translate.Set(Gf.Vec3f(*p[k]), code)
+                orient.Set(Gf.Quatf(*q[k]), code)
+    return stage
+
+
+def write_usd(poses: Poses, path: str | Path, name: str = "lifelike-mj run", parameters: dict | None = None) -> Path:
+    """Write ``poses`` as an animated USD stage (module docstring): ``.usda`` as text, ``.usdc`` or ``.usd``
+    binary (crate), atomically, with the provenance. Returns the path."""
+    path = Path(path)
+    if path.suffix.lower() not in (".usda", ".usdc", ".usd"):
+        raise UserError(f"a USD file ends in .usda, .usdc or .usd, got {path.name!r}.")
+    stage = build_stage(poses, name, parameters)
+    with atomic_path(path) as tmp:  # the temporary file has the same ending, from which USD picks the format
+        if not stage.GetRootLayer().Export(str(tmp)):
+            raise UserError(f"USD could not write {path}.")
+    return path

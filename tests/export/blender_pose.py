@@ -1,0 +1,51 @@
+"""Run by Blender: ``blender -b --python blender_pose.py -- FILE OUT.json K1 K2 ...``.
+
+Imports FILE (.glb/.gltf with Blender's glTF importer, .usd* with its USD importer) into an empty scene and
+writes, for each sampled keyframe index K, every imported body's world matrix as Blender evaluates it there:
+``{"frames": {K: {body: 4x4}}, "blender": version}`` (or ``{"error": ...}`` where it cannot import the format).
+Bodies are found by the ``mujoco_body`` property (glTF extras) or, for USD, by the names given in the
+environment variable ``BODIES`` (JSON: prim name -> body).
+"""
+
+import json
+import os
+import sys
+
+import bpy
+import numpy
+
+numpy.bool = bool  # Blender 3.4's glTF importer still uses numpy.bool, which numpy 1.24 removed
+
+argv = sys.argv[sys.argv.index("--") + 1:]
+path, out, ks = argv[0], argv[1], [int(k) for k in argv[2:]]
+bpy.ops.wm.read_factory_settings(use_empty=True)
+scene = bpy.context.scene
+if path.lower().endswith((".glb", ".gltf")):
+    scene.render.fps = 30
+    bpy.ops.import_scene.gltf(filepath=path)
+    bodies = {o.name: o["mujoco_body"] for o in bpy.data.objects if "mujoco_body" in o.keys()}
+    # the frame of keyframe k: the k-th key of the body's first animated channel
+    frames = {}
+    for o in bpy.data.objects:
+        if o.name in bodies and o.animation_data and o.animation_data.action:
+            keys = sorted({kp.co[0] for fc in o.animation_data.action.fcurves for kp in fc.keyframe_points})
+            frames = {k: keys[k] for k in ks}
+            break
+else:
+    if "usd_import" not in dir(bpy.ops.wm):  # Debian's Blender is built without USD
+        with open(out, "w") as fh:
+            json.dump({"blender": bpy.app.version_string, "error": "this Blender has no USD importer"}, fh)
+        sys.exit(0)
+    bpy.ops.wm.usd_import(filepath=path)
+    names = json.loads(os.environ["BODIES"])
+    bodies = {o.name: names[o.name] for o in bpy.data.objects if o.name in names}
+    frames = {k: float(k) for k in ks}  # USD time code k is Blender frame k
+result = {"blender": bpy.app.version_string, "frames": {}}
+for k, frame in frames.items():
+    whole = int(frame // 1)
+    scene.frame_set(whole, subframe=frame - whole)
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    result["frames"][str(k)] = {body: [list(r) for r in bpy.data.objects[name].evaluated_get(depsgraph).matrix_world]
+                                for name, body in bodies.items()}
+with open(out, "w") as fh:
+    json.dump(result, fh)

@@ -1,0 +1,64 @@
+// Opens a page in headless Chromium (Debian's, through playwright-core) and takes pictures of it:
+//   node page_check.js web URL OUTDIR           MuJoCo's web viewer: shots after 20 s and 23 s of live simulation
+//   node page_check.js html FILE EMPTY OUTDIR T1 T2   an exported page paused at T1 and T2 s (by the slider), then
+//                                                     the page EMPTY (the same without the creature) at T1
+// Prints one JSON line: {"errors": [console errors and page errors], "shots": [png paths],
+// "network": [every address asked for other than data:, file: and blob:], ...}.
+const { chromium } = require("playwright-core");
+const path = require("path");
+(async () => {
+  const args = process.argv.slice(2);
+  const mode = args.shift(), target = args.shift(), empty = mode === "html" ? args.shift() : null;
+  const [outdir, ...times] = args;
+  const browser = await chromium.launch({
+    executablePath: process.env.CHROMIUM || "/usr/bin/chromium",
+    args: ["--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-sandbox"],
+  });
+  const page = await browser.newPage({ viewport: { width: 640, height: 480 } });
+  const errors = [];
+  page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
+  page.on("pageerror", (e) => errors.push(String(e)));
+  const network = []; // what the page asked of anything but itself
+  page.on("request", (r) => { if (!/^(data|file|blob):/.test(r.url())) network.push(r.url()); });
+  const shots = [];
+  const shot = async (name, locator) => {
+    const file = path.join(outdir, name);
+    await (locator || page).screenshot({ path: file });
+    shots.push(file);
+  };
+  const result = { errors, shots, network };
+  try {
+    if (mode === "html") {
+      await page.goto("file://" + path.resolve(target));
+      await page.waitForSelector("body[data-loaded=yes]", { timeout: 60000 });
+      const viewer = page.locator("#run");
+      await page.click("#play"); // pause
+      result.paused = await page.$eval("#run", (e) => e.paused);
+      result.duration = await page.$eval("#run", (e) => e.duration);
+      for (const t of times) {
+        await page.$eval("#scrub", (e, v) => { e.value = v; e.dispatchEvent(new Event("input")); }, t);
+        await page.waitForTimeout(1500);
+        result["time_" + t] = await page.$eval("#run", (e) => e.currentTime);
+        await shot("t" + t + ".png", viewer);
+      }
+      if (empty) { // the empty scene: the same page, camera and time, without the creature
+        await page.goto("file://" + path.resolve(empty));
+        await page.waitForSelector("body[data-loaded=yes]", { timeout: 60000 });
+        await page.click("#play");
+        await page.$eval("#scrub", (e, v) => { e.value = v; e.dispatchEvent(new Event("input")); }, times[0]);
+        await page.waitForTimeout(1500);
+        await shot("empty.png", page.locator("#run"));
+      }
+    } else {
+      await page.goto(target);
+      await page.waitForTimeout(20000); // the WASM client downloads and compiles first
+      await shot("live1.png");
+      await page.waitForTimeout(3000);
+      await shot("live2.png");
+    }
+  } catch (e) {
+    errors.push("check: " + String(e));
+  }
+  await browser.close();
+  console.log(JSON.stringify(result));
+})();

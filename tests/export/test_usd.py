@@ -1,0 +1,90 @@
+"""Animated USD of a run, read back with usd-core: every body and geom where the simulation had it."""
+
+import json
+
+import mujoco
+import numpy as np
+import pytest
+
+from lifelike_mj.butterfly import evolve3d
+from lifelike_mj.butterfly.sim3d import Flight3D
+from lifelike_mj.errors import UserError
+from lifelike_mj.export.poses import drawn_geoms, record_poses
+from lifelike_mj.export.usd import write_usd
+
+pxr = pytest.importorskip("pxr", reason="usd-core is not installed (the usd extra)")
+from pxr import Usd, UsdGeom  # noqa: E402
+
+
+def _rotation_error(R, q_wxyz):
+    m = np.empty(9)
+    mujoco.mju_quat2Mat(m, np.asarray(q_wxyz, dtype=float))
+    c = (np.trace(np.asarray(R) @ m.reshape(3, 3).T) - 1.0) / 2.0
+    return float(np.arccos(np.clip(c, -1.0, 1.0)))
+
+
+@pytest.mark.parametrize("suffix", [".usda", ".usdc"])
+def test_the_stage_read_back_puts_every_body_and_geom_where_the_simulation_had_it(tmp_path, suffix):
+    f = Flight3D(controller="steer", task=evolve3d.course(100))
+    poses = record_poses(f, 1.0, fps=30.0)
+    path = write_usd(poses, tmp_path / f"run{suffix}", parameters={"controller": "steer"})
+    stage = Usd.Stage.Open(str(path))
+    assert UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.z and UsdGeom.GetStageMetersPerUnit(stage) == 1.0
+    assert stage.GetTimeCodesPerSecond() == pytest.approx(30.0, rel=1e-3) and stage.GetEndTimeCode() == 30
+    prov = json.loads(stage.GetRootLayer().customLayerData["lifelike_mj"])
+    assert prov["versions"]["lifelike-mj"] and prov["command"] and prov["parameters"] == {"controller": "steer"}
+    prims = {p.GetCustomDataByKey("mujoco_body"): p for p in stage.Traverse() if p.GetCustomDataByKey("mujoco_body")}
+    assert sorted(prims) == sorted(poses.body_names)
+    cache = UsdGeom.XformCache()
+    for k in (0, 13, 30):  # every body at three frames: 1e-4 m, 1e-3 rad
+        cache.SetTime(Usd.TimeCode(k))
+        for b, name in enumerate(poses.body_names):
+            M = np.array(cache.GetLocalToWorldTransform(prims[name]))  # USD: row vectors, translation in row 3
+            np.testing.assert_allclose(M[3, :3], poses.position_m[k, b], atol=1e-4)
+            assert _rotation_error(M[:3, :3].T, poses.quat_wxyz[k, b]) < 1e-3
+    m, d = f.model, f.data  # the last frame: every drawn geom of a body, through its reference and place
+    seen = 0
+    for prim in prims.values():
+        for child in prim.GetChildren():
+            geom = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, child.GetCustomDataByKey("mujoco_geom"))
+            M = np.array(cache.GetLocalToWorldTransform(child))
+            np.testing.assert_allclose(M[3, :3], d.geom_xpos[geom], atol=1e-4)
+            assert UsdGeom.Mesh(child).GetPointsAttr().Get()  # the referenced shape's triangles
+            seen += 1
+    drawn = drawn_geoms(m)
+    assert seen == int(np.sum(m.geom_bodyid[drawn] > 0))
+
+
+def test_a_flock_stores_one_shape_and_bad_names_are_refused(tmp_path):
+    from lifelike_mj.boids import Flock
+
+    poses = record_poses(Flock(n=300, seed=1), 20.0, fps=1.0)
+    stage = Usd.Stage.Open(str(write_usd(poses, tmp_path / "flock.usdc")))
+    shapes = stage.GetPrimAtPath("/Shapes").GetChildren()
+    bodies = [p for p in stage.Traverse() if p.GetCustomDataByKey("mujoco_body")]
+    assert len(bodies) == 300 and len(shapes) < 10
+    last = UsdGeom.XformCache(Usd.TimeCode(poses.n_frames - 1))
+    for b, prim in enumerate(bodies):
+        assert prim.GetCustomDataByKey("mujoco_body") == poses.body_names[b]
+        np.testing.assert_allclose(np.array(last.GetLocalToWorldTransform(prim))[3, :3], poses.position_m[-1, b],
+                                   atol=1e-4)
+    with pytest.raises(UserError, match=r"\.usda"):
+        write_usd(poses, tmp_path / "flock.glb")
+
+
+def _usd_validation(stage) -> list[str]:
+    """Every error and warning of usd-core's own validators (UsdValidation, all registered ones)."""
+    from pxr import UsdValidation
+
+    context = UsdValidation.ValidationContext(UsdValidation.ValidationRegistry().GetOrLoadAllValidators())
+    return [f"{e.GetType()} {e.GetName()}: {e.GetMessage()}" for e in context.Validate(stage)]
+
+
+def test_usd_cores_validators_find_nothing_in_any_creatures_stage(runs, creature, tmp_path):
+    from lifelike_mj.export.usd import build_stage
+
+    _, poses = runs(creature)
+    assert _usd_validation(build_stage(poses)) == []
+    bare = Usd.Stage.CreateInMemory()  # the validators do speak: a stage without its metadata is refused
+    UsdGeom.Xform.Define(bare, "/World")
+    assert _usd_validation(bare)
