@@ -77,13 +77,6 @@ def cmd_export(args) -> None:
          f"in {t_sim + t_write:.1f} s")
 
 
-def check_window(start: float, duration: float, limit: float, unit: str = "s") -> None:
-    """The window ends within ``limit``."""
-    if start + duration > limit:
-        raise UserError(f"--start plus --duration is {start + duration:g} {unit}, more than the {limit:g} {unit} "
-                        "that can be exported.")
-
-
 def parameters_of(args: argparse.Namespace) -> dict:
     """The creature's options as given (what made the run), for the file's provenance."""
     skip = {"func", "out", "format", "overwrite", "json", "command", "what", "rotations"}
