@@ -189,7 +189,7 @@ def frame_png(out_path: str | Path, params: BoidParams | Flock | Playback, step:
 
 def view_boids(params: BoidParams, n: int = 300, seed: int = 0, steps_per_s: float = VIEW_STEPS_PER_S,
                duration_steps: int | None = None, camera: str = "overview", warmup_steps: int = 0,
-               flock: Flock | None = None) -> None:
+               flock: Flock | None = None, web=None) -> None:
     """Run the boids in the MuJoCo viewer, ``steps_per_s`` engine steps per wall-clock second, until
     the window is closed or ``duration_steps`` steps have been shown (``None``: until closed).
 
@@ -197,9 +197,11 @@ def view_boids(params: BoidParams, n: int = 300, seed: int = 0, steps_per_s: flo
     ``camera``: ``overview`` (a free camera placed as the scene's overview camera: drag to orbit,
     scroll to zoom) or ``top`` (a free camera looking straight down: the x-y plane). The stepping slows
     down rather than freezes when the engine cannot keep up. Raises :class:`UserError` when there is
-    no display (use :func:`render_boids` instead); on macOS run it under ``mjpython``.
+    no display (use :func:`render_boids` instead); on macOS run it under ``mjpython``. ``web``:
+    :class:`~lifelike_mj.render.web.WebOptions` to serve MuJoCo's web viewer instead (no display needed).
     """
-    require_display("boids")
+    if web is None:
+        require_display("boids")
     rate = checks.positive("steps per second", steps_per_s)
     if duration_steps is not None:
         duration_steps = checks.whole("the number of steps", duration_steps, 1)
@@ -229,7 +231,7 @@ def view_boids(params: BoidParams, n: int = 300, seed: int = 0, steps_per_s: flo
             viewer.cam.azimuth = math.degrees(math.atan2(offset[1], offset[0])) + 180.0
             viewer.cam.elevation = -math.degrees(math.atan2(offset[2], math.hypot(offset[0], offset[1])))
 
-    view(flock, rate, end, setup)
+    view(flock, rate, end, setup, web=web)
 
 
 __all__ = ["CAMERAS", "DEFAULT_STEPS", "DEFAULT_STEPS_PER_FRAME", "VIEW_STEPS_PER_S", "film_flock", "frame_png",

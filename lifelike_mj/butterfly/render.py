@@ -158,15 +158,18 @@ def frame_png(out_path: str | Path, flight: Flight | Playback, width: int = 640,
 
 def view_butterfly(controller: ButterflyController | str = "simple_rule", params: ButterflyParams | None = None,
                    condition: Condition | None = None, config: str = "paper", force_mode: str | None = None,
-                   duration_s: float | None = None, flight: Flight | None = None) -> None:
+                   duration_s: float | None = None, flight: Flight | None = None, web=None) -> None:
     """Fly the butterfly in the MuJoCo viewer in about real time, until the window is closed or
     ``duration_s`` seconds of simulated flight have passed (``None``: until closed).
 
     A new flight on the MuJoCo backend, or the ``flight`` you give (either backend). The camera tracks
     the butterfly from the side, slightly behind (drag to orbit). Raises
     :class:`~lifelike_mj.errors.UserError` when there is no display; on macOS run it under ``mjpython``.
+    ``web``: :class:`~lifelike_mj.render.web.WebOptions` to serve MuJoCo's web viewer instead (no display
+    needed).
     """
-    require_display("butterfly")
+    if web is None:
+        require_display("butterfly")
     if duration_s is not None:
         duration_s = checks.positive("duration", duration_s, "s")
     if flight is None:
@@ -185,7 +188,7 @@ def view_butterfly(controller: ButterflyController | str = "simple_rule", params
         viewer.cam.elevation = FOLLOW_ELEVATION_DEG
 
     flight.sync()
-    view(flight, 1.0 / flight.dt, end, setup)
+    view(flight, 1.0 / flight.dt, end, setup, web=web)
 
 
 def snapshot_figure(out_path: str | Path, controller: ButterflyController | str = "simple_rule",

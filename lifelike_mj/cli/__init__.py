@@ -43,6 +43,27 @@ def _verb(sub, name: str, helptext: str, add: str, extra=None) -> None:
         q.set_defaults(func=globals()[f"cmd_{name}"])
 
 
+def _view_options(p) -> None:
+    p.add_argument("--web", action="store_true",
+                   help="serve MuJoCo's web viewer instead of opening a window (no display needed); open the "
+                        "printed address in a browser")
+    p.add_argument("--port", type=count(0, 65535), default=0, help="the web viewer's port (0: the first free from 8080)")
+    p.add_argument("--host", default="localhost",
+                   help="the web viewer's address to listen on; 0.0.0.0 or :: opens it to every network the machine is "
+                        "on, with no password (a warning is printed)")
+
+
+def web_options(args):
+    """The web viewer's options of ``view --web``, checked, or None without ``--web``."""
+    if not getattr(args, "web", False):
+        if getattr(args, "host", "localhost") != "localhost" or getattr(args, "port", 0):
+            raise UserError("--host and --port are for the web viewer: add --web.")
+        return None
+    from lifelike_mj.render.web import WebOptions
+
+    return WebOptions(args.host, args.port).check()
+
+
 def _render_options(p) -> None:
     p.add_argument("--out", required=True, help="FILE.mp4 or FILE.gif")
     p.add_argument("--fps", type=count(1, 240), default=30, help="frames per second of video, 1 to 240")
@@ -71,7 +92,8 @@ def build_parser() -> Parser:
     sub = top.add_subparsers(dest="command", required=True, parser_class=Parser)
     for c in CREATURES:
         creature(c).add_commands(sub)
-    _verb(sub, "view", "open the MuJoCo viewer on a live simulation", "add_view_args")
+    _verb(sub, "view", "open the MuJoCo viewer on a live simulation (--web: in a browser)", "add_view_args",
+          _view_options)
     _verb(sub, "render", "render a video offscreen", "add_render_args", _render_options)
     _verb(sub, "bench", "speed benchmark", "add_bench_args", _bench_options)
     from lifelike_mj.cli.export import add_export_verb

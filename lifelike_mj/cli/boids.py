@@ -173,8 +173,10 @@ def add_view_args(p: argparse.ArgumentParser) -> None:
 
 def view(args) -> None:
     from lifelike_mj.boids.render import view_boids
+    from lifelike_mj.cli import web_options
 
-    view_boids(_params(args), n=args.n, seed=args.seed, camera=args.camera)
+    web = web_options(args)
+    view_boids(_params(args), n=args.n, seed=args.seed, camera=args.camera, web=web)
 
 
 def add_render_args(p: argparse.ArgumentParser) -> None:

@@ -366,9 +366,11 @@ def add_view_args(p: argparse.ArgumentParser) -> None:
 
 def view(args) -> None:
     from lifelike_mj.butterfly.render import view_butterfly
+    from lifelike_mj.cli import web_options
 
+    web = web_options(args)
     view_butterfly(_controller(args), params(args), _condition(args), config=args.config, force_mode=args.force_mode,
-                   duration_s=args.duration)
+                   duration_s=args.duration, web=web)
 
 
 def add_render_args(p: argparse.ArgumentParser) -> None:

@@ -13,7 +13,6 @@ import argparse
 import time
 
 from lifelike_mj.cli.common import Parser, add_json, add_overwrite, count, emit
-from lifelike_mj.errors import UserError
 
 #: The creatures that export, in the order of the help.
 EXPORTERS = ("butterfly", "butterfly3d", "fish", "boids")

@@ -104,9 +104,11 @@ def add_view_args(p: argparse.ArgumentParser) -> None:
 
 
 def view(args) -> None:
+    from lifelike_mj.cli import web_options
     from lifelike_mj.fish.render import view_fish
 
-    view_fish(_preset(args), args.fish, args.seed, _tank(args), duration_s=args.duration, camera=args.camera)
+    web = web_options(args)
+    view_fish(_preset(args), args.fish, args.seed, _tank(args), duration_s=args.duration, camera=args.camera, web=web)
 
 
 def add_render_args(p: argparse.ArgumentParser) -> None:

@@ -298,7 +298,7 @@ def render_benchmark(n_frames: int = 120, width: int = 640, height: int = 480, n
 
 
 def view_fish(params: FishParams, n_fish: int = 10, seed: int = 0, size=None, duration_s: float | None = None,
-              camera: str = "side", follow_fish: int = 0, tank: Tank | None = None) -> None:
+              camera: str = "side", follow_fish: int = 0, tank: Tank | None = None, web=None) -> None:
     """Swim the fish in the MuJoCo viewer in about real time, until the window is closed or
     ``duration_s`` seconds of simulated swim have passed (``None``: until closed).
 
@@ -306,9 +306,11 @@ def view_fish(params: FishParams, n_fish: int = 10, seed: int = 0, size=None, du
     camera: the whole tank; drag to orbit, scroll to zoom) or ``follow`` (MuJoCo's tracking camera on
     fish ``follow_fish``, from the side at the distance of the ``follow`` video camera). Raises
     :class:`UserError` when there is no display (use :func:`render_fish` instead); on macOS run it
-    under ``mjpython``.
+    under ``mjpython``. ``web``: :class:`~lifelike_mj.render.web.WebOptions` to serve MuJoCo's web viewer
+    instead of opening a window (no display needed).
     """
-    require_display("fish")
+    if web is None:
+        require_display("fish")
     if duration_s is not None:
         duration_s = checks.positive("duration", duration_s, "s")
     if camera not in ("side", "follow"):
@@ -338,7 +340,7 @@ def view_fish(params: FishParams, n_fish: int = 10, seed: int = 0, size=None, du
             viewer.cam.elevation = FOLLOW_ELEVATION_DEG
         viewer.cam.azimuth = 90.0
 
-    view(tank, 1.0 / tank.dt, end, setup)
+    view(tank, 1.0 / tank.dt, end, setup, web=web)
 
 
 __all__ = ["CAMERAS", "FOLLOW_VIEW_M", "film_tank", "frame_png", "frame_steps", "playback", "render_benchmark",

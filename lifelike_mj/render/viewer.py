@@ -53,15 +53,24 @@ def launch_viewer(m, d):
 
 
 def view(stepper: Any, steps_per_s: float, end_step: int | None = None,
-         setup: Callable[[Any], None] | None = None) -> None:
+         setup: Callable[[Any], None] | None = None, web: Any = None) -> None:
     """Show ``stepper`` in the MuJoCo viewer, ``steps_per_s`` steps per wall-clock second, until the
     window is closed or the stepper reaches step ``end_step`` (``None``: until closed).
 
     ``setup(viewer)`` places the viewer's camera (called under the viewer's lock before the first
     refresh). The stepper is advanced with ``step(n)`` and drawn after ``sync()``; when it cannot keep
     up, the clock is re-anchored and the view runs slower than asked rather than freezing.
+
+    ``web``: :class:`~lifelike_mj.render.web.WebOptions` to show it in MuJoCo's web viewer instead (no display
+    needed; :func:`~lifelike_mj.render.web.launch_web`), until the stepper reaches ``end_step`` or Ctrl+C.
     """
-    with launch_viewer(stepper.model, stepper.data) as viewer:
+    if web is not None:
+        from lifelike_mj.render.web import launch_web
+
+        opened = launch_web(stepper.model, stepper.data, web, setup=setup)
+    else:
+        opened = launch_viewer(stepper.model, stepper.data)
+    with opened as viewer:
         with viewer.lock():
             viewer.opt.sitegroup[:] = 0
             if setup is not None:

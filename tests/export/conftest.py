@@ -1,6 +1,14 @@
 """One short run of each creature, recorded once per test session for the exporters' tests."""
 
+import json
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
 import pytest
+from PIL import Image
 
 from lifelike_mj.export.poses import record_poses
 
@@ -48,3 +56,37 @@ def runs():
 def creature(request) -> str:
     """Each creature in turn."""
     return request.param
+
+
+class _Chromium:
+    """Headless Chromium driven by ``page_check.js`` (Node and npm's playwright-core, which ``.ci/run``
+    installs into ``.ci/node``, with Debian's ``chromium``)."""
+
+    modules = Path(__file__).resolve().parents[2] / ".ci" / "node" / "node_modules"
+
+    def __init__(self, executable: str) -> None:
+        self.executable = executable
+
+    def check(self, *args: str) -> dict:
+        """``page_check.js`` run on ``args``: its JSON report."""
+        out = subprocess.run(["node", str(Path(__file__).with_name("page_check.js")), *args], capture_output=True,
+                             text=True, timeout=240, check=True,
+                             env=dict(os.environ, NODE_PATH=str(self.modules), CHROMIUM=self.executable))
+        return json.loads(out.stdout.strip().splitlines()[-1])
+
+    @staticmethod
+    def changed_pixels(a: str, b: str) -> int:
+        """Pixels whose colour differs by more than 8 of 255 in some channel between two screenshots."""
+        x = np.asarray(Image.open(a).convert("RGB"), dtype=int)
+        y = np.asarray(Image.open(b).convert("RGB"), dtype=int)
+        return int(np.sum(np.abs(x - y).max(axis=2) > 8))
+
+
+@pytest.fixture(scope="session")
+def chromium() -> _Chromium:
+    """Headless Chromium (:class:`_Chromium`), or a skip that says what is missing."""
+    exe = shutil.which("chromium")
+    if exe is None or shutil.which("node") is None or not (_Chromium.modules / "playwright-core").is_dir():
+        pytest.skip("Chromium or playwright-core is not installed (.ci/run installs Debian's chromium and npm's "
+                    "playwright-core)")
+    return _Chromium(exe)

@@ -1,5 +1,6 @@
 // Opens a page in headless Chromium (Debian's, through playwright-core) and takes pictures of it:
-//   node page_check.js web URL OUTDIR           MuJoCo's web viewer: shots after 20 s and 23 s of live simulation
+//   node page_check.js web URL [EMPTY] OUTDIR      MuJoCo's web viewer: shots after 20 s and 23 s of live simulation
+//                                                  (and of the viewer at the address EMPTY after 20 s)
 //   node page_check.js html FILE EMPTY OUTDIR T1 T2   an exported page paused at T1 and T2 s (by the slider), then
 //                                                     the page EMPTY (the same without the creature) at T1
 // Prints one JSON line: {"errors": [console errors and page errors], "shots": [png paths],
@@ -8,7 +9,7 @@ const { chromium } = require("playwright-core");
 const path = require("path");
 (async () => {
   const args = process.argv.slice(2);
-  const mode = args.shift(), target = args.shift(), empty = mode === "html" ? args.shift() : null;
+  const mode = args.shift(), target = args.shift(), empty = args.length > 1 ? args.shift() : null;
   const [outdir, ...times] = args;
   const browser = await chromium.launch({
     executablePath: process.env.CHROMIUM || "/usr/bin/chromium",
@@ -50,9 +51,22 @@ const path = require("path");
         await shot("empty.png", page.locator("#run"));
       }
     } else {
-      await page.goto(target);
+      // MuJoCo's web viewer: TARGET and, in a second tab, EMPTY (the same scene without the creature)
+      const pages = [page];
+      if (empty) {
+        const other = await browser.newPage({ viewport: { width: 640, height: 480 } });
+        other.on("console", (m) => { if (m.type() === "error") errors.push("empty: " + m.text()); });
+        other.on("pageerror", (e) => errors.push("empty: " + String(e)));
+        pages.push(other);
+      }
+      await Promise.all(pages.map((p, i) => p.goto(i === 0 ? target : empty)));
       await page.waitForTimeout(20000); // the WASM client downloads and compiles first
       await shot("live1.png");
+      if (empty) {
+        const file = path.join(outdir, "empty.png");
+        await pages[1].screenshot({ path: file });
+        shots.push(file);
+      }
       await page.waitForTimeout(3000);
       await shot("live2.png");
     }

@@ -1,0 +1,169 @@
+"""MuJoCo's web viewer (``mujoco.studio``) on a live simulation, for machines without a display.
+
+:func:`launch_web` serves the viewer over HTTP: open the address it prints in a browser on this machine, or
+through an SSH tunnel (``ssh -L 8080:localhost:8080 host``). It binds ``localhost`` unless another host is
+asked for. MuJoCo's own launcher binds every interface (``::``) and has no authentication, so anyone who
+can reach the machine could watch and drive the simulation; this module binds the host it is given
+(MuJoCo 4.0 has no setting for it, so the binding function is wrapped while the viewer starts) and warns
+when that host is not the loopback.
+
+The viewer is driven by the same real-time loop as the desktop viewer (:func:`lifelike_mj.render.viewer.view`).
+It starts from the desktop viewer's view of the creature (following it where the desktop viewer does); drag
+to orbit, scroll to zoom.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ipaddress
+import socket
+import sys
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from lifelike_mj.errors import UserError
+
+#: Hosts that only this machine can reach.
+LOOPBACK = ("localhost", "127.0.0.1", "::1")
+
+
+@dataclass(frozen=True)
+class WebOptions:
+    """Where the web viewer listens: ``host`` (default ``localhost``; ``0.0.0.0`` or ``::`` for every
+    interface) and ``port`` (0: the first free one from 8080)."""
+
+    host: str = "localhost"
+    port: int = 0
+
+    def check(self) -> WebOptions:
+        """The options, or a :class:`UserError` naming what is wrong, before anything starts."""
+        if not 0 <= int(self.port) <= 65535:
+            raise UserError(f"--port must be a whole number from 0 to 65,535, got {self.port}.")
+        try:
+            socket.getaddrinfo(self.host, None)
+        except (socket.gaierror, UnicodeError):
+            raise UserError(f"--host {self.host!r} is not an address or a name this machine can resolve.") from None
+        return self
+
+    @property
+    def is_loopback(self) -> bool:
+        if self.host == "localhost":
+            return True
+        try:
+            return ipaddress.ip_address(self.host).is_loopback
+        except ValueError:
+            return False
+
+
+class _Handle:
+    """The web viewer in the shape :func:`~lifelike_mj.render.viewer.view` drives: ``lock()``, ``sync()``,
+    ``is_running()``, ``cam``, ``opt`` (the last two are accepted and not sent)."""
+
+    def __init__(self, handle: Any, model: Any, data: Any, url: str) -> None:
+        import mujoco
+
+        self.handle, self.model, self.data, self.url = handle, model, data, url
+        self.cam = mujoco.MjvCamera()
+        self.opt = mujoco.MjvOption()
+
+    def lock(self):
+        return contextlib.nullcontext()
+
+    def sync(self) -> None:
+        self.handle.sync(self.model, self.data)
+
+    def is_running(self) -> bool:
+        return self.handle.is_running()
+
+    def __enter__(self) -> _Handle:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.handle.__exit__(*exc)
+
+
+def _first_view(model: Any, setup: Callable[[Any], None] | None) -> list:
+    """The web viewer's plugin that starts it from the desktop viewer's camera, as ``setup(viewer)`` places it
+    (a tracking camera keeps tracking its body), each time a model arrives; none without ``setup``."""
+    if setup is None:
+        return []
+    import mujoco
+    from mujoco.studio import messages, plugin
+
+    probe = _Handle(None, model, None, "")
+    mujoco.mjv_defaultFreeCamera(model, probe.cam)
+    setup(probe)
+    cam = probe.cam
+
+    class FirstView(plugin.ViewerPlugin):
+        shown = None
+
+        def on_update(self, event) -> None:
+            viewer = self.viewer
+            if viewer.model is self.shown or viewer.model.nbody != model.nbody:
+                return
+            self.shown = viewer.model
+            c = viewer.camera
+            c.type, c.trackbodyid, c.fixedcamid = cam.type, cam.trackbodyid, cam.fixedcamid
+            c.lookat[:] = cam.lookat
+            c.distance, c.azimuth, c.elevation = cam.distance, cam.azimuth, cam.elevation
+
+        # the handler is found by its argument's type (a string under postponed annotations: give the class)
+        on_update.__annotations__ = {"event": messages.UpdateEvent, "return": None}
+        on_update = messages.handler(on_update)
+
+    return [FirstView()]
+
+
+def launch_web(model: Any, data: Any, options: WebOptions | None = None, title: str = "lifelike-mj",
+               setup: Callable[[Any], None] | None = None):
+    """Start MuJoCo's web viewer on ``model`` and ``data`` (module docstring), print its address, and return a
+    handle for :func:`~lifelike_mj.render.viewer.view`. ``setup(viewer)`` places the first view as it places
+    the desktop viewer's camera (:func:`_first_view`). A port that is taken, or a MuJoCo without the web viewer,
+    is a :class:`UserError`."""
+    options = (options or WebOptions()).check()
+    try:
+        from mujoco.studio import launch_web as lw
+        from mujoco.studio import viewer_protocol, web_viewer
+        from mujoco.studio.web import web_server
+    except ImportError:
+        raise UserError("this MuJoCo has no web viewer (mujoco.studio, MuJoCo 4 or newer).") from None
+    bound: dict[str, Any] = {}
+    ready = threading.Event()
+    bind, banner = web_server.bind_public_socket, web_viewer._print_url_banner
+
+    def bind_here(_host: str, port: int = 0):
+        try:
+            sock = bind(options.host, port)
+        except Exception as exc:  # a port taken, an address not on this machine
+            bound["error"] = exc
+            ready.set()
+            raise
+        bound["port"] = sock.getsockname()[1]
+        return sock
+
+    def quiet_banner(_host: str, port: int) -> None:
+        ready.set()
+
+    web_server.bind_public_socket, web_viewer._print_url_banner = bind_here, quiet_banner
+    try:
+        handle = lw.launch(viewer_protocol.ViewerConfig(gfx="web", http_port=int(options.port), title=title),
+                           plugins=_first_view(model, setup))
+        ready.wait(timeout=60.0)
+    finally:
+        web_server.bind_public_socket, web_viewer._print_url_banner = bind, banner
+    if "port" not in bound:
+        with contextlib.suppress(Exception):
+            handle.close()
+        why = bound.get("error", "it did not start within 60 s")
+        raise UserError(f"the web viewer could not listen on {options.host} port {options.port or 'from 8080'}: {why}.")
+    handle.set_model(model, data=data)
+    shown = "localhost" if options.is_loopback else (socket.getfqdn() if options.host in ("::", "0.0.0.0") else options.host)
+    url = f"http://{'[' + shown + ']' if ':' in shown else shown}:{bound['port']}/"
+    print(f"web viewer: {url} (Ctrl+C to stop)", flush=True)
+    if not options.is_loopback:
+        print(f"warning: the web viewer listens on {options.host}, with no password and no encryption: anyone who "
+              "can reach this machine can watch and drive the simulation.", file=sys.stderr, flush=True)
+    return _Handle(handle, model, data, url)
