@@ -2,6 +2,12 @@
 
 from __future__ import annotations
 
+import json
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
 import numpy as np
 import pytest
 from PIL import Image, ImageSequence
@@ -82,3 +88,87 @@ def saved(fig, path):
     assert isinstance(fig, Figure), type(fig)
     assert path.is_file(), path
     return path
+
+
+# ---- the exporters' tests (tests/export): one short run of each creature, and headless Chromium ----
+
+from lifelike_mj.export.poses import record_poses  # noqa: E402
+
+#: The creatures every exporter is checked on.
+CREATURES = ("butterfly3d", "butterfly2d", "fish", "boids")
+
+
+def _run(creature: str):
+    if creature == "butterfly3d":
+        from lifelike_mj.butterfly import evolve3d
+        from lifelike_mj.butterfly.sim3d import Flight3D
+
+        sim = Flight3D(controller="steer", task=evolve3d.course(100))
+        return sim, record_poses(sim, 1.0, fps=30.0)
+    if creature == "butterfly2d":
+        from lifelike_mj.butterfly import Flight
+
+        sim = Flight(controller="simple_rule", backend="mujoco", config="rich")
+        return sim, record_poses(sim, 1.0, fps=30.0)
+    if creature == "fish":
+        from lifelike_mj.fish import Tank
+
+        sim = Tank(n_fish=10, seed=1)
+        return sim, record_poses(sim, 1.0, fps=30.0)
+    from lifelike_mj.boids import Flock
+
+    sim = Flock(n=300, seed=1)  # a flock's steps have no seconds: a frame every 5 steps, 30 frames a second
+    return sim, record_poses(sim, 150.0, fps=0.2, time_scale=1.0 / 150.0)
+
+
+@pytest.fixture(scope="session")
+def runs():
+    """``runs(creature)``: ``(simulation at its last frame, poses)``, recorded on first use."""
+    cache: dict = {}
+
+    def get(creature: str):
+        if creature not in cache:
+            cache[creature] = _run(creature)
+        return cache[creature]
+
+    return get
+
+
+@pytest.fixture(params=CREATURES)
+def creature(request) -> str:
+    """Each creature in turn."""
+    return request.param
+
+
+class _Chromium:
+    """Headless Chromium driven by ``page_check.js`` (Node and npm's playwright-core, which ``.ci/run``
+    installs into ``.ci/node``, with Debian's ``chromium``)."""
+
+    modules = Path(__file__).resolve().parents[1] / ".ci" / "node" / "node_modules"
+
+    def __init__(self, executable: str) -> None:
+        self.executable = executable
+
+    def check(self, *args: str) -> dict:
+        """``page_check.js`` run on ``args``: its JSON report."""
+        out = subprocess.run(["node", str(Path(__file__).parent / "export" / "page_check.js"), *args], capture_output=True,
+                             text=True, timeout=240, check=True,
+                             env=dict(os.environ, NODE_PATH=str(self.modules), CHROMIUM=self.executable))
+        return json.loads(out.stdout.strip().splitlines()[-1])
+
+    @staticmethod
+    def changed_pixels(a: str, b: str) -> int:
+        """Pixels whose colour differs by more than 8 of 255 in some channel between two screenshots."""
+        x = np.asarray(Image.open(a).convert("RGB"), dtype=int)
+        y = np.asarray(Image.open(b).convert("RGB"), dtype=int)
+        return int(np.sum(np.abs(x - y).max(axis=2) > 8))
+
+
+@pytest.fixture(scope="session")
+def chromium() -> _Chromium:
+    """Headless Chromium (:class:`_Chromium`), or a skip that says what is missing."""
+    exe = shutil.which("chromium")
+    if exe is None or shutil.which("node") is None or not (_Chromium.modules / "playwright-core").is_dir():
+        pytest.skip("Chromium or playwright-core is not installed (.ci/run installs Debian's chromium and npm's "
+                    "playwright-core)")
+    return _Chromium(exe)
