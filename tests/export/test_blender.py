@@ -63,3 +63,19 @@ def test_blender_puts_every_body_where_the_simulation_had_it(runs, creature, suf
             turn = M[:3, :3] @ Y_UP_TO_Z_UP if suffix != ".usdc" else M[:3, :3]
             angle = np.arccos(np.clip((np.trace(turn @ R.reshape(3, 3).T) - 1.0) / 2.0, -1.0, 1.0))
             assert angle < 1e-3, (k, name, angle)
+
+
+def test_the_readmes_blender_script_imports_a_flight_and_saves_it(runs, tmp_path):
+    _, poses = runs("butterfly3d")
+    glb = write_poses(poses, tmp_path / "flight.glb")
+    script = Path(__file__).resolve().parents[2] / "examples" / "blender" / "import_flight.py"
+    probe = tmp_path / "probe.py"
+    probe.write_text("import bpy, json, sys\ns = bpy.context.scene\n"
+                     "json.dump({'end': s.frame_end, 'fps': s.render.fps, 'camera': s.camera.name}, "
+                     "open(sys.argv[-1], 'w'))\n")
+    subprocess.run([BLENDER, "-b", "--factory-startup", "--python-exit-code", "1", "--python", str(script), "--",
+                    str(glb), str(tmp_path / "flight.blend")], check=True, capture_output=True, timeout=300)
+    subprocess.run([BLENDER, "-b", str(tmp_path / "flight.blend"), "--python-exit-code", "1", "--python", str(probe),
+                    "--", str(tmp_path / "scene.json")], check=True, capture_output=True, timeout=300)
+    scene = json.loads((tmp_path / "scene.json").read_text())
+    assert scene == {"end": poses.n_frames - 1, "fps": 30, "camera": "camera follow"}
