@@ -149,11 +149,11 @@ class _Chromium:
     def __init__(self, executable: str) -> None:
         self.executable = executable
 
-    def check(self, *args: str) -> dict:
-        """``page_check.js`` run on ``args``: its JSON report."""
+    def check(self, *args: str, clicks: str = "") -> dict:
+        """``page_check.js`` run on ``args`` (``clicks``: "x,y x,y" pressed in a live viewer): its JSON report."""
         out = subprocess.run(["node", str(Path(__file__).parent / "export" / "page_check.js"), *args], capture_output=True,
                              text=True, timeout=240, check=True,
-                             env=dict(os.environ, NODE_PATH=str(self.modules), CHROMIUM=self.executable))
+                             env=dict(os.environ, NODE_PATH=str(self.modules), CHROMIUM=self.executable, CLICKS=clicks))
         return json.loads(out.stdout.strip().splitlines()[-1])
 
     @staticmethod

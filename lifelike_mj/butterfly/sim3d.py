@@ -205,6 +205,48 @@ class Flight3D(StepCounter):
         self.command = command
         self._data.userdata[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS] = command.as_array()
 
+    def set_wind(self, wind_m_s) -> None:
+        """The mean wind from now on (world frame, m/s, where it blows to); the task's gusts and flutter go on.
+        For interactive scenes (the viewers' wind keys)."""
+        from dataclasses import replace
+
+        from lifelike_mj.butterfly.control3d import T_WIND
+
+        w = checks.vector("wind_m_s", wind_m_s, 3, "m/s")
+        self.task = replace(self.task, wind_m_s=w)
+        self.wind_m_s = np.array(w)
+        self._task[T_WIND : T_WIND + 3] = w
+        self._data.userdata[mj3d.U_AIR : mj3d.U_AIR + 3] = w  # the gusts are added at the next step
+
+    def set_reference(self, heading_rad: float | None = None, altitude_m: float | None = None,
+                      speed_m_s: float | None = None) -> None:
+        """Fly level at ``heading_rad`` (from +x, left > 0), ``altitude_m`` and ``speed_m_s`` from now on: the task
+        becomes a one-row schedule (:func:`~lifelike_mj.butterfly.evolve3d.level`), its weather kept. What is
+        not given stays: the schedule's current value, else the heading and altitude the butterfly has now and
+        the task's speed. For interactive scenes (the viewers' course and altitude keys)."""
+        from dataclasses import replace
+
+        from lifelike_mj.butterfly.control3d import T_ROW0
+
+        now = self.reference
+        h = float(now[0] if heading_rad is None else checks.number("heading_rad", heading_rad, unit="rad"))
+        a = float(now[1] if altitude_m is None else checks.number("altitude_m", altitude_m, -1000, 1000, unit="m"))
+        v = float(now[2] if speed_m_s is None else checks.number("speed_m_s", speed_m_s, 0.0, 10.0, unit="m/s"))
+        self.task = replace(self.task, kind="schedule", rows=((0.0, h, a, v),), name="interactive")
+        fresh = self.task.as_array(self._n_rows)
+        self._task[:T_ROW0] = fresh[:T_ROW0]
+        self._task[T_ROW0:] = fresh[T_ROW0:]
+
+    @property
+    def reference(self) -> tuple[float, float, float]:
+        """``(heading_rad, altitude_m, speed_m_s)`` the butterfly is asked to fly now: a schedule's current row,
+        else its own heading and altitude now at the task's speed."""
+        if self.task.kind == "schedule":
+            row = [r for r in self.task.rows if r[0] <= self.time][-1]
+            return float(row[1]), float(row[2]), float(row[3])
+        d, rq = self._data, self._root_q
+        return float(euler_from_quat(d.qpos[rq + 3 : rq + 7])[2]), float(d.qpos[rq + 2]), float(self.task.speed_m_s)
+
     def _fly(self, n: int) -> None:
         from lifelike_mj.butterfly import control3d
 

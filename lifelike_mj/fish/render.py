@@ -307,7 +307,9 @@ def view_fish(params: FishParams, n_fish: int = 10, seed: int = 0, size=None, du
     fish ``follow_fish``, from the side at the distance of the ``follow`` video camera). Raises
     :class:`UserError` when there is no display (use :func:`render_fish` instead); on macOS run it
     under ``mjpython``. ``web``: :class:`~lifelike_mj.render.web.WebOptions` to serve MuJoCo's web viewer
-    instead of opening a window (no display needed).
+    instead of opening a window (no display needed). The tank is a virtual aquarium
+    (:mod:`lifelike_mj.fish.aquarium`, unless it has policies of its own): ``T`` taps the front glass, ``F``
+    drops a food pellet (keys in the window, buttons in the web viewer).
     """
     if web is None:
         require_display("fish")
@@ -340,7 +342,13 @@ def view_fish(params: FishParams, n_fish: int = 10, seed: int = 0, size=None, du
             viewer.cam.elevation = FOLLOW_ELEVATION_DEG
         viewer.cam.azimuth = 90.0
 
-    view(tank, 1.0 / tank.dt, end, setup, web=web)
+    from lifelike_mj.fish.aquarium import Aquarium, controls
+
+    if tank.mu_policy is None and tank.push_policy is None:  # the virtual aquarium: T taps, F feeds
+        aquarium = Aquarium(tank)
+        view(aquarium, 1.0 / tank.dt, end, setup, web=web, controls=controls(aquarium, seed))
+    else:
+        view(tank, 1.0 / tank.dt, end, setup, web=web)
 
 
 __all__ = ["CAMERAS", "FOLLOW_VIEW_M", "film_tank", "frame_png", "frame_steps", "playback", "render_benchmark",

@@ -10,9 +10,11 @@ number of steps has been shown. Without a display ``launch_passive`` kills the w
 from __future__ import annotations
 
 import os
+import queue
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 from lifelike_mj.errors import UserError
@@ -41,19 +43,63 @@ def require_display(creature: str) -> None:
                         f"window; use `lifelike-mj render {creature} --out FILE.mp4` instead.")
 
 
-def launch_viewer(m, d):
+@dataclass(frozen=True)
+class Control:
+    """One interaction of a live scene: ``key`` (a letter or digit: the desktop viewer's key), ``label`` (the
+    web viewer's button, and the list of keys printed at the start) and ``act()``, run between two steps."""
+
+    key: str
+    label: str
+    act: Callable[[], object]
+
+
+def _mark(geom, pos, radius_m: float, rgba) -> None:
+    """Make ``geom`` (an ``MjvGeom``) a sphere of ``radius_m`` at ``pos`` in colour ``rgba``."""
+    import mujoco
+    import numpy as np
+
+    mujoco.mjv_initGeom(geom, int(mujoco.mjtGeom.mjGEOM_SPHERE), np.array([radius_m, 0.0, 0.0]),
+                        np.asarray(pos, dtype=float), np.eye(3).reshape(-1), np.asarray(rgba, dtype=np.float32))
+
+
+def mark_geoms(marks) -> list:
+    """``MjvGeom`` spheres of ``marks``: ``(position (m), radius (m), rgba)`` triples (things a scene shows that
+    its model does not hold, such as food pellets)."""
+    import mujoco
+
+    out = []
+    for pos, r, rgba in marks:
+        g = mujoco.MjvGeom()
+        _mark(g, pos, r, rgba)
+        out.append(g)
+    return out
+
+
+def launch_viewer(m, d, key_callback: Callable[[int], None] | None = None):
     """``mujoco.viewer.launch_passive`` on model ``m`` and data ``d``, side panels hidden; a viewer
     that cannot start (macOS outside ``mjpython``) is a :class:`UserError`."""
     import mujoco.viewer
 
     try:
-        return mujoco.viewer.launch_passive(m, d, show_left_ui=False, show_right_ui=False)
+        return mujoco.viewer.launch_passive(m, d, show_left_ui=False, show_right_ui=False, key_callback=key_callback)
     except RuntimeError as exc:
         raise UserError(f"the MuJoCo viewer cannot start here ({str(exc).strip()}).") from None
 
 
+def _show_marks(viewer, marks) -> None:
+    """The stepper's marks (:func:`mark_geoms`) into the desktop viewer's user scene, or the web viewer's."""
+    if hasattr(viewer, "set_marks"):
+        viewer.set_marks(mark_geoms(marks))
+        return
+    scn = viewer.user_scn
+    scn.ngeom = 0
+    for pos, r, rgba in marks[: scn.maxgeom]:
+        _mark(scn.geoms[scn.ngeom], pos, r, rgba)
+        scn.ngeom += 1
+
+
 def view(stepper: Any, steps_per_s: float, end_step: int | None = None,
-         setup: Callable[[Any], None] | None = None, web: Any = None) -> None:
+         setup: Callable[[Any], None] | None = None, web: Any = None, controls: Sequence[Control] = ()) -> None:
     """Show ``stepper`` in the MuJoCo viewer, ``steps_per_s`` steps per wall-clock second, until the
     window is closed or the stepper reaches step ``end_step`` (``None``: until closed).
 
@@ -63,13 +109,26 @@ def view(stepper: Any, steps_per_s: float, end_step: int | None = None,
 
     ``web``: :class:`~lifelike_mj.render.web.WebOptions` to show it in MuJoCo's web viewer instead (no display
     needed; :func:`~lifelike_mj.render.web.launch_web`), until the stepper reaches ``end_step`` or Ctrl+C.
+
+    ``controls``: the scene's interactions (:class:`Control`): keys in the desktop viewer, buttons in the web
+    viewer's "lifelike-mj" panel. Pressed in the viewer's thread, each is queued and run here between two
+    steps, so that the stepper is only ever touched by this loop. A stepper with a ``marks()`` method has
+    those spheres drawn too (:func:`mark_geoms`).
     """
+    pending: queue.SimpleQueue = queue.SimpleQueue()
+    by_key = {ord(c.key.upper()): c for c in controls}
+    if controls:
+        print("keys: " + "; ".join(f"{c.key} {c.label}" for c in controls), flush=True)
     if web is not None:
         from lifelike_mj.render.web import launch_web
 
-        opened = launch_web(stepper.model, stepper.data, web, setup=setup)
+        opened = launch_web(stepper.model, stepper.data, web, setup=setup, controls=controls, pending=pending)
     else:
-        opened = launch_viewer(stepper.model, stepper.data)
+        def on_key(key: int) -> None:  # GLFW's key codes: a letter's or digit's is its upper-case character
+            if key in by_key:
+                pending.put(by_key[key])
+
+        opened = launch_viewer(stepper.model, stepper.data, key_callback=on_key if controls else None)
     with opened as viewer:
         with viewer.lock():
             viewer.opt.sitegroup[:] = 0
@@ -86,9 +145,15 @@ def view(stepper: Any, steps_per_s: float, end_step: int | None = None,
             if end_step is not None:
                 target = min(target, end_step)
             with viewer.lock():
+                while not pending.empty():
+                    control = pending.get()
+                    control.act()
+                    print(control.label, flush=True)
                 if target > stepper.steps:
                     stepper.step(target - int(stepper.steps))
                 stepper.sync()
+                if hasattr(stepper, "marks"):
+                    _show_marks(viewer, stepper.marks())
             viewer.sync()
             if end_step is not None and stepper.steps >= end_step:
                 break

@@ -68,6 +68,11 @@ class _Handle:
         self.cam = mujoco.MjvCamera()
         self.opt = mujoco.MjvOption()
 
+    marks: list = []  # MjvGeoms the web viewer adds to its scene (set_marks)
+
+    def set_marks(self, geoms: list) -> None:
+        self.marks = geoms  # one assignment: the viewer's thread reads the whole list or the previous one
+
     def lock(self):
         return contextlib.nullcontext()
 
@@ -117,11 +122,43 @@ def _first_view(model: Any, setup: Callable[[Any], None] | None) -> list:
     return [FirstView()]
 
 
+def _buttons(controls, pending) -> list:
+    """The web viewer's plugin that draws a "lifelike-mj" panel with one button per control and queues the
+    pressed ones in ``pending`` (run by the simulation's loop); none without controls."""
+    if not controls:
+        return []
+    from mujoco.studio import messages, plugin
+    from mujoco.studio.dear_imgui import dear_imgui as imgui
+
+    class Buttons(plugin.ViewerPlugin):
+        handle: _Handle | None = None
+
+        def on_update(self, event) -> None:
+            if self.handle is not None:
+                self.viewer.extra_geoms[:] = self.handle.marks
+
+        on_update.__annotations__ = {"event": messages.UpdateEvent, "return": None}
+        on_update = messages.handler(on_update)
+
+        def on_gui(self, event) -> None:
+            imgui.Begin("lifelike-mj")
+            for c in controls:
+                if imgui.Button(f"{c.label} [{c.key}]"):
+                    pending.put(c)
+            imgui.End()
+
+        on_gui.__annotations__ = {"event": messages.BuildGuiEvent, "return": None}
+        on_gui = messages.handler(on_gui)
+
+    return [Buttons()]  # its handle is set by launch_web
+
+
 def launch_web(model: Any, data: Any, options: WebOptions | None = None, title: str = "lifelike-mj",
-               setup: Callable[[Any], None] | None = None):
+               setup: Callable[[Any], None] | None = None, controls=(), pending=None):
     """Start MuJoCo's web viewer on ``model`` and ``data`` (module docstring), print its address, and return a
     handle for :func:`~lifelike_mj.render.viewer.view`. ``setup(viewer)`` places the first view as it places
-    the desktop viewer's camera (:func:`_first_view`). A port that is taken, or a MuJoCo without the web viewer,
+    the desktop viewer's camera (:func:`_first_view`); ``controls`` become buttons whose presses are put in
+    ``pending`` (:func:`_buttons`). A port that is taken, or a MuJoCo without the web viewer,
     is a :class:`UserError`."""
     options = (options or WebOptions()).check()
     try:
@@ -149,8 +186,9 @@ def launch_web(model: Any, data: Any, options: WebOptions | None = None, title: 
 
     web_server.bind_public_socket, web_viewer._print_url_banner = bind_here, quiet_banner
     try:
+        plugins = _first_view(model, setup) + _buttons(controls, pending)
         handle = lw.launch(viewer_protocol.ViewerConfig(gfx="web", http_port=int(options.port), title=title),
-                           plugins=_first_view(model, setup))
+                           plugins=plugins)
         ready.wait(timeout=60.0)
     finally:
         web_server.bind_public_socket, web_viewer._print_url_banner = bind, banner
@@ -166,4 +204,8 @@ def launch_web(model: Any, data: Any, options: WebOptions | None = None, title: 
     if not options.is_loopback:
         print(f"warning: the web viewer listens on {options.host}, with no password and no encryption: anyone who "
               "can reach this machine can watch and drive the simulation.", file=sys.stderr, flush=True)
-    return _Handle(handle, model, data, url)
+    result = _Handle(handle, model, data, url)
+    for p in plugins:
+        if hasattr(p, "handle"):
+            p.handle = result  # the buttons' plugin draws the marks this handle is given
+    return result

@@ -1,6 +1,7 @@
 // Opens a page in headless Chromium (Debian's, through playwright-core) and takes pictures of it:
 //   node page_check.js web URL [EMPTY] OUTDIR      MuJoCo's web viewer: shots after 20 s and 23 s of live simulation
-//                                                  (and of the viewer at the address EMPTY after 20 s)
+//                                                  (and of the viewer at the address EMPTY after 20 s); the
+//                                                  environment's CLICKS ("x,y x,y") are clicked between the two
 //   node page_check.js html FILE EMPTY OUTDIR T1 T2   an exported page paused at T1 and T2 s (by the slider), then
 //                                                     the page EMPTY (the same without the creature) at T1
 // Prints one JSON line: {"errors": [console errors and page errors], "shots": [png paths],
@@ -66,6 +67,11 @@ const path = require("path");
         const file = path.join(outdir, "empty.png");
         await pages[1].screenshot({ path: file });
         shots.push(file);
+      }
+      for (const xy of (process.env.CLICKS || "").split(" ").filter(Boolean)) { // buttons drawn in the canvas
+        const [x, y] = xy.split(",").map(Number);
+        await page.mouse.click(x, y);
+        await page.waitForTimeout(300);
       }
       await page.waitForTimeout(3000);
       await shot("live2.png");

@@ -1,6 +1,7 @@
 """``lifelike-mj view fish --web``: MuJoCo's web viewer on the live tank, bound to this machine only, drawn in
 headless Chromium (the fish are drawn: the picture differs from the same tank without fish, and it changes
-as the simulation runs), and stopped by Ctrl+C with exit status 130."""
+as the simulation runs), its aquarium buttons pressed in the page reach the tank, and Ctrl+C stops it with
+exit status 130."""
 
 import signal
 import socket
@@ -31,11 +32,13 @@ def _listening(port: int) -> list[str]:
     return found
 
 
-def _start(argv: list[str]) -> tuple[subprocess.Popen, str]:
+def _start(argv: list[str]) -> tuple[subprocess.Popen, str, str]:
     proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    line = proc.stdout.readline()  # "web viewer: URL (Ctrl+C to stop)", once it listens
+    line, keys = proc.stdout.readline(), ""
+    while line.startswith("keys:"):  # the scene's keys come first
+        keys, line = line.strip(), proc.stdout.readline()
     assert line.startswith("web viewer: http://"), (line, proc.stderr.read() if proc.poll() is not None else "")
-    return proc, line.split()[2]
+    return proc, line.split()[2], keys
 
 
 EMPTY_TANK = textwrap.dedent("""
@@ -53,19 +56,22 @@ EMPTY_TANK = textwrap.dedent("""
 @pytest.mark.skipif(not Path("/proc/net/tcp").exists(), reason="reads the listening sockets from Linux's /proc")
 def test_the_web_viewer_draws_the_live_tank_on_localhost_only(chromium, tmp_path):
     port, empty_port = _free_port(), _free_port()
-    live, url = _start([sys.executable, "-m", "lifelike_mj", "view", "fish", "--seed", "1", "--web",
+    live, url, keys = _start([sys.executable, "-m", "lifelike_mj", "view", "fish", "--seed", "1", "--web",
                         "--port", str(port)])
-    empty, empty_url = _start([sys.executable, "-c", EMPTY_TANK, str(empty_port)])
+    empty, empty_url, _ = _start([sys.executable, "-c", EMPTY_TANK, str(empty_port)])
     try:
         assert url == f"http://localhost:{port}/"
         assert _listening(port) == ["0100007F"]  # 127.0.0.1 only: not reachable from another machine
-        r = chromium.check("web", url, empty_url, str(tmp_path))
+        # between the two pictures, the panel's buttons are pressed: "drop a food pellet", then "tap the front glass"
+        r = chromium.check("web", url, empty_url, str(tmp_path), clicks="126,128 126,102")
     finally:
         live.send_signal(signal.SIGINT)  # Ctrl+C
         empty.send_signal(signal.SIGINT)
         out, err = live.communicate(timeout=30)
         empty.communicate(timeout=30)
     assert live.returncode == 130 and "interrupted" in err and "Traceback" not in err, err
+    assert keys == "keys: T tap the front glass; F drop a food pellet"
+    assert "drop a food pellet\ntap the front glass" in out  # the buttons reached the aquarium, in order
     assert r["errors"] == [], r
     first, empty_shot, later = r["shots"][0], r["shots"][1], r["shots"][2]
     assert chromium.changed_pixels(first, empty_shot) > 50  # the fish are drawn

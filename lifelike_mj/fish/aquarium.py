@@ -1,0 +1,198 @@
+"""The virtual aquarium: a tank whose fish react to the people watching it (the use that Satoi et al. 2015
+have in mind), as two stated rules on top of the four motion units. Nothing else of the model changes.
+
+* **A tap on the glass** at a point ``p``: every fish whose centre lies within :data:`TAP_RADIUS_M` of ``p``
+  startles. For :data:`STARTLE_S` it accelerates at every control step (motion unit *accelerate*, in place
+  of the Markov chain's draw) with the strongest push the preset draws (``r_max_N``), pointed away from
+  ``p`` (in eq. 2-9's angles: the push's direction in the fish's frame is the direction from ``p`` to the
+  fish). A fish farther away does not notice.
+* **A food pellet** dropped at ``(x, y)``: it appears at the surface and sinks at :data:`FOOD_SINK_M_S` to
+  the bottom. A fish within :data:`FOOD_SIGHT_M` of a pellet notices it: when its Markov chain chooses to
+  accelerate, it pushes toward the nearest pellet it notices (with the preset's mean push,
+  ``(r_min_N + r_max_N) / 2``) instead of in a drawn direction; its timing stays the chain's. The first fish
+  whose centre comes within :data:`EAT_RADIUS_M` of a pellet eats it.
+
+The random numbers are drawn as without the aquarium (the tank's policies, :class:`~lifelike_mj.fish.sim.Tank`),
+so until the first tap or pellet a tank swims exactly as the same tank without them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+
+from lifelike_mj import checks
+from lifelike_mj.errors import UserError
+from lifelike_mj.fish.params import ACCELERATE
+from lifelike_mj.fish.sim import Tank
+
+#: A tap startles the fish within this distance of it (m).
+TAP_RADIUS_M = 1.0
+#: A startle lasts this long (s).
+STARTLE_S = 0.25
+#: A fish notices a pellet within this distance (m).
+FOOD_SIGHT_M = 1.5
+#: A pellet sinks this fast (m/s) until it lies on the bottom.
+FOOD_SINK_M_S = 0.05
+#: A fish eats a pellet when its centre comes this close (m).
+EAT_RADIUS_M = 0.04
+#: A pellet's radius (m) and colour, as the viewers draw it.
+PELLET_DRAWN_M = 0.02
+PELLET_RGBA = (0.75, 0.45, 0.15, 1.0)
+
+
+def _angles(direction_body: np.ndarray) -> tuple[float, float]:
+    """eq. 2-9's push angles ``(theta, phi)`` (deg) of a unit direction in the fish's frame (x ahead, y left,
+    z up): the push is ``r (sin theta sin phi, sin theta cos phi, cos theta)``."""
+    x, y, z = direction_body
+    return math.degrees(math.acos(max(-1.0, min(1.0, z)))), math.degrees(math.atan2(x, y))
+
+
+class Aquarium:
+    """A :class:`~lifelike_mj.fish.sim.Tank` with taps and food (module docstring), in the stepper shape.
+
+    ``tank``: the tank (made with no policies of its own). ``tap(point_m)`` and ``drop_food(x_m, y_m)`` act now;
+    ``pellets_m`` holds the pellets still in the water; ``startled`` says which fish are startled."""
+
+    def __init__(self, tank: Tank) -> None:
+        if tank.mu_policy is not None or tank.push_policy is not None:
+            raise UserError("the aquarium needs a tank without policies of its own.")
+        self.tank = tank
+        self.tank.mu_policy, self.tank.push_policy = self._mu, self._push
+        self.dt = tank.dt
+        self._startle_until = np.full(tank.n_fish, -np.inf)
+        self._startle_from = np.zeros((tank.n_fish, 3))
+        self.pellets_m = np.zeros((0, 3))
+        self.eaten = 0
+
+    # ---- the stepper shape ----------------------------------------------------------------------
+    @property
+    def steps(self) -> int:
+        return self.tank.steps
+
+    @property
+    def time(self) -> float:
+        return self.tank.time
+
+    @property
+    def model(self):
+        return self.tank.model
+
+    @property
+    def data(self):
+        return self.tank.data
+
+    def reset(self, seed: int | None = None) -> None:
+        self.tank.reset(seed)
+        self._startle_until[:] = -np.inf
+        self.pellets_m = np.zeros((0, 3))
+        self.eaten = 0
+
+    def step(self, n: int = 1) -> None:
+        for _ in range(checks.whole("the number of steps", n, 0)):
+            self.tank.step(1)
+            self._food()
+
+    def state(self) -> dict[str, np.ndarray]:
+        return {**self.tank.state(), "startled": self.startled, "pellets_m": self.pellets_m.copy()}
+
+    def sync(self) -> None:
+        self.tank.sync()
+
+    def marks(self) -> list:
+        """The pellets, for the viewers (:func:`lifelike_mj.render.viewer.mark_geoms`)."""
+        return [(p, PELLET_DRAWN_M, PELLET_RGBA) for p in self.pellets_m]
+
+    # ---- what the viewers do ----------------------------------------------------------------------
+    @property
+    def startled(self) -> np.ndarray:
+        """Which fish are startled now."""
+        return self._startle_until > self.time
+
+    def tap(self, point_m) -> int:
+        """A tap on the glass at ``point_m`` (x, y, z in m, on or near the tank): the fish within
+        :data:`TAP_RADIUS_M` startle (module docstring). Returns how many."""
+        p = np.asarray(point_m, dtype=float).reshape(-1)
+        L, D, H = self.tank.scene.size
+        if p.shape != (3,) or not np.all(np.isfinite(p)) or np.any(np.abs(p[:2]) > np.array([L, D]) / 2 + 0.1) \
+                or not -0.1 <= p[2] <= H + 0.1:
+            raise UserError(f"a tap is a point x, y, z (m) on the tank ({L:g} x {D:g} x {H:g} m, centred on x = y = 0, "
+                            f"bottom at z = 0), got {point_m!r}.")
+        pos, _ = self.tank.snapshot()
+        near = np.linalg.norm(pos - p, axis=1) <= TAP_RADIUS_M
+        self._startle_until[near] = self.time + STARTLE_S
+        self._startle_from[near] = p
+        return int(near.sum())
+
+    def drop_food(self, x_m: float, y_m: float) -> None:
+        """A pellet at ``(x_m, y_m)`` on the surface (module docstring)."""
+        L, D, H = self.tank.scene.size
+        x = checks.number("the food's x", x_m, -L / 2, L / 2, unit="m")
+        y = checks.number("the food's y", y_m, -D / 2, D / 2, unit="m")
+        self.pellets_m = np.vstack([self.pellets_m, [x, y, H]])
+
+    # ---- the rules ---------------------------------------------------------------------------------
+    def _mu(self, tank: Tank) -> np.ndarray:
+        return np.where(self.startled, ACCELERATE, -1)
+
+    def _push(self, tank: Tank) -> np.ndarray:
+        p = tank.params
+        out = np.full((tank.n_fish, 3), np.nan)
+        startled = self.startled
+        if not startled.any() and len(self.pellets_m) == 0:
+            return out
+        pos, quat = tank.snapshot()
+        R = np.empty(9)
+        for i in range(tank.n_fish):
+            if startled[i]:
+                target, r = pos[i] + (pos[i] - self._startle_from[i]), p.r_max_N  # away from the tap
+            elif len(self.pellets_m):
+                dist = np.linalg.norm(self.pellets_m - pos[i], axis=1)
+                k = int(np.argmin(dist))
+                if dist[k] > FOOD_SIGHT_M:
+                    continue
+                target, r = self.pellets_m[k], 0.5 * (p.r_min_N + p.r_max_N)
+            else:
+                continue
+            d = target - pos[i]
+            norm = np.linalg.norm(d)
+            if norm < 1e-9:
+                continue
+            mujoco.mju_quat2Mat(R, quat[i])
+            theta, phi = _angles(R.reshape(3, 3).T @ (d / norm))
+            out[i] = (r, theta, phi)
+        return out
+
+    def _food(self) -> None:
+        if len(self.pellets_m) == 0:
+            return
+        self.pellets_m[:, 2] = np.maximum(self.pellets_m[:, 2] - FOOD_SINK_M_S * self.dt, 0.0)
+        pos, _ = self.tank.snapshot()
+        gone = np.zeros(len(self.pellets_m), dtype=bool)
+        for k, pellet in enumerate(self.pellets_m):
+            if np.min(np.linalg.norm(pos - pellet, axis=1)) <= EAT_RADIUS_M:
+                gone[k] = True
+        self.eaten += int(gone.sum())
+        self.pellets_m = self.pellets_m[~gone]
+
+
+def controls(aquarium: Aquarium, seed: int = 0) -> list:
+    """The aquarium's keys and buttons (:class:`lifelike_mj.render.viewer.Control`): ``T`` taps the front glass
+    (the side the viewers look from, y < 0) level with a fish drawn at random, ``F`` drops a pellet at a random
+    place along the middle of the surface. ``seed`` draws the places."""
+    from lifelike_mj.render.viewer import Control
+
+    rng = np.random.default_rng(seed)
+    L, D, _H = aquarium.tank.scene.size
+
+    def tap() -> None:
+        pos, _ = aquarium.tank.snapshot()
+        k = int(rng.integers(len(pos)))
+        aquarium.tap((pos[k, 0], -D / 2, pos[k, 2]))
+
+    def food() -> None:
+        aquarium.drop_food(float(rng.uniform(-0.4 * L, 0.4 * L)), 0.0)
+
+    return [Control("T", "tap the front glass", tap), Control("F", "drop a food pellet", food)]

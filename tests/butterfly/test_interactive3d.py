@@ -1,0 +1,43 @@
+"""The 3D butterfly's interactive scene, scripted through the stepper: a new altitude, a new course and a
+wind, set mid-flight, are flown to (the shipped `wind` controller measures its speeds through the air)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from lifelike_mj.butterfly import evolve3d
+from lifelike_mj.butterfly.backends import mj3d
+from lifelike_mj.butterfly.sim3d import Flight3D
+from lifelike_mj.errors import UserError
+
+
+def _fly(f, seconds):
+    f.step(int(round(seconds / f.dt)))
+    return f.state()
+
+
+def test_a_new_altitude_course_and_wind_are_flown_to():
+    f = Flight3D(controller="wind", task=evolve3d.level(1.5))
+    _fly(f, 3.0)
+    f.set_reference(altitude_m=1.0)
+    assert f.reference == (0.0, 1.0, 1.5)
+    assert abs(_fly(f, 3.0)["position_m"][2] - 1.0) < 0.1  # climbed the metre within 3 s
+    alts = [_fly(f, 0.5)["position_m"][2] for _ in range(4)]
+    assert max(abs(a - 1.0) for a in alts) < 0.1  # and holds it
+    f.set_reference(heading_rad=math.pi / 2)
+    s = _fly(f, 2.0)
+    assert abs(math.degrees(s["attitude_rad"][2]) - 90.0) < 10.0  # turned left within 2 s
+    f.set_wind((1.0, 0.0, 0.0))
+    np.testing.assert_array_equal(f.data.userdata[mj3d.U_AIR : mj3d.U_AIR + 3], [1.0, 0.0, 0.0])
+    s = _fly(f, 3.0)
+    assert abs(math.degrees(s["attitude_rad"][2]) - 90.0) < 10.0 and abs(s["position_m"][2] - 1.0) < 0.15
+    assert 0.8 < s["velocity_m_s"][0] < 1.2  # carried along by the cross wind, through which it flies its course
+
+
+def test_bad_references_are_refused():
+    f = Flight3D(controller="wind")
+    with pytest.raises(UserError, match="altitude_m"):
+        f.set_reference(altitude_m=float("nan"))
+    with pytest.raises(UserError, match="wind_m_s"):
+        f.set_wind((1.0, 2.0))
