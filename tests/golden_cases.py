@@ -19,6 +19,7 @@ import contextlib
 import hashlib
 import io
 import json
+import math
 import sys
 import tempfile
 from pathlib import Path
@@ -113,8 +114,18 @@ def run_case(name: str) -> dict:
     return record
 
 
+#: The boids' measures (nearest-neighbour distance, anisotropy, polarisation ...) go through BLAS and LAPACK
+#: (a matrix product for the distances, an eigen-solver), whose kernels are chosen for the processor: on an
+#: AVX-512 machine they differ from the records' machine in the last 1-4 bits (seen: 0.037379307495051875
+#: against 0.03737930749505196) while the trajectories stay identical bit for bit. Those numbers are compared
+#: to this relative tolerance; everything else, the trajectories' files included, exactly.
+BLAS_REL = 1e-12
+BLAS_PREFIXES = ("boids_run/stdout/", "boids_run_2d/stdout/", "boids_sweep/stdout/")
+
+
 def differences(expected, actual, where: str = "") -> list[str]:
-    """Where ``actual`` differs from ``expected`` (keys that ``actual`` adds are allowed)."""
+    """Where ``actual`` differs from ``expected`` (keys that ``actual`` adds are allowed): exactly, except the
+    numbers under :data:`BLAS_PREFIXES` (to :data:`BLAS_REL`)."""
     if isinstance(expected, dict):
         if not isinstance(actual, dict):
             return [f"{where}: expected an object, got {actual!r:.80}"]
@@ -129,6 +140,9 @@ def differences(expected, actual, where: str = "") -> list[str]:
         if not isinstance(actual, list) or len(actual) != len(expected):
             return [f"{where}: expected a list of {len(expected)}, got {actual!r:.80}"]
         return [d for i, (e, a) in enumerate(zip(expected, actual)) for d in differences(e, a, f"{where}[{i}]")]
+    if isinstance(expected, float) and isinstance(actual, float) and where.startswith(BLAS_PREFIXES):
+        same = (math.isnan(expected) and math.isnan(actual)) or math.isclose(expected, actual, rel_tol=BLAS_REL)
+        return [] if same else [f"{where}: expected {expected!r}, got {actual!r}"]
     if expected != actual:
         return [f"{where}: expected {expected!r}, got {actual!r}"]
     return []

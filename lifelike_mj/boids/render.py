@@ -199,6 +199,7 @@ def view_boids(params: BoidParams, n: int = 300, seed: int = 0, steps_per_s: flo
     down rather than freezes when the engine cannot keep up. Raises :class:`UserError` when there is
     no display (use :func:`render_boids` instead); on macOS run it under ``mjpython``. ``web``:
     :class:`~lifelike_mj.render.web.WebOptions` to serve MuJoCo's web viewer instead (no display needed).
+    Keys ``1`` ... ``8`` change the weights live (:func:`weight_controls`).
     """
     if web is None:
         require_display("boids")
@@ -231,8 +232,25 @@ def view_boids(params: BoidParams, n: int = 300, seed: int = 0, steps_per_s: flo
             viewer.cam.azimuth = math.degrees(math.atan2(offset[1], offset[0])) + 180.0
             viewer.cam.elevation = -math.degrees(math.atan2(offset[2], math.hypot(offset[0], offset[1])))
 
-    view(flock, rate, end, setup, web=web)
+    view(flock, rate, end, setup, web=web, controls=weight_controls(flock))
+
+
+def weight_controls(flock: Flock) -> list:
+    """Keys ``1`` ... ``8`` (buttons in the web viewer): the flock takes pattern 4a, 4b, 4c, 4d, 5a, 5b, 5c or 5d's
+    weight matrices ``W_a``, ``W_c`` (Nakamura 2013 Fig. 4-5) from the next step on (:meth:`Flock.set_weights`),
+    the agents where they are."""
+    from lifelike_mj.boids.presets import PATTERNS, load_preset
+    from lifelike_mj.render.viewer import Control
+
+    def switch(name: str):
+        def act() -> None:
+            p = load_preset(name, flock.params.dims)
+            flock.set_weights(wa=p.wa, wc=p.wc)
+
+        return act
+
+    return [Control(str(i + 1), f"weights of pattern {name}", switch(name)) for i, name in enumerate(PATTERNS)]
 
 
 __all__ = ["CAMERAS", "DEFAULT_STEPS", "DEFAULT_STEPS_PER_FRAME", "VIEW_STEPS_PER_S", "film_flock", "frame_png",
-           "playback", "render_boids", "render_frame", "view_boids"]
+           "playback", "render_boids", "render_frame", "view_boids", "weight_controls"]

@@ -304,3 +304,65 @@ def snapshot_figure(out_path: str | Path, controller: ButterflyController | str 
         a.set_title(f"t = {times[i]:.3f} s", fontsize=9, pad=2)
     save(fig, out, dpi=dpi)
     return out
+
+
+#: The 3D viewer's keys: the altitude step (m), the heading step (rad) and the wind (m/s) of keys 1-4.
+ALTITUDE_STEP_M = 0.5
+HEADING_STEP_RAD = math.pi / 4
+WIND_KEY_M_S = 1.0
+
+
+def flight3d_controls(flight) -> list:
+    """The 3D butterfly's keys (buttons in the web viewer; :class:`~lifelike_mj.render.viewer.Control`): ``W``/``S``
+    raise or lower the target altitude by :data:`ALTITUDE_STEP_M`, ``A``/``D`` turn the course left or right by
+    45 deg, ``1``-``4`` blow a :data:`WIND_KEY_M_S` wind toward +x, +y, -x, -y and ``0`` calms it
+    (:meth:`~lifelike_mj.butterfly.sim3d.Flight3D.set_reference`, :meth:`~lifelike_mj.butterfly.sim3d.Flight3D.set_wind`)."""
+    from lifelike_mj.render.viewer import Control
+
+    def climb(dz: float):
+        return lambda: flight.set_reference(altitude_m=flight.reference[1] + dz)
+
+    def turn(da: float):
+        return lambda: flight.set_reference(heading_rad=flight.reference[0] + da)
+
+    def blow(x: float, y: float):
+        return lambda: flight.set_wind((x, y, 0.0))
+
+    w = WIND_KEY_M_S
+    return [Control("W", "climb 0.5 m", climb(ALTITUDE_STEP_M)), Control("S", "descend 0.5 m", climb(-ALTITUDE_STEP_M)),
+            Control("A", "turn left 45 deg", turn(HEADING_STEP_RAD)),
+            Control("D", "turn right 45 deg", turn(-HEADING_STEP_RAD)),
+            Control("1", "wind 1 m/s toward +x", blow(w, 0.0)), Control("2", "wind 1 m/s toward +y", blow(0.0, w)),
+            Control("3", "wind 1 m/s toward -x", blow(-w, 0.0)), Control("4", "wind 1 m/s toward -y", blow(0.0, -w)),
+            Control("0", "calm", blow(0.0, 0.0))]
+
+
+def view_flight3d(controller="wind", speed_m_s: float = 1.5, duration_s: float | None = None, flight=None,
+                  web=None) -> None:
+    """Fly a 3D butterfly in the MuJoCo viewer in about real time, level at ``speed_m_s``, the camera following
+    it, with the keys of :func:`flight3d_controls` (the butterfly paper's game: steer it, change the wind).
+    ``controller``: a 3D controller (default ``wind``, which senses the air and holds its course in wind);
+    ``flight``: a :class:`~lifelike_mj.butterfly.sim3d.Flight3D` of your own instead; ``web``:
+    :class:`~lifelike_mj.render.web.WebOptions` to serve MuJoCo's web viewer (no display needed)."""
+    from lifelike_mj.butterfly import evolve3d
+    from lifelike_mj.butterfly.sim3d import Flight3D
+
+    if web is None:
+        require_display("butterfly3d")
+    if duration_s is not None:
+        duration_s = checks.positive("duration", duration_s, "s")
+    if flight is None:
+        flight = Flight3D(controller=controller, task=evolve3d.level(checks.positive("speed_m_s", speed_m_s, "m/s")))
+    flight.step(1)  # compiles the flight loop before the window opens
+    end = None if duration_s is None else flight.steps + int(round(duration_s / flight.dt))
+    body = flight.model.body("butterfly").id
+
+    def setup(viewer) -> None:
+        import mujoco
+
+        viewer.cam.type = mujoco.mjtCamera.mjCAMERA_TRACKING
+        viewer.cam.trackbodyid = body
+        viewer.cam.distance, viewer.cam.azimuth, viewer.cam.elevation = 1.0, 200.0, -15.0
+
+    flight.sync()
+    view(flight, 1.0 / flight.dt, end, setup, web=web, controls=flight3d_controls(flight))

@@ -31,10 +31,10 @@ def creature(name: str) -> ModuleType:
     return importlib.import_module(f"lifelike_mj.cli.{name}")
 
 
-def _verb(sub, name: str, helptext: str, add: str, extra=None) -> None:
+def _verb(sub, name: str, helptext: str, add: str, extra=None, creatures=CREATURES) -> None:
     p = sub.add_parser(name, help=helptext)
     per = p.add_subparsers(dest="what", required=True, parser_class=Parser, metavar="CREATURE")
-    for c in CREATURES:
+    for c in creatures:
         mod = creature(c)
         q = per.add_parser(c, help=mod.HELP)
         getattr(mod, add)(q)
@@ -93,7 +93,7 @@ def build_parser() -> Parser:
     for c in CREATURES:
         creature(c).add_commands(sub)
     _verb(sub, "view", "open the MuJoCo viewer on a live simulation (--web: in a browser)", "add_view_args",
-          _view_options)
+          _view_options, creatures=(*CREATURES[:1], "butterfly3d", *CREATURES[1:]))
     _verb(sub, "render", "render a video offscreen", "add_render_args", _render_options)
     _verb(sub, "bench", "speed benchmark", "add_bench_args", _bench_options)
     from lifelike_mj.cli.export import add_export_verb

@@ -286,3 +286,19 @@ def export_poses(args):
 
         sim = Flight3D(controller=ctrl, task=_task(args))
     return run_window(sim, args.start, args.duration, args.fps), parameters_of(args)
+
+
+def add_view_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--controller", default="wind", help="a shipped 3D controller's name (wind, steer, cruise) or a file")
+    p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
+    p.add_argument("--duration", type=num(0, None, lo_open=True, unit="s"), default=None,
+                   help="stop after this many seconds (default: run until the window is closed)")
+
+
+def view(args) -> None:
+    from lifelike_mj.butterfly.control3d import load_controller
+    from lifelike_mj.butterfly.render import view_flight3d
+    from lifelike_mj.cli import web_options
+
+    web = web_options(args)
+    view_flight3d(load_controller(args.controller), args.speed, args.duration, web=web)

@@ -9,9 +9,12 @@ number of steps has been shown. Without a display ``launch_passive`` kills the w
 
 from __future__ import annotations
 
+import contextlib
 import os
 import queue
+import signal
 import sys
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -36,11 +39,13 @@ def has_display() -> bool:
 
 
 def require_display(creature: str) -> None:
-    """Raise :class:`UserError` (pointing to ``lifelike-mj render CREATURE``) when :func:`has_display`
-    says no window can be opened: ``launch_passive`` would kill the whole process."""
+    """Raise :class:`UserError` (pointing to ``view CREATURE --web`` and, where there is one, ``render
+    CREATURE``) when :func:`has_display` says no window can be opened: ``launch_passive`` would kill the
+    whole process."""
     if not has_display():
+        video = f" or `lifelike-mj render {creature} --out FILE.mp4`" if creature != "butterfly3d" else ""
         raise UserError("no display found (DISPLAY and WAYLAND_DISPLAY are unset), so the viewer cannot open a "
-                        f"window; use `lifelike-mj render {creature} --out FILE.mp4` instead.")
+                        f"window; use `lifelike-mj view {creature} --web` (a browser){video} instead.")
 
 
 @dataclass(frozen=True)
@@ -129,7 +134,8 @@ def view(stepper: Any, steps_per_s: float, end_step: int | None = None,
                 pending.put(by_key[key])
 
         opened = launch_viewer(stepper.model, stepper.data, key_callback=on_key if controls else None)
-    with opened as viewer:
+    stop = threading.Event()  # Ctrl+C ends the loop between two frames, never inside MuJoCo's viewer code
+    with opened as viewer, _ctrl_c_sets(stop):
         with viewer.lock():
             viewer.opt.sitegroup[:] = 0
             if setup is not None:
@@ -137,7 +143,7 @@ def view(stepper: Any, steps_per_s: float, end_step: int | None = None,
         max_chunk = max(1, int(round(MAX_CATCH_UP_S * steps_per_s)))
         start = time.perf_counter()
         at_start = int(stepper.steps)
-        while viewer.is_running():
+        while viewer.is_running() and not stop.is_set():
             target = at_start + int((time.perf_counter() - start) * steps_per_s)
             if target - stepper.steps > max_chunk:  # fell behind: re-anchor the clock, run slower than asked
                 target = int(stepper.steps) + max_chunk
@@ -158,3 +164,20 @@ def view(stepper: Any, steps_per_s: float, end_step: int | None = None,
             if end_step is not None and stepper.steps >= end_step:
                 break
             time.sleep(FRAME_S)
+    if stop.is_set():  # the viewer is closed: now the interruption goes on to the caller
+        raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def _ctrl_c_sets(stop: threading.Event):
+    """While the block runs (in the main thread), Ctrl+C sets ``stop`` instead of raising wherever the main
+    thread happens to be: a KeyboardInterrupt inside the web viewer's sync could leave its lock held and the
+    shutdown waiting on it."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: stop.set())
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)

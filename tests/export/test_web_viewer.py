@@ -67,8 +67,14 @@ def test_the_web_viewer_draws_the_live_tank_on_localhost_only(chromium, tmp_path
     finally:
         live.send_signal(signal.SIGINT)  # Ctrl+C
         empty.send_signal(signal.SIGINT)
-        out, err = live.communicate(timeout=30)
-        empty.communicate(timeout=30)
+        try:
+            out, err = live.communicate(timeout=60)
+            empty.communicate(timeout=60)
+        finally:  # never leave a server behind, even when it does not stop
+            for proc in (live, empty):
+                if proc.poll() is None:
+                    proc.kill()
+                    proc.communicate()
     assert live.returncode == 130 and "interrupted" in err and "Traceback" not in err, err
     assert keys == "keys: T tap the front glass; F drop a food pellet"
     assert "drop a food pellet\ntap the front glass" in out  # the buttons reached the aquarium, in order

@@ -1,0 +1,59 @@
+"""The live scenes' keys and buttons act on the stepper: the 3D butterfly's course, altitude and wind, the
+boids' weights, the aquarium's tap and food (each scripted here through the controls, as the viewers run
+them between two steps)."""
+
+import math
+
+import numpy as np
+
+from lifelike_mj.boids import Flock
+from lifelike_mj.boids.presets import load_preset
+from lifelike_mj.boids.render import weight_controls
+from lifelike_mj.butterfly import evolve3d
+from lifelike_mj.butterfly.render import flight3d_controls
+from lifelike_mj.butterfly.sim3d import Flight3D
+from lifelike_mj.fish import Tank
+from lifelike_mj.fish.aquarium import Aquarium, controls
+
+
+def _press(controls, key):
+    next(c for c in controls if c.key == key).act()
+
+
+def test_the_butterflys_keys_change_its_course_altitude_and_wind():
+    f = Flight3D(controller="wind", task=evolve3d.level(1.5))
+    keys = flight3d_controls(f)
+    assert sorted(c.key for c in keys) == sorted("WSAD12340")
+    _press(keys, "W")
+    _press(keys, "W")
+    _press(keys, "A")
+    assert f.reference == (math.pi / 4, 1.0, 1.5)
+    _press(keys, "2")
+    np.testing.assert_array_equal(f.wind_m_s, [0.0, 1.0, 0.0])
+    f.step(int(4.0 / f.dt))
+    s = f.state()
+    assert abs(s["position_m"][2] - 1.0) < 0.15 and abs(math.degrees(s["attitude_rad"][2]) - 45.0) < 15.0
+    _press(keys, "0")
+    np.testing.assert_array_equal(f.wind_m_s, [0.0, 0.0, 0.0])
+
+
+def test_the_boids_keys_switch_the_weights_live():
+    flock = Flock(load_preset("5a"), n=50, seed=1)
+    flock.step(10)
+    keys = weight_controls(flock)
+    assert [c.key for c in keys] == list("12345678")
+    _press(keys, "2")  # pattern 4b
+    p = load_preset("4b")
+    np.testing.assert_array_equal(flock.params.wa, p.wa)
+    np.testing.assert_array_equal(flock.params.wc, p.wc)
+    assert flock.steps == 10  # the agents stay where they are
+    flock.step(5)
+
+
+def test_the_aquariums_keys_tap_and_feed():
+    a = Aquarium(Tank(n_fish=10, seed=2))
+    keys = controls(a, seed=0)
+    _press(keys, "T")
+    assert a.startled.any()
+    _press(keys, "F")
+    assert len(a.pellets_m) == 1 and len(a.marks()) == 1
