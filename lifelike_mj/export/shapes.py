@@ -25,7 +25,7 @@ def _flat(pos: np.ndarray, tris: np.ndarray):
     n = np.cross(b - a, c - a)
     norm = np.linalg.norm(n, axis=1, keepdims=True)
     n = np.where(norm > 0, n / np.where(norm > 0, norm, 1.0), np.array([0.0, 0.0, 1.0]))
-    return p, np.repeat(n, 3, axis=0), np.arange(len(p))
+    return p, np.repeat(n, 3, axis=0), np.arange(len(p)).reshape(-1, 3)
 
 
 def _box(hx: float, hy: float, hz: float):
@@ -109,7 +109,8 @@ def _mesh(model: mujoco.MjModel, mesh_id: int):
 
 
 def geom_shape(model: mujoco.MjModel, geom: int):
-    """``(positions, normals, triangle indices)`` of geom ``geom`` in its own frame (m)."""
+    """``(positions (n, 3), normals (n, 3), triangles (t, 3) of vertex indices)`` of geom ``geom`` in its own frame
+    (m)."""
     t = model.geom_type[geom]
     s = model.geom_size[geom]
     T = mujoco.mjtGeom

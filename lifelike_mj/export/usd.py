@@ -4,9 +4,10 @@
 Layout of the stage (Z up, metres, as MuJoCo's world; ``timeCodesPerSecond`` is the frame rate and time code
 ``k`` is frame ``k``):
 
-* ``/World``: one ``Xform`` per exported body, animated (``xformOp:translate`` and ``xformOp:orient``
-  time samples at every frame, 32-bit floats; a body that never moves holds one still value), and the
-  world body's drawn geoms as still meshes;
+* ``/World``: one ``Xform`` per exported body (its MuJoCo name in ``customData["mujoco_body"]`` and in the
+  attribute ``userProperties:mujoco_body``, which Blender shows as a custom property), animated
+  (``xformOp:translate`` and ``xformOp:orient`` time samples at every frame, 32-bit floats; a body that never
+  moves holds one still value), and the world body's drawn geoms as still meshes;
 * under each body, one ``Mesh`` per drawn geom at its place in the body;
 * ``/Shapes`` (a class, not drawn): one mesh per distinct shape, which the geoms reference, so a flock of
   hundreds stores one bird; ``/Looks``: one ``UsdPreviewSurface`` material per colour.
@@ -131,6 +132,8 @@ def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | 
     for body, bname in zip(poses.body_ids, poses.body_names):
         xf = UsdGeom.Xform.Define(stage, world.GetPath().AppendChild(_ident(bname, used)))
         xf.GetPrim().SetCustomDataByKey("mujoco_body", bname)
+        # and as a user property, which Blender's USD importer turns into the object's custom property
+        xf.GetPrim().CreateAttribute("userProperties:mujoco_body", Sdf.ValueTypeNames.String).Set(bname)
         ops.append((xf.AddTranslateOp(UsdGeom.XformOp.PrecisionFloat), xf.AddOrientOp(UsdGeom.XformOp.PrecisionFloat)))
         inner: set[str] = set()
         for geom in drawn[m.geom_bodyid[drawn] == body]:

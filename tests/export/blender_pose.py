@@ -1,20 +1,21 @@
-"""Run by Blender: ``blender -b --python blender_pose.py -- FILE OUT.json K1 K2 ...``.
+"""Run by Blender: ``blender -b --python blender_pose.py -- FILE OUT.json K1 K2 ...``, or by a Python that has
+Blender as a module (PyPI's ``bpy``): ``python blender_pose.py -- FILE OUT.json K1 K2 ...``.
 
 Imports FILE (.glb/.gltf with Blender's glTF importer, .usd* with its USD importer) into an empty scene and
 writes, for each sampled keyframe index K, every imported body's world matrix as Blender evaluates it there:
 ``{"frames": {K: {body: 4x4}}, "blender": version}`` (or ``{"error": ...}`` where it cannot import the format).
-Bodies are found by the ``mujoco_body`` property (glTF extras) or, for USD, by the names given in the
-environment variable ``BODIES`` (JSON: prim name -> body).
+Bodies are found by their ``mujoco_body`` custom property (glTF: the node's extras; USD: the Xform's
+``userProperties:mujoco_body``).
 """
 
 import json
-import os
 import sys
 
 import bpy
 import numpy
 
-numpy.bool = bool  # Blender 3.4's glTF importer still uses numpy.bool, which numpy 1.24 removed
+if not hasattr(numpy, "bool"):
+    numpy.bool = bool  # Blender 3.4's glTF importer still uses numpy.bool, which numpy 1.24 lacks
 
 argv = sys.argv[sys.argv.index("--") + 1:]
 path, out, ks = argv[0], argv[1], [int(k) for k in argv[2:]]
@@ -36,9 +37,10 @@ else:
         with open(out, "w") as fh:
             json.dump({"blender": bpy.app.version_string, "error": "this Blender has no USD importer"}, fh)
         sys.exit(0)
-    bpy.ops.wm.usd_import(filepath=path)
-    names = json.loads(os.environ["BODIES"])
-    bodies = {o.name: names[o.name] for o in bpy.data.objects if o.name in names}
+    # every Xform its own object (Blender merges a body with its only mesh by default: the object is then the
+    # mesh, at the geom's place in the body)
+    bpy.ops.wm.usd_import(filepath=path, merge_parent_xform=False)
+    bodies = {o.name: o["mujoco_body"] for o in bpy.data.objects if "mujoco_body" in o.keys()}
     frames = {k: float(k) for k in ks}  # USD time code k is Blender frame k
 result = {"blender": bpy.app.version_string, "frames": {}}
 for k, frame in frames.items():
