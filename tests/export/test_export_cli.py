@@ -43,3 +43,13 @@ def test_the_same_seed_exports_the_same_motion(tmp_path):
         assert main(["export", "boids", "--n", "50", "--steps", "50", "--out", str(tmp_path / f"f{k}.glb")]) == 0
     a, b = (pygltflib.GLTF2().load(str(tmp_path / f"f{k}.glb")).binary_blob() for k in (1, 2))
     assert a == b
+
+
+def test_a_garden_exports_every_butterfly_and_one_overview(tmp_path, capsys):
+    out = tmp_path / "garden.glb"
+    assert main(["export", "butterfly3d", "--garden", "3", "--duration", "0.5", "--out", str(out), "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    gl = pygltflib.GLTF2().load(str(out))
+    bodies = [n for n in gl.nodes if n.extras.get("mujoco_body")]
+    assert info["bodies"] == len(bodies) and len(bodies) % 3 == 0 and len(bodies) >= 3
+    assert [c.name for c in gl.cameras] == ["overview"]  # three butterflies: no single one to follow
