@@ -38,16 +38,24 @@ def gl_backend():
 @pytest.fixture
 def stand_in_viewer(monkeypatch):
     """Replace ``mujoco.viewer.launch_passive`` by a window-less stand-in; yields the list of the
-    stand-ins opened (each counts its ``sync`` calls and has a real ``cam`` and ``opt``)."""
+    stand-ins opened (each counts its ``sync`` calls and has a real ``cam``, ``opt`` and ``user_scn``; set
+    ``opened.viewer_class.presses`` to press keys)."""
     import contextlib
 
     import mujoco
     import mujoco.viewer
 
     class StandInViewer:
-        def __init__(self, m, d):
+        """``presses``: ``{sync number: key code}``, pressed (through the key callback the viewer was given)
+        when that many frames have been shown."""
+
+        presses: dict[int, int] = {}
+
+        def __init__(self, m, d, key_callback=None):
             self.m, self.d, self.syncs = m, d, 0
             self.cam, self.opt = mujoco.MjvCamera(), mujoco.MjvOption()
+            self.user_scn = mujoco.MjvScene(m, maxgeom=100)
+            self.key_callback = key_callback
 
         def __enter__(self):
             return self
@@ -63,11 +71,16 @@ def stand_in_viewer(monkeypatch):
 
         def sync(self):
             self.syncs += 1
+            if self.syncs in self.presses and self.key_callback is not None:
+                self.key_callback(self.presses[self.syncs])
 
-    opened = []
+    class Opened(list):
+        viewer_class = StandInViewer
 
-    def launch_passive(m, d, **kwargs):
-        opened.append(StandInViewer(m, d))
+    opened = Opened()
+
+    def launch_passive(m, d, key_callback=None, **kwargs):
+        opened.append(StandInViewer(m, d, key_callback))
         return opened[-1]
 
     monkeypatch.setattr(mujoco.viewer, "launch_passive", launch_passive)
