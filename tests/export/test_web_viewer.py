@@ -1,7 +1,7 @@
-"""``lifelike-mj view fish --web``: MuJoCo's web viewer on the live tank, bound to this machine only, drawn in
-headless Chromium (the fish are drawn: the picture differs from the same tank without fish, and it changes
-as the simulation runs), its aquarium buttons pressed in the page reach the tank, and Ctrl+C stops it with
-exit status 130."""
+"""``lifelike-mj view CREATURE --web``: MuJoCo's web viewer on each live creature, bound to this machine only,
+drawn in headless Chromium (the creature is drawn: the picture differs from the same scene without it, and it
+changes as the simulation runs), the aquarium's buttons pressed in the page reach the tank, and Ctrl+C stops
+it with exit status 130."""
 
 import signal
 import socket
@@ -41,29 +41,36 @@ def _start(argv: list[str]) -> tuple[subprocess.Popen, str, str]:
     return proc, line.split()[2], keys
 
 
-EMPTY_TANK = textwrap.dedent("""
+#: The same command with the creatures' geoms moved to group 5, which viewers do not draw by default: the
+#: empty scene, with the same camera (a tracking camera still follows the invisible body).
+EMPTY = textwrap.dedent("""
     import sys
-    from lifelike_mj.fish import Tank
-    from lifelike_mj.render.viewer import view
-    from lifelike_mj.render.web import WebOptions
-    tank = Tank(n_fish=10, seed=1)
-    m = tank.model
-    m.geom_rgba[m.geom_bodyid > 0, 3] = 0.0  # the same tank, the fish not drawn
-    view(tank, 1.0 / tank.dt, None, None, web=WebOptions("localhost", int(sys.argv[1])))
+    import lifelike_mj.render.web as web
+    launch = web.launch_web
+    def without_creatures(model, data, *args, **kwargs):
+        model.geom_group[model.geom_bodyid > 0] = 5
+        return launch(model, data, *args, **kwargs)
+    web.launch_web = without_creatures
+    from lifelike_mj.cli import main
+    sys.exit(main(sys.argv[1:]))
 """)
+#: Each creature's command, and the buttons pressed between the two pictures (the fish's panel: "drop a food
+#: pellet", then "tap the front glass").
+SCENES = {"fish": (["fish", "--seed", "1"], "126,128 126,102"), "butterfly": (["butterfly"], ""),
+          "butterfly3d": (["butterfly3d"], ""), "boids": (["boids", "--n", "100"], "")}
 
 
 @pytest.mark.skipif(not Path("/proc/net/tcp").exists(), reason="reads the listening sockets from Linux's /proc")
-def test_the_web_viewer_draws_the_live_tank_on_localhost_only(chromium, tmp_path):
+@pytest.mark.parametrize("scene", sorted(SCENES))
+def test_the_web_viewer_draws_the_live_creature_on_localhost_only(chromium, tmp_path, scene):
+    args, clicks = SCENES[scene]
     port, empty_port = _free_port(), _free_port()
-    live, url, keys = _start([sys.executable, "-m", "lifelike_mj", "view", "fish", "--seed", "1", "--web",
-                        "--port", str(port)])
-    empty, empty_url, _ = _start([sys.executable, "-c", EMPTY_TANK, str(empty_port)])
+    live, url, keys = _start([sys.executable, "-m", "lifelike_mj", "view", *args, "--web", "--port", str(port)])
+    empty, empty_url, _ = _start([sys.executable, "-c", EMPTY, "view", *args, "--web", "--port", str(empty_port)])
     try:
         assert url == f"http://localhost:{port}/"
         assert _listening(port) == ["0100007F"]  # 127.0.0.1 only: not reachable from another machine
-        # between the two pictures, the panel's buttons are pressed: "drop a food pellet", then "tap the front glass"
-        r = chromium.check("web", url, empty_url, str(tmp_path), clicks="126,128 126,102")
+        r = chromium.check("web", url, empty_url, str(tmp_path), clicks=clicks)
     finally:
         live.send_signal(signal.SIGINT)  # Ctrl+C
         empty.send_signal(signal.SIGINT)
@@ -76,12 +83,14 @@ def test_the_web_viewer_draws_the_live_tank_on_localhost_only(chromium, tmp_path
                     proc.kill()
                     proc.communicate()
     assert live.returncode == 130 and "interrupted" in err and "Traceback" not in err, err
-    assert keys == "keys: T tap the front glass; F drop a food pellet"
-    assert "drop a food pellet\ntap the front glass" in out  # the buttons reached the aquarium, in order
     assert r["errors"] == [], r
     first, empty_shot, later = r["shots"][0], r["shots"][1], r["shots"][2]
-    assert chromium.changed_pixels(first, empty_shot) > 50  # the fish are drawn
-    assert chromium.changed_pixels(first, later) > 20  # and swim
+    assert chromium.changed_pixels(first, empty_shot) > 50  # the creature is drawn
+    assert chromium.changed_pixels(first, later) > 20  # and moves
+    if scene != "fish":
+        return
+    assert keys == "keys: T tap the front glass; F drop a food pellet"
+    assert "drop a food pellet\ntap the front glass" in out  # the buttons reached the aquarium, in order
 
 
 def test_host_and_port_need_web_and_only_the_loopback_goes_unwarned(capsys):
