@@ -61,6 +61,10 @@ def cmd_export(args) -> None:
 
     fmt = format_of(args.out, args.format)
     check_output_file(args.out, "--out", overwrite=args.overwrite)
+    if fmt == "usd":  # usd-core is an extra: say so before the simulation, not after
+        from lifelike_mj.export.usd import require_usd
+
+        require_usd()
     mod = _module(args.what)
     t0 = time.perf_counter()
     poses, parameters = mod.export_poses(args)

@@ -36,7 +36,8 @@ from lifelike_mj.io import atomic_path, strict
 from lifelike_mj.provenance import provenance
 
 
-def _pxr():
+def require_usd():
+    """usd-core's modules, or a :class:`UserError` saying how to install them."""
     try:
         from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade, Vt
     except ImportError:
@@ -59,7 +60,7 @@ def _ident(text: str, used: set[str]) -> str:
 
 def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | None = None):
     """The USD stage (module docstring) of ``poses``, in memory; :func:`write_usd` writes it."""
-    Gf, Sdf, Usd, UsdGeom, UsdShade, Vt = _pxr()
+    Gf, Sdf, Usd, UsdGeom, UsdShade, Vt = require_usd()
     m = poses.model
     n = poses.n_frames
     span = float(poses.t_s[-1] - poses.t_s[0])

@@ -53,3 +53,14 @@ def test_a_garden_exports_every_butterfly_and_one_overview(tmp_path, capsys):
     bodies = [n for n in gl.nodes if n.extras.get("mujoco_body")]
     assert info["bodies"] == len(bodies) and len(bodies) % 3 == 0 and len(bodies) >= 3
     assert [c.name for c in gl.cameras] == ["overview"]  # three butterflies: no single one to follow
+
+
+def test_usd_without_usd_core_is_one_sentence_before_any_work():
+    import subprocess
+    import sys
+
+    code = ("import sys; sys.modules['pxr'] = None; from lifelike_mj.cli import main; "
+            "sys.exit(main(['export', 'fish', '--out', 'never.usda', '--duration', '600']))")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and r.stderr.strip() == ('lifelike-mj: error: USD export needs usd-core: pip install '
+                                                      '"lifelike-mj[usd]" (or pip install usd-core).')
