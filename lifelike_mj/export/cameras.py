@@ -32,14 +32,13 @@ ASPECT = 4.0 / 3.0
 
 @dataclass
 class Framing:
-    """``centre_m``, ``radius_m``: a sphere around every body at every frame (m, MuJoCo's world);
+    """``centre_m``: the centre of the box around every body at every frame (m, MuJoCo's world);
     ``direction``: unit vector from what is looked at to the camera; ``follow``: index (into the poses'
     bodies) of the one creature's root body, or None; ``follow_m``: the follow camera's distance;
     ``overview_m``: the overview camera's distance from ``centre_m``, the nearest that keeps the box around
     everything in a picture of aspect :data:`ASPECT`."""
 
     centre_m: np.ndarray
-    radius_m: float
     direction: np.ndarray
     follow: int | None
     follow_m: float
@@ -47,10 +46,7 @@ class Framing:
 
     def axes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The cameras' right, up and back unit vectors in MuJoCo's world (back = ``direction``)."""
-        back = self.direction
-        right = np.cross(np.array([0.0, 0.0, 1.0]), back)
-        right /= np.linalg.norm(right)
-        return right, np.cross(back, right), back
+        return _axes(self.direction)
 
     def look_quat_wxyz(self) -> np.ndarray:
         """The cameras' orientation (w, x, y, z) in MuJoCo's world, for a glTF camera (it looks along its
@@ -59,6 +55,12 @@ class Framing:
         q = np.empty(4)
         mujoco.mju_mat2Quat(q, R.reshape(-1))
         return q
+
+
+def _axes(back: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    right = np.cross(np.array([0.0, 0.0, 1.0]), back)
+    right /= np.linalg.norm(right)
+    return right, np.cross(back, right), back
 
 
 def framing(poses: Poses) -> Framing:
@@ -79,7 +81,6 @@ def framing(poses: Poses) -> Framing:
             half = np.abs(R) @ m.geom_aabb[g, 3:]
             lo, hi = np.minimum(lo, centre_g - half), np.maximum(hi, centre_g + half)
     centre = (lo + hi) / 2.0
-    radius = max(float(np.linalg.norm(hi - lo)) / 2.0, 1e-3)
     az, el = math.radians(AZIMUTH_DEG), math.radians(ELEVATION_DEG)
     direction = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
     roots = {int(m.body_rootid[b]) for b in poses.body_ids}
@@ -91,10 +92,8 @@ def framing(poses: Poses) -> Framing:
             follow = ids.index(root)
             reach = np.linalg.norm(poses.position_m[0] - poses.position_m[0, follow], axis=1).max() + size
             follow_m = max(FOLLOW_SIZES * float(reach), FOLLOW_MIN_M)
-    f = Framing(centre, radius, direction, follow, follow_m, 0.0)
-    right, up, back = f.axes()
+    right, up, back = _axes(direction)
     corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]) - centre
     tan_v = math.tan(math.radians(FOV_DEG) / 2.0)
     need = corners @ back + np.maximum(np.abs(corners @ up) / tan_v, np.abs(corners @ right) / (tan_v * ASPECT))
-    f.overview_m = 1.05 * float(need.max())
-    return f
+    return Framing(centre, direction, follow, follow_m, 1.05 * float(need.max()))

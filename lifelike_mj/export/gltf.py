@@ -36,8 +36,9 @@ from lifelike_mj.export.shapes import geom_shape, shape_key
 from lifelike_mj.io import atomic_path, strict
 from lifelike_mj.provenance import provenance
 
-#: The root's rotation (glTF x, y, z, w): -90 deg about X takes MuJoCo's Z-up to glTF's Y-up.
+#: The root's rotation (glTF x, y, z, w): -90 deg about X takes MuJoCo's Z-up to glTF's Y-up; and as a matrix.
 Z_UP_TO_Y_UP = (-math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5))
+Z_UP_TO_Y_UP_MATRIX = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
 
 
 # ---- the file -----------------------------------------------------------------------------------

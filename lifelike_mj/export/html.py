@@ -21,7 +21,7 @@ import numpy as np
 
 from lifelike_mj.errors import UserError
 from lifelike_mj.export.cameras import FOV_DEG, framing
-from lifelike_mj.export.gltf import build_gltf
+from lifelike_mj.export.gltf import Z_UP_TO_Y_UP_MATRIX, build_gltf
 from lifelike_mj.export.poses import Poses
 from lifelike_mj.io import atomic_path
 
@@ -125,7 +125,7 @@ def build_html(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
     """The page (module docstring) of ``poses`` as text; :func:`write_html` writes it."""
     gl = build_gltf(poses, name, parameters, rotations)
     f = framing(poses)
-    y_up = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])  # MuJoCo's Z-up to glTF's Y-up
+    y_up = Z_UP_TO_Y_UP_MATRIX
     d = y_up @ f.direction  # model-viewer's orbit: theta about +Y from +Z, phi from +Y
     theta, phi = math.degrees(math.atan2(d[0], d[2])), math.degrees(math.acos(max(-1.0, min(1.0, d[1]))))
     follow = f.follow is not None
@@ -138,7 +138,7 @@ def build_html(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
     return _PAGE.format(generator=html.escape(gl.asset.generator), title=html.escape(name),
                         viewer=_inline(viewer_js()), glb=base64.b64encode(glb).decode("ascii"),
                         animation=html.escape(gl.animations[0].name if gl.animations else ""),
-                        duration=float(poses.t_s[-1] - poses.t_s[0]), provenance=_inline(prov),
+                        duration=frame["span_s"], provenance=_inline(prov),
                         framing=_inline(json.dumps(frame, allow_nan=False)), fov=FOV_DEG, theta=frame["theta"],
                         phi=frame["phi"], radius=f.follow_m if follow else f.overview_m,
                         target=" ".join(f"{v}m" for v in ((y_up @ poses.position_m[0, f.follow]) if follow else centre)),

@@ -57,21 +57,40 @@ class WebOptions:
             return False
 
 
+class _Shown:
+    """What the simulation's loop hands the viewer's thread: ``marks``, the ``MjvGeom`` spheres to add."""
+
+    def __init__(self) -> None:
+        self.marks: list = []
+
+
+def _on(event_type):
+    """``messages.handler`` for a method handling ``event_type``: the handler is found by its argument's
+    annotation, which postponed annotations turn into a string that a class made in a function cannot
+    resolve, so the class itself is given."""
+    from mujoco.studio import messages
+
+    def stamp(fn):
+        fn.__annotations__ = {"event": event_type, "return": None}
+        return messages.handler(fn)
+
+    return stamp
+
+
 class _Handle:
     """The web viewer in the shape :func:`~lifelike_mj.render.viewer.view` drives: ``lock()``, ``sync()``,
     ``is_running()``, ``cam``, ``opt`` (the last two are accepted and not sent)."""
 
-    def __init__(self, handle: Any, model: Any, data: Any, url: str) -> None:
+    def __init__(self, handle: Any, model: Any, data: Any, url: str, shown: _Shown | None = None) -> None:
         import mujoco
 
         self.handle, self.model, self.data, self.url = handle, model, data, url
         self.cam = mujoco.MjvCamera()
         self.opt = mujoco.MjvOption()
-
-    marks: list = []  # MjvGeoms the web viewer adds to its scene (set_marks)
+        self.shown = shown or _Shown()
 
     def set_marks(self, geoms: list) -> None:
-        self.marks = geoms  # one assignment: the viewer's thread reads the whole list or the previous one
+        self.shown.marks = geoms  # one assignment: the viewer's thread reads the whole list or the previous one
 
     def lock(self):
         return contextlib.nullcontext()
@@ -105,6 +124,7 @@ def _first_view(model: Any, setup: Callable[[Any], None] | None) -> list:
     class FirstView(plugin.ViewerPlugin):
         shown = None
 
+        @_on(messages.UpdateEvent)
         def on_update(self, event) -> None:
             viewer = self.viewer
             if viewer.model is self.shown or viewer.model.nbody != model.nbody:
@@ -115,31 +135,24 @@ def _first_view(model: Any, setup: Callable[[Any], None] | None) -> list:
             c.lookat[:] = cam.lookat
             c.distance, c.azimuth, c.elevation = cam.distance, cam.azimuth, cam.elevation
 
-        # the handler is found by its argument's type (a string under postponed annotations: give the class)
-        on_update.__annotations__ = {"event": messages.UpdateEvent, "return": None}
-        on_update = messages.handler(on_update)
-
     return [FirstView()]
 
 
-def _buttons(controls, pending) -> list:
-    """The web viewer's plugin that draws a "lifelike-mj" panel with one button per control and queues the
-    pressed ones in ``pending`` (run by the simulation's loop); none without controls."""
+def _buttons(controls, pending, shown: _Shown) -> list:
+    """The web viewer's plugin that draws a "lifelike-mj" panel with one button per control, queues the
+    pressed ones in ``pending`` (run by the simulation's loop) and adds ``shown``'s marks to the scene; none
+    without controls."""
     if not controls:
         return []
     from mujoco.studio import messages, plugin
     from mujoco.studio.dear_imgui import dear_imgui as imgui
 
     class Buttons(plugin.ViewerPlugin):
-        handle: _Handle | None = None
-
+        @_on(messages.UpdateEvent)
         def on_update(self, event) -> None:
-            if self.handle is not None:
-                self.viewer.extra_geoms[:] = self.handle.marks
+            self.viewer.extra_geoms[:] = shown.marks
 
-        on_update.__annotations__ = {"event": messages.UpdateEvent, "return": None}
-        on_update = messages.handler(on_update)
-
+        @_on(messages.BuildGuiEvent)
         def on_gui(self, event) -> None:
             imgui.Begin("lifelike-mj")
             for c in controls:
@@ -147,10 +160,7 @@ def _buttons(controls, pending) -> list:
                     pending.put(c)
             imgui.End()
 
-        on_gui.__annotations__ = {"event": messages.BuildGuiEvent, "return": None}
-        on_gui = messages.handler(on_gui)
-
-    return [Buttons()]  # its handle is set by launch_web
+    return [Buttons()]
 
 
 def launch_web(model: Any, data: Any, options: WebOptions | None = None, title: str = "lifelike-mj",
@@ -186,7 +196,8 @@ def launch_web(model: Any, data: Any, options: WebOptions | None = None, title: 
 
     web_server.bind_public_socket, web_viewer._print_url_banner = bind_here, quiet_banner
     try:
-        plugins = _first_view(model, setup) + _buttons(controls, pending)
+        shown = _Shown()
+        plugins = _first_view(model, setup) + _buttons(controls, pending, shown)
         handle = lw.launch(viewer_protocol.ViewerConfig(gfx="web", http_port=int(options.port), title=title),
                            plugins=plugins)
         ready.wait(timeout=60.0)
@@ -198,14 +209,10 @@ def launch_web(model: Any, data: Any, options: WebOptions | None = None, title: 
         why = bound.get("error", "it did not start within 60 s")
         raise UserError(f"the web viewer could not listen on {options.host} port {options.port or 'from 8080'}: {why}.")
     handle.set_model(model, data=data)
-    shown = "localhost" if options.is_loopback else (socket.getfqdn() if options.host in ("::", "0.0.0.0") else options.host)
-    url = f"http://{'[' + shown + ']' if ':' in shown else shown}:{bound['port']}/"
+    host = "localhost" if options.is_loopback else (socket.getfqdn() if options.host in ("::", "0.0.0.0") else options.host)
+    url = f"http://{'[' + host + ']' if ':' in host else host}:{bound['port']}/"
     print(f"web viewer: {url} (Ctrl+C to stop)", flush=True)
     if not options.is_loopback:
         print(f"warning: the web viewer listens on {options.host}, with no password and no encryption: anyone who "
               "can reach this machine can watch and drive the simulation.", file=sys.stderr, flush=True)
-    result = _Handle(handle, model, data, url)
-    for p in plugins:
-        if hasattr(p, "handle"):
-            p.handle = result  # the buttons' plugin draws the marks this handle is given
-    return result
+    return _Handle(handle, model, data, url, shown)
