@@ -8,6 +8,7 @@ Both hold one folder per creature: ``models/butterfly/butterfly.xml``,
 
 from __future__ import annotations
 
+import errno
 import json
 from collections.abc import Iterable
 from pathlib import Path
@@ -55,7 +56,7 @@ def resolve(creature: str, name_or_path: str | Path, what: str) -> Path:
     text = str(name_or_path)
     path = Path(text)
     shipped = controllers_dir() / creature / f"{text}.json"
-    if text.endswith(".json") or (path.exists() and not (path.is_dir() and shipped.is_file())):
+    if text.endswith(".json") or (_exists(path) and not (path.is_dir() and shipped.is_file())):
         return existing_file(path, what)
     path = shipped
     if not path.is_file():
@@ -67,7 +68,12 @@ def resolve(creature: str, name_or_path: str | Path, what: str) -> Path:
 def existing_file(path: str | Path, what: str) -> Path:
     """``path`` if it is an existing regular file; else a :class:`UserError` saying what it is instead."""
     p = Path(path)
-    if not p.exists():
+    if not _exists(p):
+        try:
+            p.stat()
+        except OSError as exc:
+            if exc.errno not in (errno.ENOENT, errno.ENOTDIR):
+                raise UserError(f"{what} file {str(p)[:80]} cannot be read: {exc.strerror}.") from None
         raise UserError(f"{what} file {p} does not exist.")
     if p.is_dir():
         raise UserError(f"{what} file {p} is a folder, not a file.")
@@ -76,9 +82,17 @@ def existing_file(path: str | Path, what: str) -> Path:
     return p
 
 
+def _exists(p: Path) -> bool:
+    """``p.exists()``, false for a name the file system refuses (too long) instead of an ``OSError``."""
+    try:
+        return p.exists()
+    except OSError:
+        return False
+
+
 def _existing_parent(path: Path) -> Path:
     parent = path.absolute().parent
-    while not parent.exists():
+    while not _exists(parent):
         parent = parent.parent
     return parent
 
@@ -87,12 +101,37 @@ def check_writable(path: str | Path, what: str = "output") -> Path:
     """Before any work: :class:`UserError` unless a file could be written at ``path`` (its folder exists
     or can be made, and is writable; ``path`` itself is not a folder or another kind of file)."""
     p = Path(path)
+    parent = _existing_parent(p)
+    _check_name(p, parent, what)
     if p.exists() and p.is_dir():
         raise UserError(f"{what} {p} is a folder; give a file name.")
     if p.exists() and not p.is_file():
         raise UserError(f"{what} {p} exists and is not a regular file.")
-    _probe(_existing_parent(p), p, what, "written")
+    _probe(parent, p, what, "written")
     return p
+
+
+def _check_name(p: Path, parent: Path, what: str) -> None:
+    """:class:`UserError` if a part of ``p`` still to be made is longer than the file system allows, or the
+    whole path is (``NAME_MAX``, ``PATH_MAX`` of the folder that exists)."""
+    import os
+
+    try:
+        name_max = os.pathconf(parent, "PC_NAME_MAX")
+        path_max = os.pathconf(parent, "PC_PATH_MAX")
+    except (OSError, ValueError):
+        return
+    try:
+        rest = p.absolute().relative_to(parent).parts
+    except ValueError:
+        rest = (p.name,)
+    for part in rest:
+        if len(part.encode()) > name_max:
+            raise UserError(f"{what} {str(p)[:80]}... cannot be written: the name {part[:40]!r}... is "
+                            f"{len(part.encode())} bytes long, and this file system allows {name_max}.")
+    if len(str(p.absolute()).encode()) >= path_max:
+        raise UserError(f"{what} {str(p)[:80]}... cannot be written: its path is {len(str(p.absolute()).encode())} "
+                        f"bytes long, and this file system allows {path_max - 1}.")
 
 
 def _probe(folder: Path, target: Path, what: str, verb: str) -> None:
@@ -110,28 +149,45 @@ def _probe(folder: Path, target: Path, what: str, verb: str) -> None:
         raise UserError(f"{what} {target} cannot be written in {folder} ({exc.strerror or type(exc).__name__}).") from None
 
 
-def check_output_file(path: str | Path, what: str, *, suffixes: Iterable[str] = (), overwrite: bool = False) -> Path:
+def check_output_file(path: str | Path, what: str, *, suffixes: Iterable[str] = (), overwrite: bool = False,
+                      claim: bool = True) -> Path:
     """Before any work: the file ``path`` may be written (:func:`check_writable`), ends in one of
-    ``suffixes`` (if given), and does not exist unless ``overwrite``."""
+    ``suffixes`` (if given), and does not exist unless ``overwrite``; then it is claimed for this process
+    (:func:`lifelike_mj.io.claim`, unless ``claim`` is false), so that a second run writing it stops at once and
+    the final write re-checks that nobody made it meanwhile."""
     p = Path(path)
     suffixes = tuple(suffixes)
     if suffixes and p.suffix.lower() not in suffixes:
         raise UserError(f"{what} must end in {' or '.join(suffixes)}, got {str(p)!r}.")
     check_writable(p, what)
-    if p.exists() and not overwrite:
-        raise UserError(f"{what} {p} already exists; add --overwrite to replace it.")
+    for claimed in (False, True) if claim else (False,):  # checked again once claimed: another run may just have written it
+        if claimed:
+            from lifelike_mj.io import claim as _claim
+
+            _claim(p, what, overwrite=overwrite)
+        if p.exists() and not overwrite:
+            raise UserError(f"{what} {p} already exists; add --overwrite to replace it.")
     return p
 
 
-def check_output_dir(path: str | Path, what: str, names: Iterable[str] = (), *, overwrite: bool = False) -> Path:
+def check_output_dir(path: str | Path, what: str, names: Iterable[str] = (), *, overwrite: bool = False,
+                     claim: bool = True) -> Path:
     """Before any work: the folder ``path`` may be made or written into, and none of the files ``names``
-    it will hold exists yet unless ``overwrite``."""
+    it will hold exists yet unless ``overwrite``; the folder is claimed for this process
+    (:func:`lifelike_mj.io.claim`), as :func:`check_output_file` claims a file."""
     p = Path(path)
+    parent = p if _exists(p) else _existing_parent(p)
+    _check_name(p / "x", parent, what)
     if p.exists() and not p.is_dir():
         raise UserError(f"{what} {p} is a file; give a folder.")
-    _probe(p if p.exists() else _existing_parent(p), p, what, "made")
-    if not overwrite:
-        there = [n for n in names if (p / n).exists()]
+    _probe(parent, p, what, "made")
+    names = tuple(names)
+    for claimed in (False, True) if claim else (False,):  # checked again once claimed, as a file is
+        if claimed:
+            from lifelike_mj.io import claim as _claim
+
+            _claim(p, what, overwrite=overwrite)
+        there = [n for n in names if (p / n).exists()] if not overwrite else []
         if there:
             raise UserError(f"{what} {p} already holds {', '.join(there[:3])}{' ...' if len(there) > 3 else ''}; "
                             "add --overwrite to replace them, or choose another folder.")

@@ -185,3 +185,36 @@ def chromium() -> _Chromium:
         pytest.skip("Chromium or playwright-core is not installed (.ci/run installs Debian's chromium and npm's "
                     "playwright-core)")
     return _Chromium(exe)
+
+
+class _OtherProcess:
+    """Claims on outputs held by another process (:func:`lifelike_mj.io.claim`), as a second run would find them."""
+
+    def __init__(self) -> None:
+        self.procs: list = []
+
+    def hold(self, path) -> int:
+        """Claim ``path`` in a child process that keeps it until the test ends; returns its process id."""
+        import subprocess
+        import sys
+
+        code = ("import sys; from lifelike_mj.io import claim; claim(sys.argv[1], 'output'); print('held', flush=True); "
+                "sys.stdin.read()")
+        p = subprocess.Popen([sys.executable, "-c", code, str(path)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                             text=True)
+        assert p.stdout.readline().strip() == "held"
+        self.procs.append(p)
+        return p.pid
+
+    def close(self) -> None:
+        for p in self.procs:
+            p.stdin.close()
+            p.wait(10)
+
+
+@pytest.fixture
+def other_process():
+    """Hold outputs' claims from another process for the test's length (``other_process.hold(path)``)."""
+    o = _OtherProcess()
+    yield o
+    o.close()

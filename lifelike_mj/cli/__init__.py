@@ -137,9 +137,10 @@ def cmd_reproduce(args) -> None:
     whats = CREATURES if args.what == "all" else (args.what,)
     from lifelike_mj.paths import check_output_dir
 
-    for what in whats:  # every folder checked before the first stage starts
-        out = Path(args.out or "reports") / what if (args.what == "all" or not args.out) else Path(args.out)
-        check_output_dir(out, "--out", ("report.md", "results.json"), overwrite=args.overwrite)
+    for claim in (False, True):  # every folder checked before the first stage starts, then claimed
+        for what in whats:
+            out = Path(args.out or "reports") / what if (args.what == "all" or not args.out) else Path(args.out)
+            check_output_dir(out, "--out", ("report.md", "results.json"), overwrite=args.overwrite, claim=claim)
     import time
 
     from lifelike_mj.progress import duration_text
@@ -162,6 +163,9 @@ def main(argv: list[str] | None = None) -> int:
     from lifelike_mj.provenance import set_command
 
     set_command(argv)
+    from lifelike_mj.io import held_claims, release_claims
+
+    before = held_claims()
     try:
         args = build_parser().parse_args(join_negative_values(argv))
         args.func(args)
@@ -177,4 +181,26 @@ def main(argv: list[str] | None = None) -> int:
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except OSError as exc:  # the file system refused (no space, read-only, name too long ...): one sentence
+        print(f"lifelike-mj: error: {file_system_error(exc)}", file=sys.stderr)
+        return 2
+    finally:
+        release_claims(keep=before)
     return 0
+
+
+def file_system_error(exc: OSError) -> str:
+    """One sentence for an ``OSError`` raised while reading or writing a file (what, which file, why)."""
+    import errno
+
+    why = {errno.ENOSPC: "there is no space left on the device", errno.EDQUOT: "the disk quota is exhausted",
+           errno.EROFS: "the file system is read-only", errno.EACCES: "permission is denied",
+           errno.EPERM: "the operation is not permitted", errno.ENAMETOOLONG: "the name is too long for the file system",
+           errno.EISDIR: "it is a folder", errno.ENOTDIR: "a part of its path is not a folder",
+           errno.ENOENT: "it does not exist", errno.EMFILE: "too many files are open"}.get(exc.errno or -1,
+                                                                                            exc.strerror or str(exc))
+    name = exc.filename if exc.filename is not None else ""
+    name = str(name)
+    if len(name) > 100:
+        name = name[:60] + "..." + name[-30:]
+    return f"the file system refused {name or 'a file'}: {why}."

@@ -153,15 +153,17 @@ def check_outputs(args: argparse.Namespace, files: dict[str, tuple[str, ...]] | 
                   folders: dict[str, tuple[str, ...]] | None = None) -> None:
     """Before any work: each option in ``files`` (name -> allowed suffixes) names a file that can be written
     and does not exist unless ``--overwrite``; each option in ``folders`` (name -> the files it will hold)
-    names a folder whose files do not exist yet unless ``--overwrite``."""
+    names a folder whose files do not exist yet unless ``--overwrite``; then each is claimed for this run
+    (:func:`lifelike_mj.io.claim`: a second run on the same output stops at once, naming this one)."""
     from lifelike_mj.paths import check_output_dir, check_output_file
 
     overwrite = bool(getattr(args, "overwrite", False))
-    for opt, suffixes in (files or {}).items():
-        value = getattr(args, opt.lstrip("-").replace("-", "_"), None)
-        if value:
-            check_output_file(value, opt, suffixes=suffixes, overwrite=overwrite)
-    for opt, names in (folders or {}).items():
-        value = getattr(args, opt.lstrip("-").replace("-", "_"), None)
-        if value:
-            check_output_dir(value, opt, names, overwrite=overwrite)
+    for claim in (False, True):  # every output checked before the first is claimed (a refusal leaves no trace)
+        for opt, suffixes in (files or {}).items():
+            value = getattr(args, opt.lstrip("-").replace("-", "_"), None)
+            if value:
+                check_output_file(value, opt, suffixes=suffixes, overwrite=overwrite, claim=claim)
+        for opt, names in (folders or {}).items():
+            value = getattr(args, opt.lstrip("-").replace("-", "_"), None)
+            if value:
+                check_output_dir(value, opt, names, overwrite=overwrite, claim=claim)

@@ -167,9 +167,10 @@ def guarded_run_files(out: str | Path, checkpoint: str | Path | None, *, resume:
     ckpt = Path(checkpoint) if checkpoint else out.with_name(out.name + ".ckpt")
     if ckpt.absolute().resolve() == out.absolute().resolve():
         raise UserError(f"the checkpoint and the controller file are the same file ({out}); give another --checkpoint.")
-    check_output_file(out, "--out", suffixes=(".json",), overwrite=True)
+    check_output_file(out, "--out", suffixes=(".json",), overwrite=True, claim=False)
     check_writable(ckpt, "checkpoint")
-    with exclusive(out, "--out"), exclusive(ckpt, "checkpoint"):
+    with exclusive(out, "--out", overwrite=overwrite or resume), exclusive(ckpt, "checkpoint",
+                                                                           overwrite=overwrite or resume):
         check_output_file(out, "--out", suffixes=(".json",), overwrite=overwrite or resume)
         check_checkpoint_path(ckpt, resume=resume, overwrite=overwrite)
         yield ckpt

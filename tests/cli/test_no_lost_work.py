@@ -11,7 +11,7 @@ import time
 import pytest
 
 from lifelike_mj.cli import main
-from lifelike_mj.io import exclusive
+from lifelike_mj.io import lock_path
 
 
 @pytest.fixture
@@ -61,16 +61,17 @@ def test_an_unrelated_file_is_never_turned_into_a_checkpoint(tmp_path, capsys, s
     assert not (tmp_path / "ctrl.json").exists()
 
 
-def test_a_second_run_on_the_same_out_stops_at_once(tmp_path, capsys, small_problem):
-    with exclusive(tmp_path / "ctrl.json", "--out"):
-        t0 = time.perf_counter()
-        assert main(_evolve(tmp_path)) == 2
-        assert time.perf_counter() - t0 < 5
+def test_a_second_run_on_the_same_out_stops_at_once(tmp_path, capsys, small_problem, other_process):
+    pid = other_process.hold(tmp_path / "ctrl.json")
+    t0 = time.perf_counter()
+    assert main(_evolve(tmp_path)) == 2
+    assert time.perf_counter() - t0 < 5
     err = capsys.readouterr().err
-    assert "another run is writing" in err and str(os.getpid()) in err
+    assert "another run is writing" in err and f"process {pid}" in err
     assert not (tmp_path / "ctrl.json").exists()
+    other_process.close()
     assert main(_evolve(tmp_path)) == 0  # the lock is released with its holder
-    assert not (tmp_path / "ctrl.json.lock").exists()
+    assert not lock_path(tmp_path / "ctrl.json").exists() and not lock_path(tmp_path / "ctrl.json.ckpt").exists()
 
 
 def test_two_concurrent_processes_one_wins(tmp_path):
