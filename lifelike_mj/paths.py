@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import errno
 import json
+import sys
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -204,6 +205,9 @@ def read_json(path: str | Path, what: str) -> object:
             return json.loads(p.read_text(encoding="utf-8"), parse_constant=_no_constant)
     except (OSError, ValueError) as exc:  # UnicodeDecodeError and JSONDecodeError are ValueErrors
         raise UserError(f"{what} file {p} is not readable JSON ({exc.__class__.__name__}).") from None
+    except RecursionError:  # json's decoder recurses once per level of nesting
+        raise UserError(f"{what} file {p} is nested too deeply to be one (more than about "
+                        f"{sys.getrecursionlimit()} levels of lists or objects).") from None
     raise UserError(f"{what} file {p} is larger than {MAX_JSON_BYTES // 1_000_000} MB; it cannot be one.")
 
 

@@ -1,14 +1,23 @@
-"""Checks shared by every preset and controller file: the format and version, and keys: an unknown
-key is named with the closest known one ("did you mean"), a missing key is named, and a number is a
-finite JSON number (never a string or a bool). Each file's own values are ranged by the class it
-builds (:class:`~lifelike_mj.fish.params.FishParams`, :class:`~lifelike_mj.boids.engine.BoidParams`,
-:class:`~lifelike_mj.butterfly.controllers.ButterflyController`)."""
+"""One validation path for every file format the project reads.
+
+Each format has one description, its JSON Schema (draft 2020-12), built in code by the module that owns the
+format and written to ``docs/schemas/`` for editors. Loaders check the header (:func:`check_header`: the
+format and its version, with the clearest sentence for a file of another kind), then the whole document
+against that schema (:func:`validate`): types, shapes, sizes and bounds, unknown keys named with the closest
+known one ("did you mean"), missing keys named. A number is a finite JSON number, never a string, a bool or
+an infinity (``1e999`` parses as one). Only then does a loader convert values (``float()``, ``int()``) and
+build its object, whose own checks add what a schema cannot say (a schedule's first row at 0 s, ``r_min`` not
+above ``r_max``, as many weights as the layers need).
+
+Every failure is one sentence (:class:`~lifelike_mj.errors.UserError`) naming the file, the place in it
+(``base.frequency_hz``, ``weights[3]``) and what was expected.
+"""
 
 from __future__ import annotations
 
-import difflib
+import functools
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Sequence
 
 from lifelike_mj import checks
 from lifelike_mj.errors import UserError
@@ -31,12 +40,9 @@ def check_header(data: object, fmt: str, where: str, versions: Iterable[int] = (
 
 def check_keys(obj: dict, allowed: Iterable[str], where: str, required: Iterable[str] = ()) -> None:
     """Unknown keys of ``obj`` are an error naming the closest allowed key; so are missing ``required`` ones."""
-    allowed = list(allowed)
-    for key in obj:
-        if key not in allowed:
-            close = difflib.get_close_matches(str(key), allowed, n=1, cutoff=0.6)
-            hint = f" (did you mean {close[0]!r}?)" if close else f"; known keys: {', '.join(allowed)}"
-            raise UserError(f"{where} has an unknown key {key!r}{hint}.")
+    from lifelike_mj.errors import check_names
+
+    check_names(obj, allowed, f"{where} has an unknown key")
     missing = [k for k in required if k not in obj]
     if missing:
         raise UserError(f"{where} lacks {', '.join(repr(k) for k in missing)}.")
@@ -100,3 +106,127 @@ def number(description: str = "", minimum: float | None = None, maximum: float |
     if maximum is not None:
         out["maximum"] = maximum
     return out
+
+
+# ---- validating a document against its schema -------------------------------------------------------
+
+#: Keywords of our own (ignored by other JSON Schema tools): ``x-array`` marks a NumPy array stored beside the
+#: JSON (a checkpoint's), checked by the ``arrays`` function given to :func:`validate`.
+X_ARRAY = "x-array"
+
+
+def _finite_number(checker, value) -> bool:
+    return checks.is_number(value) and math.isfinite(float(value))
+
+
+def _whole_number(checker, value) -> bool:
+    return checks.is_whole(value)  # a JSON integer: 2.0 is a float, as json reads it
+
+
+@functools.lru_cache(maxsize=1)
+def _validator_class():
+    from jsonschema import Draft202012Validator, validators
+
+    types = Draft202012Validator.TYPE_CHECKER.redefine_many({"number": _finite_number, "integer": _whole_number})
+    return validators.extend(Draft202012Validator, type_checker=types)
+
+
+def _with_arrays(arrays: Callable[[object, dict], str | None]):
+    from jsonschema import ValidationError, validators
+
+    def x_array(validator, spec, instance, schema):
+        problem = arrays(instance, spec)
+        if problem:
+            yield ValidationError(problem)
+
+    return validators.extend(_validator_class(), validators={X_ARRAY: x_array})
+
+
+def validate(data: object, schema: dict, where: str, arrays: Callable | None = None) -> None:
+    """:class:`UserError` (one sentence, beginning with ``where``) unless ``data`` is valid against ``schema``.
+    ``arrays(instance, spec)``: for documents with :data:`X_ARRAY` keywords, returns what is wrong with the array
+    ``instance`` refers to (``None`` if nothing)."""
+    from jsonschema.exceptions import best_match
+
+    cls = _validator_class() if arrays is None else _with_arrays(arrays)
+    try:
+        errors = list(cls(schema).iter_errors(data))
+        # an unknown key first: a misspelt key also leaves a required one missing, and the typo is the news
+        unknown = [e for e in errors if e.validator == "additionalProperties"]
+        err = best_match(unknown or errors)
+    except RecursionError:
+        raise UserError(f"{where} is nested too deeply to be one of ours.") from None
+    if err is not None:
+        raise UserError(sentence(err, where))
+
+
+def path_text(path: Sequence) -> str:
+    """``("base", "frequency_hz")`` as ``base.frequency_hz``, ``("weights", 3)`` as ``weights[3]``."""
+    out = ""
+    for part in path:
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out
+
+
+def _show(value: object) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:45] + " ... " + text[-10:]
+
+
+def _kind(schema: dict) -> str:
+    """What ``schema`` asks for, in words: ``a number in [0, 3.14159]``, ``a whole number of at least 1``."""
+    t = schema.get("type")
+    types = t if isinstance(t, list) else [t]
+    lo, hi = schema.get("minimum"), schema.get("maximum")
+    xlo, xhi = schema.get("exclusiveMinimum"), schema.get("exclusiveMaximum")
+    if "integer" in types:
+        noun = "a whole number"
+        if lo is not None and hi is not None:
+            return f"{noun} from {lo:,} to {hi:,}"
+        return f"{noun} of at least {lo:,}" if lo is not None else noun
+    if "number" in types:
+        if lo is None and xlo is None and hi is None and xhi is None:
+            return "a finite number"
+        left = f"[{lo:g}" if lo is not None else (f"({xlo:g}" if xlo is not None else "(-inf")
+        right = f"{hi:g}]" if hi is not None else (f"{xhi:g})" if xhi is not None else "inf)")
+        return f"a number in {left}, {right}"
+    words = {"object": "an object", "array": "a list", "string": "a text", "boolean": "true or false", "null": "null"}
+    named = [words.get(str(x), str(x)) for x in types if x]
+    return " or ".join(named) if named else "valid"
+
+
+def sentence(err, where: str) -> str:
+    """One sentence for the ``jsonschema`` error ``err`` in the file ``where``."""
+    path = path_text(err.absolute_path)
+    at = f"{where}: {path}" if path else where
+    v, inst, sch = err.validator, err.instance, err.schema if isinstance(err.schema, dict) else {}
+    if v in ("type", "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum", "multipleOf"):
+        return f"{at} must be {_kind(sch)}, got {_show(inst)}."
+    if v == "required":
+        missing = [k for k in err.validator_value if isinstance(inst, dict) and k not in inst]
+        return f"{at} lacks {', '.join(repr(k) for k in missing) or err.message}."
+    if v == "additionalProperties" and isinstance(inst, dict):
+        from lifelike_mj.errors import unknown_name
+
+        known = list(sch.get("properties", {}))
+        extra = [k for k in inst if k not in known]
+        return str(unknown_name(f"{at} has an unknown key", extra[0] if extra else "?", known))
+    if v in ("minItems", "maxItems", "prefixItems"):
+        n = len(inst) if isinstance(inst, (list, tuple)) else 0
+        lo, hi = sch.get("minItems"), sch.get("maxItems")
+        want = f"{lo}" if lo == hi and lo is not None else (
+            f"{lo} to {hi}" if lo is not None and hi is not None else (f"at least {lo}" if lo is not None else f"at most {hi}"))
+        items = sch.get("items") if isinstance(sch.get("items"), dict) else {}
+        noun = {"number": "numbers", "integer": "whole numbers", "array": "rows", "object": "objects"}.get(
+            items.get("type"), "items")
+        return f"{at} must have {want} {noun}, got {n}."
+    if v in ("enum", "const"):
+        allowed = err.validator_value if v == "enum" else [err.validator_value]
+        return f"{at} must be {' or '.join(_show(a) for a in allowed)}, got {_show(inst)}."
+    if v in ("minLength", "maxLength"):
+        return f"{at} must be a text of {v.removesuffix('Length')}imum {err.validator_value} characters."
+    if v == X_ARRAY:
+        return f"{at}: {err.message}."
+    if v is None:  # a false schema: the key may not appear here
+        return f"{at} is not allowed here."
+    return f"{at}: {err.message}."

@@ -9,7 +9,8 @@ from lifelike_mj.cli.schemas import write_schemas
 from lifelike_mj.paths import controllers_dir
 
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "schemas"
-KINDS = {"butterfly": "butterfly-controller", "fish": "fish-preset", "boids": "boids-preset"}
+KINDS = {"butterfly": "butterfly-controller", "butterfly3d": "butterfly3d-controller", "fish": "fish-preset",
+         "boids": "boids-preset"}
 
 
 def test_published_schemas_are_current(tmp_path):
@@ -31,7 +32,7 @@ def test_schema_keys_are_the_loaders_keys():
                                      "provenance"}
 
 
-@pytest.mark.parametrize("creature", ["butterfly", "fish", "boids"])
+@pytest.mark.parametrize("creature", ["butterfly", "butterfly3d", "fish", "boids"])
 def test_every_shipped_file_validates(creature):
     jsonschema = pytest.importorskip("jsonschema")
     for path in sorted((controllers_dir() / creature).glob("*.json")):

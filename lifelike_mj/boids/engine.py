@@ -50,6 +50,12 @@ N_AGENTS = 300
 #: the swarm stays finite but agents pass 20 box units per step within 35-500 steps. Anti-alignment
 #: (a negative W_a entry, as in 5b) can throw a lone agent past it too (5b seed 2, at step 626).
 DIVERGED_BOX_PER_STEP = 1.0
+#: The most agent types, and the largest weight (in size) of a W_a or W_c entry: far beyond the paper's (types 2,
+#: weights below 1, runs diverging from w_a = 10 or w_c = 1) and keeping every number of the compiled step finite.
+MAX_TYPES = 64
+MAX_WEIGHT = 1.0e3
+#: The largest zone radius (box units).
+MAX_RADIUS = 1.0e3
 
 
 @dataclass(frozen=True)
@@ -79,6 +85,9 @@ class BoidParams:
             v = getattr(self, k)
             if not checks.is_number(v) or not math.isfinite(v):
                 raise UserError(f"{k} must be a finite number, got {v!r}.")
+        for k in ("r_s", "r_a", "r_c"):
+            checks.number(k, getattr(self, k), hi=MAX_RADIUS, unit="box units")
+        checks.number("w_s", self.w_s, -MAX_WEIGHT, MAX_WEIGHT)
         if not (0 < self.r_s < self.r_a < self.r_c):
             raise UserError(f"the zones must nest: 0 < R_s < R_a < R_c, got R_s = {self.r_s}, R_a = {self.r_a}, "
                             f"R_c = {self.r_c}.")
@@ -107,10 +116,11 @@ def _matrix(name: str, m) -> np.ndarray:
         a = np.array(m, dtype=float)
     except (TypeError, ValueError):
         raise UserError(f"{name} must be a square matrix of numbers, got {m!r}.") from None
-    if a.ndim != 2 or a.shape[0] != a.shape[1] or a.shape[0] < 1:
-        raise UserError(f"{name} must be a square k x k matrix (one row and column per type), got shape {a.shape}.")
-    if not np.all(np.isfinite(a)):
-        raise UserError(f"{name} must contain finite numbers.")
+    if a.ndim != 2 or a.shape[0] != a.shape[1] or not 1 <= a.shape[0] <= MAX_TYPES:
+        raise UserError(f"{name} must be a square k x k matrix (one row and column per type, at most {MAX_TYPES} "
+                        f"types), got shape {a.shape}.")
+    if not np.all(np.isfinite(a)) or np.any(np.abs(a) > MAX_WEIGHT):
+        raise UserError(f"{name} must contain finite numbers within +-{MAX_WEIGHT:g}.")
     return a
 
 

@@ -14,17 +14,17 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from lifelike_mj.boids.engine import BoidParams
+from lifelike_mj.boids.engine import MAX_BOX_ZONES, MAX_RADIUS, MAX_TYPES, MAX_WEIGHT, BoidParams
 from lifelike_mj.errors import UserError
 from lifelike_mj.paths import controllers_dir, load_named_json
-from lifelike_mj.schema import check_header, check_keys, finite, number_list
+from lifelike_mj.schema import check_header, validate
 
 FORMAT = "lifelike-mj/boids-preset"
 GRID_FORMAT = "lifelike-mj/boids-grid"
 PATTERNS = ("4a", "4b", "4c", "4d", "5a", "5b", "5c", "5d")
 _SETTINGS = ("r_s", "r_a", "r_c", "w_s", "box")
 #: Largest homogeneous weight and grid of :func:`load_grid`.
-MAX_WEIGHT = 100.0
+MAX_GRID_WEIGHT = 100.0
 MAX_GRID_CELLS = 10_000
 
 
@@ -41,14 +41,9 @@ def load_preset(ref: str | Path, dims: int = 3) -> BoidParams:
     data, p = _read(ref)
     where = f"boids preset {p}"
     check_header(data, FORMAT, where, kind="boids preset")
-    check_keys(data, ("format", "version", "name", "figure", "description", "W_a", "W_c", "settings"), where,
-               required=("W_a", "W_c"))
-    settings = data.get("settings", {})
-    if not isinstance(settings, dict):
-        raise UserError(f"{where}: 'settings' must be an object like {{\"r_s\": 1.0}}, got {settings!r}.")
-    check_keys(settings, _SETTINGS, f"{where} 'settings'")
-    values = {k: finite(v, k, where) for k, v in settings.items()}
-    return BoidParams(wa=data["W_a"], wc=data["W_c"], dims=dims, name=str(data.get("name", p.stem)), **values)
+    validate(data, json_schema(), where)
+    return BoidParams(wa=data["W_a"], wc=data["W_c"], dims=dims, name=data.get("name", p.stem),
+                      **data.get("settings", {}))
 
 
 def preset_info(ref: str | Path) -> dict:
@@ -61,11 +56,8 @@ def load_grid(ref: str | Path = "fig2_grid") -> dict:
     data, p = _read(ref)
     where = f"boids grid {p}"
     check_header(data, GRID_FORMAT, where, kind="boids grid")
-    check_keys(data, ("format", "version", "name", "description", "w_a", "w_c"), where, required=("w_a", "w_c"))
-    axes = {k: number_list(data[k], k, where) for k in ("w_a", "w_c")}
-    for k, vals in axes.items():
-        if any(v < 0 or v > MAX_WEIGHT for v in vals):
-            raise UserError(f"{where}: every {k} must be in [0, {MAX_WEIGHT:g}], got {vals}.")
+    validate(data, grid_json_schema(), where)
+    axes = {k: [float(v) for v in data[k]] for k in ("w_a", "w_c")}
     if len(axes["w_a"]) * len(axes["w_c"]) > MAX_GRID_CELLS:
         raise UserError(f"{where} has {len(axes['w_a']) * len(axes['w_c'])} cells; at most {MAX_GRID_CELLS}.")
     return {**axes, "name": p.stem}
@@ -80,14 +72,16 @@ def json_schema() -> dict:
     """The JSON Schema of a boids preset file (``docs/schemas/boids-preset.schema.json``)."""
     from lifelike_mj.schema import document_schema, number
 
-    matrix = {"type": "array", "minItems": 1, "items": {"type": "array", "minItems": 1, "items": {"type": "number"}},
+    matrix = {"type": "array", "minItems": 1, "maxItems": MAX_TYPES,
+              "items": {"type": "array", "minItems": 1, "maxItems": MAX_TYPES, "items": number("", -MAX_WEIGHT, MAX_WEIGHT)},
               "description": "k x k weights, row: own type, column: the neighbour's type"}
     settings = {"type": "object", "additionalProperties": False, "properties": {
-        "r_s": number("separation zone radius, box units", exclusive_minimum=0),
-        "r_a": number("alignment zone radius, box units", exclusive_minimum=0),
-        "r_c": number("cohesion zone radius, box units", exclusive_minimum=0),
-        "w_s": number("separation weight (the paper: 0.05)"),
-        "box": number("box side, box units (at most 200 R_c)", exclusive_minimum=0)}}
+        "r_s": number("separation zone radius, box units", maximum=MAX_RADIUS, exclusive_minimum=0),
+        "r_a": number("alignment zone radius, box units", maximum=MAX_RADIUS, exclusive_minimum=0),
+        "r_c": number("cohesion zone radius, box units", maximum=MAX_RADIUS, exclusive_minimum=0),
+        "w_s": number("separation weight (the paper: 0.05)", -MAX_WEIGHT, MAX_WEIGHT),
+        "box": number("box side, box units (at most 200 R_c)", maximum=MAX_BOX_ZONES * MAX_RADIUS,
+                      exclusive_minimum=0)}}
     return document_schema(FORMAT, "lifelike-mj boids preset", {"figure": {"type": "string"}, "W_a": matrix,
                            "W_c": matrix, "settings": settings}, ["W_a", "W_c"],
                            "Nakamura 2013: the alignment and cohesion matrices of a two-type (or k-type) flock.")
@@ -97,6 +91,7 @@ def grid_json_schema() -> dict:
     """The JSON Schema of a homogeneous grid file (``docs/schemas/boids-grid.schema.json``)."""
     from lifelike_mj.schema import document_schema
 
-    axis = {"type": "array", "minItems": 1, "items": {"type": "number", "minimum": 0, "maximum": MAX_WEIGHT}}
+    axis = {"type": "array", "minItems": 1, "maxItems": MAX_GRID_CELLS,
+            "items": {"type": "number", "minimum": 0, "maximum": MAX_GRID_WEIGHT}}
     return document_schema(GRID_FORMAT, "lifelike-mj boids grid", {"w_a": axis, "w_c": axis}, ["w_a", "w_c"],
                            "Nakamura 2013 Fig. 2: the homogeneous alignment and cohesion weights to sweep.")

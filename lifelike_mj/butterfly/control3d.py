@@ -331,6 +331,10 @@ def fly_batch(mptr, dptrs, off, nq, nv, n_steps, dt, every, layers, weights, bas
 # ---- controller files ------------------------------------------------------------------------
 
 FORMAT = "lifelike-mj/butterfly3d-controller"
+#: Bounds of a 3D controller (files and Python alike; every one of these numbers reaches the compiled loop):
+#: at most this many layers (inputs and outputs included), neurons per hidden layer, size of a weight, steps
+#: between two runs of the network, and rate at which the kinematics follow a command (rad/s).
+MAX_LAYERS, MAX_WIDTH, MAX_WEIGHT, MAX_EVERY, MAX_OMEGA_C = 6, 256, 1.0e6, 12_000, 1.0e4
 #: What a controller's forward and sideways speeds are measured against (module docstring).
 INPUTS = ("ground", "air")
 #: Default ``scale`` of the actions (rad; Hz for the frequency).
@@ -361,23 +365,39 @@ class Controller3D:
 
         self.name = name
         where = f"3D controller {name}" if name else "3D controller"
-        layers = [int(v) for v in layers] if all(checks.is_whole(v) for v in layers) else None
-        if not layers or len(layers) < 2 or layers[0] != N_OBS or layers[-1] != N_ACT or min(layers) < 1:
-            raise UserError(f"{where}: layers must run from {N_OBS} inputs to {N_ACT} outputs, got {layers!r}.")
+        try:
+            given = list(layers)
+        except TypeError:
+            given = None
+        ok = (given is not None and 2 <= len(given) <= MAX_LAYERS and all(checks.is_whole(v) for v in given)
+              and given[0] == N_OBS and given[-1] == N_ACT and all(1 <= v <= MAX_WIDTH for v in given))
+        if not ok:
+            raise UserError(f"{where}: layers must be whole numbers running from {N_OBS} inputs to {N_ACT} outputs, "
+                            f"at most {MAX_LAYERS} layers of at most {MAX_WIDTH} neurons, got {layers!r}.")
+        layers = [int(v) for v in given]
         self.layers = np.array(layers, dtype=np.int64)
-        self.weights = np.ascontiguousarray(weights, dtype=np.float64).reshape(-1)
-        if len(self.weights) != n_weights(layers) or not np.all(np.isfinite(self.weights)):
-            raise UserError(f"{where}: layers {layers} need {n_weights(layers)} finite weights, got {len(self.weights)}.")
+        try:
+            self.weights = np.ascontiguousarray(weights, dtype=np.float64).reshape(-1)
+        except (TypeError, ValueError):
+            raise UserError(f"{where}: the weights must be numbers, got {weights!r}.") from None
+        if len(self.weights) != n_weights(layers) or not np.all(np.abs(self.weights) <= MAX_WEIGHT):
+            raise UserError(f"{where}: layers {layers} need {n_weights(layers)} finite weights, each within "
+                            f"+-{MAX_WEIGHT:g}, got {len(self.weights)}"
+                            + ("" if len(self.weights) != n_weights(layers) else " with one beyond") + ".")
         self.base = base if base is not None else default_base()
         if not isinstance(self.base, KinematicsCommand):
             raise UserError(f"{where}: the base is a KinematicsCommand, got {self.base!r}.")
+        if scale is not None and not isinstance(scale, dict):
+            raise UserError(f"{where}: scale is a mapping of action names to numbers, got {scale!r}.")
         scale = dict(DEFAULT_SCALE, **(scale or {}))
         unknown = set(scale) - set(ACTION_NAMES)
         if unknown:
-            raise UserError(f"{where}: unknown action {sorted(unknown)[0]!r} in scale; actions: {', '.join(ACTION_NAMES)}.")
+            from lifelike_mj.errors import unknown_name
+
+            raise unknown_name(f"{where}: unknown action", sorted(unknown, key=str)[0], ACTION_NAMES, "in scale")
         self.scale = np.array([checks.number(f"scale of {a}", scale[a], 0.0, math.pi) for a in ACTION_NAMES])
-        self.every = checks.whole("every", every, 1)
-        self.omega_c_rad_s = checks.positive("omega_c_rad_s", omega_c_rad_s, "rad/s")
+        self.every = checks.whole("every", every, 1, MAX_EVERY)
+        self.omega_c_rad_s = checks.number("omega_c_rad_s", omega_c_rad_s, 0.0, MAX_OMEGA_C, lo_open=True, unit="rad/s")
         if inputs not in INPUTS:
             raise UserError(f"{where}: inputs are {' or '.join(repr(v) for v in INPUTS)}, got {inputs!r}.")
         self.inputs = inputs
@@ -402,26 +422,48 @@ class Controller3D:
                             self.omega_c_rad_s, self.provenance, self.name, inputs or self.inputs)
 
 
-def controller_from_dict(data: object, name: str = "") -> Controller3D:
-    """A :class:`Controller3D` from plain data (a parsed controller file); one sentence for anything wrong."""
+def json_schema() -> dict:
+    """The JSON Schema of a 3D controller file (``docs/schemas/butterfly3d-controller.schema.json``): what
+    :func:`controller_from_dict` enforces before building the controller."""
     from lifelike_mj.butterfly.kinematics3d import KinematicsCommand
-    from lifelike_mj.schema import check_header, check_keys, number_list
+    from lifelike_mj.schema import document_schema, number
+
+    max_weights = n_weights([N_OBS, *[MAX_WIDTH] * (MAX_LAYERS - 2), N_ACT])
+    props = {
+        "layers": {"type": "array", "minItems": 2, "maxItems": MAX_LAYERS,
+                   "items": {"type": "integer", "minimum": 1, "maximum": MAX_WIDTH},
+                   "description": f"neurons per layer, from the {N_OBS} observations to the {N_ACT} actions"},
+        "weights": {"type": "array", "maxItems": max_weights, "items": number("", -MAX_WEIGHT, MAX_WEIGHT),
+                    "description": "per layer, per neuron: its input weights, then its bias"},
+        "base": KinematicsCommand.json_schema(),
+        "scale": {"type": "object", "additionalProperties": False, "description": "each action's full scale (rad; Hz "
+                  "for the frequency); missing ones take the defaults",
+                  "properties": {a: number("rad (Hz for frequency)", 0.0, math.pi) for a in ACTION_NAMES}},
+        "every": {"type": "integer", "minimum": 1, "maximum": MAX_EVERY, "description": "time steps between two runs "
+                  "of the network"},
+        "omega_c_rad_s": number("rad/s: how fast the kinematics follow a command", maximum=MAX_OMEGA_C,
+                                exclusive_minimum=0.0),
+        "inputs": {"enum": list(INPUTS), "description": "the network's speeds over the ground or through the air"},
+        "provenance": {"type": "object"},
+    }
+    return document_schema(FORMAT, "lifelike-mj 3D butterfly controller", props, ["layers", "weights"],
+                           "A network from the 3D butterfly's attitude and motion to changes of its wing and abdomen "
+                           "kinematics, with the base command and the actions' scales.")
+
+
+def controller_from_dict(data: object, name: str = "") -> Controller3D:
+    """A :class:`Controller3D` from plain data (a parsed controller file); one sentence for anything wrong
+    (checked against :func:`json_schema` before any value is used)."""
+    from lifelike_mj.butterfly.kinematics3d import KinematicsCommand
+    from lifelike_mj.schema import check_header, validate
 
     where = f"3D controller {name}" if name else "3D controller"
     d = check_header(data, FORMAT, f"file {name}" if name else "the data", kind="3D controller file")
-    check_keys(d, ("format", "version", "layers", "weights", "base", "scale", "every", "omega_c_rad_s", "inputs",
-                   "provenance"),
-               where, required=("layers", "weights"))
+    validate(d, json_schema(), where)
     base = d.get("base")
     if base is not None:
-        if not isinstance(base, dict):
-            from lifelike_mj.errors import UserError
-
-            raise UserError(f"{where}: base must be an object of kinematics parameters, got {base!r}.")
-        check_keys(base, KinematicsCommand.names(), f"{where} base")
         base = KinematicsCommand(**{k: float(v) for k, v in base.items()})
-    return Controller3D(d["layers"] if isinstance(d["layers"], list) else [],
-                        number_list(d["weights"], "weights", where), base, d.get("scale"), d.get("every", 1),
+    return Controller3D(d["layers"], d["weights"], base, d.get("scale"), d.get("every", 1),
                         d.get("omega_c_rad_s", 2.0 * math.pi * 10.0), d.get("provenance"), name, d.get("inputs", "ground"))
 
 

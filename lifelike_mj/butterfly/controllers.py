@@ -30,10 +30,10 @@ import numpy as np
 
 from lifelike_mj import checks
 from lifelike_mj.butterfly import ann
-from lifelike_mj.butterfly.params import FlapPattern
+from lifelike_mj.butterfly.params import MAX_FLAP_HZ, FlapPattern
 from lifelike_mj.errors import UserError
 from lifelike_mj.paths import load_named_json, shipped_names
-from lifelike_mj.schema import check_header, check_keys
+from lifelike_mj.schema import check_header, validate
 
 FORMAT = "lifelike-mj/butterfly-controller"
 
@@ -54,6 +54,11 @@ PITCH_LAWS: dict[str, tuple[int, tuple[str, ...]]] = {
     "ann": (KIND_ANN, ("weights",)),
 }
 
+
+#: Bounds of a controller's numbers (files and Python alike): a pitch (deg), a network weight, an input scale.
+MAX_PITCH_DEG = 90.0
+MAX_WEIGHT = 1.0e6
+MAX_INPUT_SCALE = 1.0e6
 
 #: Optional parameters of an ann controller file besides its weights.
 ANN_OPTIONAL = ("inputs", "input_scale", "layers", "max_dphi_deg", "phi_limit_deg")
@@ -80,9 +85,7 @@ class ButterflyController:
             _check_ann(self.parameters, where=f"controller {self.name}" if self.name else "controller")
             return
         for k in needed:
-            v = self.parameters[k]
-            if not checks.is_number(v) or not math.isfinite(v):
-                raise UserError(f"controller parameter {k} must be a finite number, got {v!r}.")
+            checks.number(f"controller parameter {k}", self.parameters[k], -MAX_PITCH_DEG, MAX_PITCH_DEG, unit="deg")
 
     def compiled(self) -> tuple[int, np.ndarray]:
         """``(kind, params)`` for compiled code; angles converted to rad."""
@@ -150,28 +153,13 @@ def from_dict(data: object, name: str = "") -> ButterflyController:
     """Validate plain data and build a controller; malformed data raises :class:`UserError`."""
     where = f"controller {name}" if name else "controller"
     check_header(data, FORMAT, where, kind="butterfly controller file")
-    check_keys(data, ("format", "version", "name", "description", "type", "flap", "parameters", "provenance"), where,
-               required=("type", "flap", "parameters"))
-    for key, kind in (("type", str), ("flap", dict), ("parameters", dict)):
-        if not isinstance(data.get(key), kind):
-            raise UserError(f"{where} needs a {key!r} entry of type {kind.__name__}.")
-    if data["type"] in PITCH_LAWS:
-        allowed = PITCH_LAWS[data["type"]][1] + (ANN_OPTIONAL if data["type"] == "ann" else ())
-        check_keys(data["parameters"], allowed, f"{where} 'parameters'")
-    check_keys(data["flap"], ("frequency_hz", "theta_min_deg", "theta_max_deg"), f"{where} 'flap'")
+    if data.get("type") not in PITCH_LAWS:  # the clearest sentence for an unknown law, before the schema's
+        raise UserError(f"{where}: unknown controller type {data.get('type')!r}; known types: "
+                        f"{', '.join(sorted(PITCH_LAWS))}.")
+    validate(data, json_schema(), where)
     flap = data["flap"]
-    try:
-        pattern = FlapPattern(
-            float(flap.get("frequency_hz", 10.0)), float(flap["theta_min_deg"]), float(flap["theta_max_deg"])
-        )
-    except (KeyError, TypeError, ValueError) as exc:
-        if isinstance(exc, UserError):
-            raise
-        raise UserError(f"{where} has a malformed 'flap' entry (needs theta_min_deg and theta_max_deg numbers).") from None
-    prov = data.get("provenance", {})
-    if not isinstance(prov, dict):
-        raise UserError(f"{where} has a 'provenance' entry that is not an object.")
-    return ButterflyController(data["type"], pattern, dict(data["parameters"]), dict(prov), name)
+    pattern = FlapPattern(flap.get("frequency_hz", 10.0), flap["theta_min_deg"], flap["theta_max_deg"])
+    return ButterflyController(data["type"], pattern, dict(data["parameters"]), dict(data.get("provenance", {})), name)
 
 
 def _check_ann(p: dict, where: str) -> None:
@@ -185,8 +173,8 @@ def _check_ann(p: dict, where: str) -> None:
     if len(w) != ann.n_weights(layers):
         what = "the network of section 6" if layers == ann.PAPER_LAYERS else f"a {list(layers)} network"
         raise UserError(f"{where} has {len(w)} weights; {what} needs {ann.n_weights(layers)}.")
-    if not all(math.isfinite(x) for x in w):
-        raise UserError(f"{where} has weights that are not finite numbers.")
+    if not all(math.isfinite(x) and abs(x) <= MAX_WEIGHT for x in w):
+        raise UserError(f"{where} has weights that are not finite numbers within +-{MAX_WEIGHT:g}.")
     if p.get("inputs") not in ann.INPUT_KINDS:
         raise UserError(f"{where} needs 'inputs' to be one of {', '.join(ann.INPUT_KINDS)}.")
     for key in ("max_dphi_deg", "phi_limit_deg"):
@@ -199,9 +187,10 @@ def _check_ann(p: dict, where: str) -> None:
     for key, v in scales.items():
         if key not in ann.SCALE_KEYS:
             raise UserError(f"{where} has an unknown input scale {key!r}; known: {', '.join(ann.SCALE_KEYS)}.")
-        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and abs(v) <= MAX_INPUT_SCALE
         if not ok or (key != "theta_center_deg" and v <= 0):
-            raise UserError(f"{where} has input scale {key} = {v!r}; it must be a positive number.")
+            raise UserError(f"{where} has input scale {key} = {v!r}; it must be a positive number up to "
+                            f"{MAX_INPUT_SCALE:g}.")
 
 
 def ann_controller(weights, flap: FlapPattern | None = None, inputs: str = "relative",
@@ -237,27 +226,31 @@ def json_schema() -> dict:
     """The JSON Schema of a butterfly controller file (``docs/schemas/butterfly-controller.schema.json``)."""
     from lifelike_mj.schema import document_schema, number
 
-    angle = number("deg", -90, 90)
+    angle = number("deg", -MAX_PITCH_DEG, MAX_PITCH_DEG)
     flap = {"type": "object", "additionalProperties": False, "required": ["theta_min_deg", "theta_max_deg"],
-            "properties": {"frequency_hz": number("flap frequency, Hz (the paper: 10)", exclusive_minimum=0),
+            "properties": {"frequency_hz": number("flap frequency, Hz (the paper: 10)", maximum=MAX_FLAP_HZ,
+                                                  exclusive_minimum=0),
                            "theta_min_deg": number("lowest flap angle, deg", -180, 180),
                            "theta_max_deg": number("highest flap angle, deg", -180, 180)}}
-    ann_params = {"weights": {"type": "array", "items": {"type": "number"},
+    max_weights = ann.n_weights((ann.N_INPUTS, *[ann.MAX_WIDTH] * ann.MAX_HIDDEN_LAYERS, 1))
+    ann_params = {"weights": {"type": "array", "maxItems": max_weights, "items": number("", -MAX_WEIGHT, MAX_WEIGHT),
                               "description": "49 weights for the 6-6-1 network, or as many as layers need"},
                   "inputs": {"enum": list(ann.INPUT_KINDS)},
-                  "input_scale": {"type": "object", "additionalProperties": {"type": "number", "exclusiveMinimum": 0}},
-                  "layers": {"type": "array", "items": {"type": "integer", "minimum": 1}},
-                  "max_dphi_deg": number("largest change of pitch per step, deg", exclusive_minimum=0),
-                  "phi_limit_deg": number("pitch limit, deg", exclusive_minimum=0)}
+                  "input_scale": {"type": "object", "additionalProperties": False,
+                                  "properties": {k: number("", -MAX_INPUT_SCALE, MAX_INPUT_SCALE) for k in ann.SCALE_KEYS}},
+                  "layers": {"type": "array", "minItems": 2, "maxItems": ann.MAX_HIDDEN_LAYERS + 2,
+                             "items": {"type": "integer", "minimum": 1, "maximum": max(ann.MAX_WIDTH, ann.N_INPUTS)}},
+                  "max_dphi_deg": number("largest change of pitch per step, deg", maximum=90, exclusive_minimum=0),
+                  "phi_limit_deg": number("pitch limit, deg", maximum=90, exclusive_minimum=0)}
     laws = {"simple_rule": {"phi_up_deg": angle, "phi_down_deg": angle}, "constant": {"phi_deg": angle},
             "ann": ann_params}
-    variants = [{"properties": {"type": {"const": t}, "parameters": {
-        "type": "object", "properties": props, "required": list(PITCH_LAWS[t][1]), "additionalProperties": False}}}
-        for t, props in laws.items()]
     schema = document_schema(FORMAT, "lifelike-mj butterfly controller",
                              {"type": {"enum": sorted(PITCH_LAWS)}, "flap": flap, "parameters": {"type": "object"},
                               "provenance": {"type": "object"}}, ["type", "flap", "parameters"],
                              "Oe 2010: a flap pattern and a pitch law (section 5.1 rule, a constant, or the "
                              "section 6 network) with its parameters.")
-    schema["oneOf"] = variants
+    schema["allOf"] = [{"if": {"properties": {"type": {"const": t}}, "required": ["type"]},
+                        "then": {"properties": {"parameters": {
+                            "type": "object", "properties": props, "required": list(PITCH_LAWS[t][1]),
+                            "additionalProperties": False}}}} for t, props in laws.items()]
     return schema

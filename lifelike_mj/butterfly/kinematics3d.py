@@ -32,6 +32,10 @@ from lifelike_mj.errors import UserError
 JOINTS = ("flap_left", "flap_right", "feather_left", "feather_right", "abdomen")
 
 
+#: The highest flap frequency a command may ask for (Hz).
+MAX_FREQUENCY_HZ = 100.0
+
+
 @dataclass(frozen=True)
 class KinematicsCommand:
     """One command: every parameter of the kinematics (Hz, rad). Defaults: the paper's section 6 flap
@@ -52,9 +56,21 @@ class KinematicsCommand:
     abdomen_phase: float = 0.0
 
     def __post_init__(self) -> None:
-        checks.number("frequency_hz", self.frequency_hz, 0.0, 100.0, lo_open=True, unit="Hz")
+        checks.number("frequency_hz", self.frequency_hz, 0.0, MAX_FREQUENCY_HZ, lo_open=True, unit="Hz")
         for f in fields(self)[1:]:
             checks.number(f.name, getattr(self, f.name), -math.pi, math.pi, unit="rad")
+
+    @staticmethod
+    def json_schema() -> dict:
+        """The JSON Schema of a command (the ``base`` of a 3D controller file): the bounds ``__post_init__`` checks."""
+        from lifelike_mj.schema import number
+
+        props = {"frequency_hz": number("flap frequency, Hz", maximum=MAX_FREQUENCY_HZ, exclusive_minimum=0.0)}
+        for f in fields(KinematicsCommand)[1:]:
+            props[f.name] = number("rad", -math.pi, math.pi)
+        return {"type": "object", "properties": props, "additionalProperties": False,
+                "description": "the kinematics (module lifelike_mj.butterfly.kinematics3d); missing ones take the "
+                               "defaults: 10 Hz over [-60, 75] deg"}
 
     def as_array(self) -> np.ndarray:
         return np.array([getattr(self, f.name) for f in fields(self)])

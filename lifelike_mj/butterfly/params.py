@@ -57,6 +57,11 @@ class ButterflyParams:
         return replace(self, **changes)
 
 
+#: The highest flap frequency (Hz) of a flap pattern: far above any insect's, and a period the time step can
+#: still be compared with.
+MAX_FLAP_HZ = 1000.0
+
+
 @dataclass(frozen=True)
 class FlapPattern:
     """Cosine flap ``theta(t) = theta_c + theta_a cos(2 pi f t)`` (Oe 2010 sections 4.3, 5.1, 6.3).
@@ -71,8 +76,8 @@ class FlapPattern:
     theta_max_deg: float = 90.0
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.frequency_hz) and self.frequency_hz > 0):
-            raise UserError(f"flap frequency must be positive, got {self.frequency_hz} Hz.")
+        if not (math.isfinite(self.frequency_hz) and 0 < self.frequency_hz <= MAX_FLAP_HZ):
+            raise UserError(f"flap frequency must be in (0, {MAX_FLAP_HZ:g}] Hz, got {self.frequency_hz} Hz.")
         lo, hi = self.theta_min_deg, self.theta_max_deg
         if not (math.isfinite(lo) and math.isfinite(hi) and -180.0 <= lo <= hi <= 180.0):
             raise UserError(f"flap range must satisfy -180 <= min <= max <= 180 degrees, got [{lo}, {hi}].")

@@ -1,4 +1,5 @@
-"""The JSON Schemas of every file format, gathered from the creatures (for ``docs/schemas/``)."""
+"""The JSON Schemas of every file format, gathered from the modules that own them (for ``docs/schemas/``): the
+same descriptions the loaders validate against (:func:`lifelike_mj.schema.validate`)."""
 
 from __future__ import annotations
 
@@ -9,11 +10,14 @@ def write_schemas(folder: str | Path) -> list[Path]:
     """Write every file format's JSON Schema into ``folder`` (for editors); returns the paths."""
     from lifelike_mj.boids.presets import grid_json_schema
     from lifelike_mj.boids.presets import json_schema as boids_schema
+    from lifelike_mj.butterfly.control3d import json_schema as butterfly3d_schema
     from lifelike_mj.butterfly.controllers import json_schema as butterfly_schema
+    from lifelike_mj.evolve.checkpoint import json_schema as checkpoint_schema
     from lifelike_mj.fish.params import json_schema as fish_schema
     from lifelike_mj.io import write_json
 
     out = Path(folder)
-    docs = {"butterfly-controller": butterfly_schema(), "fish-preset": fish_schema(), "boids-preset": boids_schema(),
-            "boids-grid": grid_json_schema()}
+    docs = {"butterfly-controller": butterfly_schema(), "butterfly3d-controller": butterfly3d_schema(),
+            "fish-preset": fish_schema(), "boids-preset": boids_schema(), "boids-grid": grid_json_schema(),
+            "evolve-checkpoint": checkpoint_schema()}
     return [write_json(out / f"{name}.schema.json", schema) for name, schema in docs.items()]

@@ -44,8 +44,10 @@ from typing import Any
 
 import numpy as np
 
+from lifelike_mj import checks
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import atomic_path
+from lifelike_mj.schema import validate
 
 FORMAT = "lifelike_mj.evolve.checkpoint"
 VERSION = 2
@@ -176,6 +178,100 @@ def guarded_run_files(out: str | Path, checkpoint: str | Path | None, *, resume:
         yield ckpt
 
 
+# ---- the one description of a checkpoint ---------------------------------------------------------------
+
+#: The optimisers whose state a checkpoint holds, and the layout of each state.
+_NLOPT = ("crs2", "esch", "isres")
+
+
+def json_schema() -> dict:
+    """The JSON Schema of a checkpoint's ``meta`` (``docs/schemas/evolve-checkpoint.schema.json``): every field's
+    type and bounds, the optimiser's state per optimiser, and, for each NumPy array the JSON refers to
+    (``{"__array__": "a0"}``), its kind and shape under the keyword ``x-array`` (``"dim"`` and ``"population"``
+    stand for the checkpoint's own values, ``"*"`` for any length). :func:`load_checkpoint` enforces it before any
+    value is used."""
+    from lifelike_mj.evolve.optimizers import OPTIMIZERS
+
+    nonfinite = {"type": "object", "properties": {"__float__": {"enum": ["nan", "inf", "-inf"]}},
+                 "required": ["__float__"], "additionalProperties": False}
+    real = {"anyOf": [{"type": "number"}, nonfinite]}
+
+    def array(kind: str, *shape: int | str, finite: bool = False) -> dict:
+        return {"type": "object", "properties": {"__array__": {"type": "string"}}, "required": ["__array__"],
+                "additionalProperties": False, "x-array": {"kind": kind, "shape": list(shape), "finite": finite}}
+
+    def obj(props: dict, required: list[str] | None = None) -> dict:
+        return {"type": "object", "properties": props, "required": list(props) if required is None else required,
+                "additionalProperties": False}
+
+    count = {"type": "integer", "minimum": 0}
+    u128 = {"type": "integer", "minimum": 0, "maximum": 2**128 - 1}
+    states = {
+        "rcga": obj({"P": array("float", "population", "dim", finite=True), "f": array("float", "population"),
+                     "rng": obj({"bit_generator": {"const": "PCG64"}, "state": obj({"state": u128, "inc": u128}),
+                                 "has_uint32": {"enum": [0, 1]},
+                                 "uinteger": {"type": "integer", "minimum": 0, "maximum": 2**32 - 1}})}),
+        "cmaes": obj({"F": array("float", "*"), "sizes": array("int", "*"), "digest": {"type": "string"},
+                      "cma_version": {"type": "string"}}),
+        **{n: obj({"X": array("float", "*", "dim", finite=True), "F": array("float", "*"),
+                   "nlopt_version": {"type": "string"}}) for n in _NLOPT},
+    }
+    record = obj({"generation": {"type": "integer", "minimum": 1}, "best": real, "mean": real,
+                  "evaluations": count, "elapsed_s": {"type": "number", "minimum": 0}})
+    return {
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "$id": "https://lifelike-mj.example/schemas/evolve-checkpoint.schema.json",
+        "title": "lifelike-mj evolution checkpoint (the JSON member 'meta' of the .npz)",
+        "description": "Arrays live beside the JSON in the .npz, referred to as {\"__array__\": NAME}; non-finite "
+                       "numbers are {\"__float__\": \"nan\" | \"inf\" | \"-inf\"}.",
+        "type": "object",
+        "properties": {
+            "format": {"const": FORMAT}, "version": {"const": VERSION}, "fingerprint": {"type": "string"},
+            "dim": {"type": "integer", "minimum": 1, "maximum": 10**7}, "maximize": {"type": "boolean"},
+            "optimizer": {"enum": list(OPTIMIZERS)}, "seed": {"type": "integer", "minimum": 0, "maximum": 2**64 - 1},
+            "population": {"type": "integer", "minimum": 1, "maximum": 10**7},
+            "budget": obj({"kind": {"enum": ["generations", "evaluations"]},
+                           "value": {"type": "integer", "minimum": 1}}),
+            "state": {"type": "object"},
+            "history": {"type": "array", "items": record},
+            "best_x": {"anyOf": [{"type": "null"}, array("float", "dim", finite=True)]},
+            "best_f": real, "evaluations": count, "generations": count,
+            "elapsed_s": {"type": "number", "minimum": 0}, "finished": {"type": "boolean"},
+            "saved_at": {"type": "number"}, "package": {"type": "string"},
+        },
+        "required": ["format", "version", "fingerprint", "dim", "maximize", "optimizer", "seed", "population", "budget",
+                     "state", "history", "best_x", "best_f", "evaluations", "generations", "elapsed_s", "finished"],
+        "additionalProperties": False,
+        "allOf": [{"if": {"properties": {"optimizer": {"const": n}}, "required": ["optimizer"]},
+                   "then": {"properties": {"state": st}}} for n, st in states.items()],
+    }
+
+
+def _array_problem(arrays: Any, meta: dict) -> Any:
+    """The ``x-array`` check of :func:`json_schema` over the archive ``arrays``: what is wrong with the array a
+    reference names (``None`` if nothing)."""
+
+    def check(ref: Any, spec: dict) -> str | None:
+        if not isinstance(ref, dict) or not isinstance(ref.get("__array__"), str):
+            return None  # the schema's own keywords report it
+        key = ref["__array__"]
+        if key not in arrays.files:
+            return f"refers to an array {key!r} the file does not hold"
+        a = arrays[key]
+        kinds = {"float": "fiu", "int": "iu"}[spec["kind"]]
+        if a.dtype.kind not in kinds and a.size:
+            return f"must be an array of {spec['kind']}s, got {a.dtype}"
+        want = [meta.get(d) if isinstance(d, str) and d != "*" else d for d in spec["shape"]]
+        ok = a.ndim == len(want) and all(w == "*" or not checks.is_whole(w) or n == w for n, w in zip(a.shape, want))
+        if not ok:
+            return f"must be an array of shape ({', '.join(map(str, spec['shape']))}) = {tuple(want)}, got {a.shape}"
+        if spec.get("finite") and a.size and not np.all(np.isfinite(a)):
+            return "must hold finite numbers only"
+        return None
+
+    return check
+
+
 def load_checkpoint(path: str | Path) -> dict[str, Any]:
     """Read a checkpoint; :class:`UserError` if it is unreadable, an old pickle, or not a checkpoint of this
     version. ``FileNotFoundError`` if there is no file."""
@@ -206,9 +302,12 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
             if meta.get("version") != VERSION:
                 raise UserError(f"checkpoint {path} has format version {meta.get('version')!r}, but this code reads "
                                 f"version {VERSION}.")
+            validate(meta, json_schema(), f"checkpoint {path}", arrays=_array_problem(arrays, meta))
             data = _decode(meta, arrays, path)
     except UserError:
         raise
+    except RecursionError:
+        raise UserError(f"checkpoint {path} is damaged (its meta is nested too deeply).") from None
     except Exception as exc:  # truncated zip, bad JSON, object arrays refused by allow_pickle=False, ...
         raise UserError(f"checkpoint {path} is unreadable ({type(exc).__name__}: {str(exc)[:160]}).") from None
     return data

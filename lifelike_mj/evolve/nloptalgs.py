@@ -55,6 +55,9 @@ def run_nlopt(run: Run, name: str, lower: np.ndarray, upper: np.ndarray, max_eva
     else:
         log_x = [np.array(x, dtype=np.float64) for x in run.state["X"]]
         log_f = [float(v) for v in run.state["F"]]
+        if len(log_x) != len(log_f):
+            raise UserError(f"checkpoint {run.checkpoint} is damaged (its log has {len(log_x)} points and "
+                            f"{len(log_f)} values).")
     replay = len(log_f)
     status = {"calls": 0, "stopping": False, "budget_spent": False, "recorded": replay}
 

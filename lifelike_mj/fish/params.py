@@ -55,7 +55,7 @@ import numpy as np
 from lifelike_mj import checks
 from lifelike_mj.errors import UserError
 from lifelike_mj.paths import controllers_dir, load_named_json
-from lifelike_mj.schema import check_header, check_keys, finite, number_list
+from lifelike_mj.schema import check_header, unit_of, validate
 
 FORMAT = "lifelike-mj/fish-preset"
 #: The paper's four patterns (section 5.1.1) and the calibrated default.
@@ -108,9 +108,11 @@ class FishParams:
                 t = np.array(self.transition, dtype=float)
             except (TypeError, ValueError):
                 raise UserError("transition must be a 4 x 4 matrix of numbers.") from None
-            if t.shape != (4, 4) or not np.all(np.isfinite(t)) or np.any(t < 0) or np.any(t.sum(axis=1) <= 0):
-                raise UserError("transition must be a 4 x 4 matrix of non-negative weights, each row with a "
-                                f"positive sum (rows: from accelerate, coast, cruise, brake), got {self.transition!r}.")
+            if (t.shape != (4, 4) or not np.all(np.isfinite(t)) or np.any(t < 0) or np.any(t > MAX_TRANSITION_WEIGHT)
+                    or np.any(t.sum(axis=1) <= 0)):
+                raise UserError(f"transition must be a 4 x 4 matrix of weights in [0, {MAX_TRANSITION_WEIGHT:g}], "
+                                "each row with a positive sum (rows: from accelerate, coast, cruise, brake), got "
+                                f"{self.transition!r}.")
             object.__setattr__(self, "transition", tuple(tuple(float(x) for x in row) for row in t))
         for f in fields(self):
             if f.name in ("name", "description", "transition"):
@@ -155,6 +157,9 @@ class FishParams:
             raise UserError(f"substeps must be a whole number from 1 to 100, got {self.substeps}.")
         if not 1.0 <= self.control_hz <= 10_000.0:
             raise UserError(f"control_hz must be in [1, 10000] Hz (the paper's is 60), got {self.control_hz}.")
+        for k, (lo, hi, lo_open) in RANGES.items():  # the same bounds as the preset file's schema
+            for x in (v if isinstance(v := getattr(self, k), tuple) else (v,)):
+                checks.number(f"fish parameter {k}", x, lo, hi, lo_open=lo_open, unit=unit_of(k))
 
     # ---- the Markov chain (section 3.3) ----
     def transition_matrix(self, avoiding: bool = False) -> np.ndarray:
@@ -203,25 +208,33 @@ class FishParams:
 
 _FIELDS = {f.name for f in fields(FishParams)} - {"name", "description"}
 
+#: Every number's range ``(low, high, low excluded)``: what :class:`FishParams` accepts and the preset file's
+#: schema says (:func:`json_schema`). The highs are far beyond a fish (a force of 1000 N on a 3 g fish) and
+#: keep every number that reaches the compiled tank finite; the tank reports a divergence long before.
+RANGES: dict[str, tuple[float, float, bool]] = {
+    **{k: (0.0, 1e6, False) for k in ("P_a", "P_b", "P_c", "P_d", "P_e")},
+    "r_min_N": (0.0, 1000.0, False), "r_max_N": (0.0, 1000.0, False),
+    "theta_range_deg": (0.0, 360.0, False), "phi_range_deg": (0.0, 360.0, False),
+    "balance_A_deg": (0.0, 180.0, False), "balance_k_per_deg": (0.0, 1000.0, False),
+    "inertia_radius_m": (0.0, 10.0, True), "water_density_kg_m3": (0.0, 1e5, True), "cd": (0.0, 1000.0, True),
+    "cd_rot": (0.0, 1e4, True), "buoyancy_offset_m": (0.0, 1.0, False),
+    "brake_dS_v_m2": (0.0, 1.0, False), "brake_dS_w_m5": (0.0, 1.0, False),
+    "vision_distance_m": (0.0, 100.0, True), "vision_angle_deg": (0.0, 90.0, True),
+    "avoid_duration_s": (0.0, 3600.0, False), "avoid_accel_gain": (1.0, 1e6, False),
+    "avoid_force_scale": (0.0, 1.0, True), "avoid_turn_deg": (0.0, 180.0, False),
+    "runaway_speed_bl_s": (0.0, 1e4, True), "control_hz": (1.0, 10_000.0, False), "substeps": (1.0, 100.0, False),
+}
+#: A transition weight's largest value (the matrix's rows are normalised).
+MAX_TRANSITION_WEIGHT = 1e6
+
 
 def params_from_dict(data: dict, name: str = "") -> FishParams:
     """Build :class:`FishParams` from a preset file's content (unknown keys are an error)."""
     where = f"fish preset {name}".strip()
     check_header(data, FORMAT, where, kind="fish preset")
-    check_keys(data, ("format", "version", "name", "description", "parameters"), where, required=("parameters",))
-    params = data["parameters"]
-    if not isinstance(params, dict):
-        raise UserError(f"{where}: 'parameters' must be an object, got {params!r}.")
-    check_keys(params, sorted(_FIELDS), f"{where} 'parameters'")
-    kw = {}
-    for k, v in params.items():
-        if k in ("brake_dS_v_m2", "brake_dS_w_m5"):
-            kw[k] = tuple(number_list(v, k, where, length=3))
-        elif k == "transition":
-            kw[k] = v
-        else:
-            kw[k] = finite(v, k, where)
-    return FishParams(**kw, name=str(data.get("name", name)), description=str(data.get("description", "")))
+    validate(data, json_schema(), where)
+    kw = {k: (tuple(v) if isinstance(v, list) else v) for k, v in data["parameters"].items()}
+    return FishParams(**kw, name=data.get("name", name), description=data.get("description", ""))
 
 
 def preset_path(name: str) -> Path:
@@ -235,13 +248,13 @@ def load_preset(name_or_path: str | Path | None = None, _seen: tuple[str, ...] =
     if isinstance(data, dict) and "same_as" in data:
         where = f"fish preset {p.stem}"
         check_header(data, FORMAT, where, kind="fish preset")
-        check_keys(data, ("format", "version", "name", "description", "same_as"), where)
-        target = str(data["same_as"])
+        validate(data, json_schema(), where)
+        target = data["same_as"]
         if target in _seen:
             raise UserError(f"fish preset {ref} refers back to itself through 'same_as'.")
         base = load_preset(target, (*_seen, ref))
-        return FishParams(**{k: getattr(base, k) for k in _FIELDS}, name=str(data.get("name", p.stem)),
-                          description=str(data.get("description", base.description)))
+        return FishParams(**{k: getattr(base, k) for k in _FIELDS}, name=data.get("name", p.stem),
+                          description=data.get("description", base.description))
     return params_from_dict(data, p.stem)
 
 
@@ -256,6 +269,10 @@ def json_schema() -> dict:
     """The JSON Schema of a fish preset file (``docs/schemas/fish-preset.schema.json``)."""
     from lifelike_mj.schema import document_schema, number, unit_of
 
+    def ranged(k: str, description: str) -> dict:
+        lo, hi, lo_open = RANGES[k]
+        return number(description, None if lo_open else lo, hi, exclusive_minimum=lo if lo_open else None)
+
     props: dict = {}
     for f in fields(FishParams):
         if f.name in ("name", "description"):
@@ -264,19 +281,21 @@ def json_schema() -> dict:
             props[f.name] = {"type": "array", "minItems": 4, "maxItems": 4, "description": "4 x 4 Markov weights, "
                              "rows from accelerate, coast, cruise, brake (instead of P_a..P_e)",
                              "items": {"type": "array", "minItems": 4, "maxItems": 4,
-                                       "items": {"type": "number", "minimum": 0}}}
+                                       "items": number("", 0, MAX_TRANSITION_WEIGHT)}}
         elif f.name.startswith("brake_dS"):
-            props[f.name] = {"type": "array", "minItems": 3, "maxItems": 3, "items": {"type": "number", "minimum": 0},
+            props[f.name] = {"type": "array", "minItems": 3, "maxItems": 3, "items": ranged(f.name, ""),
                              "description": f"per body axis (x, y, z), {unit_of(f.name)}"}
         elif f.name == "substeps":
             props[f.name] = {"type": "integer", "minimum": 1, "maximum": 100, "description": "MuJoCo steps per control step"}
         elif f.name == "control_hz":
-            props[f.name] = number("control steps per second, Hz (the paper: 60)", 1, 10_000)
+            props[f.name] = ranged(f.name, "control steps per second, Hz (the paper: 60)")
         else:
-            props[f.name] = number(unit_of(f.name) and f"unit: {unit_of(f.name)}", minimum=0)
+            props[f.name] = ranged(f.name, unit_of(f.name) and f"unit: {unit_of(f.name)}")
     params = {"type": "object", "properties": props, "additionalProperties": False,
               "description": "every parameter is optional; missing ones take the calibrated default (B-D)"}
     schema = document_schema(FORMAT, "lifelike-mj fish preset", {"parameters": params, "same_as": {"type": "string"}},
                              [], "Satoi 2015 motion units: a preset's parameters, or same_as another preset.")
-    schema["oneOf"] = [{"required": ["parameters"]}, {"required": ["same_as"]}]
+    schema["if"] = {"required": ["same_as"]}
+    schema["then"] = {"properties": {"parameters": False}}
+    schema["else"] = {"required": ["parameters"]}
     return schema

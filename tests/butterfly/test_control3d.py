@@ -96,16 +96,16 @@ def test_a_controller_file_round_trips_and_bad_ones_are_one_sentence(tmp_path):
     np.testing.assert_array_equal(again.weights, ctl.weights)
     assert again.to_dict() == ctl.to_dict()
     good = ctl.to_dict()
-    with pytest.raises(UserError, match="layers must run from 10 inputs to 9 outputs"):
+    with pytest.raises(UserError, match="layers must be whole numbers running from 10 inputs to 9 outputs"):
         c3.controller_from_dict(dict(good, layers=[6, 1]))
     with pytest.raises(UserError, match="need 89 finite weights"):
         c3.controller_from_dict(dict(good, weights=[0.0] * 84))
     with pytest.raises(UserError, match="unknown key 'wieghts'"):
         c3.controller_from_dict(dict(good, wieghts=good["weights"]))
-    with pytest.raises(UserError, match="inputs are 'ground' or 'air', got 'sky'"):
+    with pytest.raises(UserError, match="inputs must be 'ground' or 'air', got 'sky'"):
         c3.controller_from_dict(dict(good, inputs="sky"))
     assert c3.controller_from_dict({k: v for k, v in good.items() if k != "inputs"}).inputs == "ground"
-    with pytest.raises(UserError, match="unknown action 'yaw'"):
+    with pytest.raises(UserError, match="scale has an unknown key 'yaw'"):
         c3.controller_from_dict(dict(good, scale={"yaw": 0.1}))
     with pytest.raises(UserError, match="base has an unknown key 'flap_hz'"):
         c3.controller_from_dict(dict(good, base={"flap_hz": 10.0}))

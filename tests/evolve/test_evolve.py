@@ -475,7 +475,7 @@ def test_a_crafted_checkpoint_runs_no_code(tmp_path):
         np.savez(fh, meta=np.frombuffer(b'{"format": "%s", "version": %d, "state": {"__array__": "a0"}}'
                                         % (FORMAT.encode(), VERSION), dtype=np.uint8),
                  a0=np.array([_Marker(marker)], dtype=object))
-    with pytest.raises(UserError, match="unreadable"):
+    with pytest.raises(UserError, match="unreadable|lacks"):
         _run(Sphere(dim=3), "rcga", checkpoint=ckpt, resume=True)
     assert not marker.exists()
 
