@@ -75,3 +75,41 @@ def vector(name: str, v: object, n: int, unit: str = "") -> tuple[float, ...]:
         u = f" ({unit})" if unit else ""
         raise UserError(f"{name} must be {n} finite numbers{u}, got {v!r}.")
     return tuple(float(x) for x in items)
+
+
+# ---- how much work a command may ask for ---------------------------------------------------------------
+
+#: The most simulation steps one command may ask for, summed over every body it simulates (a flight, each fish
+#: of a tank, each butterfly of a garden) and every run it makes: 10^9, about an hour of a 3D garden or a
+#: 1,000-fish tank on two cores. The boids count agent-steps, which cost far less: see ``MAX_AGENT_STEPS``.
+MAX_BODY_STEPS = 1_000_000_000
+#: The most agent-steps of boids one command may ask for (2 x 10^9, about 20 minutes at the engine's speed).
+MAX_AGENT_STEPS = 2_000_000_000
+#: The most agent-steps of a boids sweep (every cell and seed): ten runs' worth, since a sweep runs on a process
+#: pool or a Ray cluster.
+MAX_SWEEP_AGENT_STEPS = 10 * MAX_AGENT_STEPS
+#: The most seeds (or courses) one command may run.
+MAX_SEEDS = 10_000
+#: The most simulation steps an evolution may ask for (generations x population x flights x steps per flight):
+#: 10^12, a thousand times the paper's whole evolution (1000 generations of 40 flights of 24,000 steps).
+MAX_EVOLUTION_STEPS = 1_000_000_000_000
+#: The most rows a recorded run may keep in memory (10^7 rows of a few dozen numbers: a few GB).
+MAX_RECORD_ROWS = 10_000_000
+#: The most frames a video or an exported animation may have (36,000: ten minutes at 60 frames per second).
+MAX_FRAMES = 36_000
+
+
+def work(what: str, amount: float, limit: float, unit: str, hint: str = "") -> int:
+    """Before any work: ``amount`` (of ``unit``: "steps", "frames") as an int, or a :class:`UserError` saying how
+    much ``what`` asks for and the limit (``hint``: what to change)."""
+    if not (math.isfinite(float(amount)) and amount <= limit):
+        tail = f" ({hint})" if hint else ""
+        raise UserError(f"{what} asks for {float(amount):,.0f} {unit}; at most {limit:,.0f} are allowed{tail}.")
+    return int(amount)
+
+
+def steps_of(duration_s: float, dt_s: float) -> int:
+    """The number of time steps of ``dt_s`` in ``duration_s`` (rounded; at least 1), computed without
+    building anything (a huge count is for :func:`work` to refuse)."""
+    n = float(duration_s) / float(dt_s)
+    return max(1, int(round(n))) if math.isfinite(n) and n < 1e18 else int(1e18)

@@ -92,6 +92,12 @@ class PitchProblem:
     def maximize(self) -> bool:
         return True
 
+    @property
+    def steps_per_candidate(self) -> int:
+        """Simulation steps one evaluation of a candidate takes (every flight of the task): what an evolution's
+        budget is checked against (:func:`~lifelike_mj.evolve.optimizers.check_work`)."""
+        return len(self.flights()) * check_timing(self.duration_s, self.dt_s)
+
     def describe(self) -> dict:
         """Plain-data description (what the fingerprint hashes; ``weighting`` only when not
         ``none`` and ``layers`` only when not the paper's, so that fingerprints made before either

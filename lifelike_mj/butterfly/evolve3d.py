@@ -176,7 +176,11 @@ class FlightProblem3D:
     def __post_init__(self) -> None:
         if not self.tasks:
             raise UserError("an evolution needs at least one task.")
-        checks.positive("duration_s", self.duration_s, "s")
+        checks.number("duration_s", self.duration_s, 0.0, 3600.0, lo_open=True, unit="s")
+        checks.number("dt_s", self.dt_s, 0.0, 0.01, lo_open=True, unit="s")
+        checks.number("gene_bound", self.gene_bound, 0.0, 1e6, lo_open=True)
+        checks.work(f"a training flight of {self.duration_s:g} s at {self.dt_s:g} s", checks.steps_of(self.duration_s,
+                    self.dt_s), checks.MAX_BODY_STEPS, "time steps")
         if not self.prior:
             self.prior = tuple(float(v) for v in self.template.weights)
         if len(self.prior) != self.dim:
@@ -203,6 +207,12 @@ class FlightProblem3D:
     @property
     def maximize(self) -> bool:
         return True
+
+    @property
+    def steps_per_candidate(self) -> int:
+        """Simulation steps one evaluation of a candidate takes (one flight per task): what an evolution's budget
+        is checked against (:func:`~lifelike_mj.evolve.optimizers.check_work`)."""
+        return len(self.tasks) * checks.steps_of(self.duration_s, self.dt_s)
 
     def describe(self) -> dict:
         t = self.template.to_dict()

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from lifelike_mj import checks
 from lifelike_mj.butterfly import aero, backends, controllers
 from lifelike_mj.butterfly.flight import Trajectory
 from lifelike_mj.butterfly.params import ButterflyParams
@@ -318,6 +319,10 @@ def e4_trim(
         raise UserError(f"trim range must satisfy lo < hi, got [{lo_deg}, {hi_deg}] deg.")
     if not (math.isfinite(tol_deg) and tol_deg > 0):
         raise UserError(f"trim tolerance must be positive, got {tol_deg} deg.")
+    rounds = math.ceil(math.log((hi_deg - lo_deg) / tol_deg, 17 if backend == "paper" else 2)) + 1
+    flights = (16 * rounds if backend == "paper" else 5 + 2 * rounds) + 3  # the search, then 3 recorded flights
+    checks.work(f"E4's search ({flights} flights of {duration_s:g} s at {dt_s:g} s)",
+                flights * checks.steps_of(duration_s, dt_s), checks.MAX_BODY_STEPS, "time steps", "a larger time step")
     base = controllers.load("simple_rule").with_parameters(phi_down_deg=0.0)
     # the search needs the climb-rate slope only: sample about every millisecond
     search_every = max(1, int(round(1e-3 / dt_s)))

@@ -25,6 +25,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from lifelike_mj import checks
 from lifelike_mj.butterfly.ann import ann_pitch, mlp_pitch
 from lifelike_mj.butterfly.controllers import KIND_ANN, KIND_MLP, KIND_SIMPLE_RULE, OMEGA_EPS
 from lifelike_mj.errors import UserError
@@ -43,8 +44,6 @@ class Condition:
     wind_m_s: tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self) -> None:
-        from lifelike_mj import checks
-
         checks.number("the start altitude y0", self.y0_m, -MAX_ALTITUDE_M, MAX_ALTITUDE_M, unit="m")
         w = self.wind_m_s
         if not (isinstance(w, (tuple, list)) and len(w) == 2):
@@ -65,6 +64,10 @@ def check_timing(duration_s: float, dt_s: float, record_every: int = 1) -> int:
         raise UserError(f"time step must be in (0, 0.1] s, got {dt_s}.")
     if record_every < 1:
         raise UserError("record_every must be at least 1.")
+    steps = checks.work(f"a flight of {duration_s:g} s at a time step of {dt_s:g} s", checks.steps_of(duration_s, dt_s),
+                        checks.MAX_BODY_STEPS, "time steps", "a shorter flight or a larger time step")
+    checks.work(f"recording a flight of {steps:,} steps every {record_every} steps", steps / record_every,
+                checks.MAX_RECORD_ROWS, "rows", "a shorter flight, a larger time step or recording less often")
     return int(round(duration_s / dt_s))
 
 

@@ -21,6 +21,7 @@ from lifelike_mj.butterfly import control3d as c3
 from lifelike_mj.butterfly import evolve3d as e3
 from lifelike_mj.butterfly.backends import mj3d
 from lifelike_mj.butterfly.kinematics3d import Kinematics
+from lifelike_mj.butterfly.sim3d import DT_S
 from lifelike_mj.errors import Diverged, UserError
 from lifelike_mj.physics import mjabi
 from lifelike_mj.physics.callbacks import passive_callback
@@ -106,7 +107,7 @@ class Garden(StepCounter):
 
     def __init__(self, n: int = 20, controller="steer", *, seed: int = 0, n_flowers: int = 10, size_m: float = 6.0,
                  speed_m_s: float = 1.5, flutter: float = 0.1, gust_m_s: float = 0.0, wind_m_s=(0.0, 0.0, 0.0),
-                 gust_vertical_m_s: float | None = None, dt_s: float = 1.0 / 1200.0, n_strips: int = 8, n_chord: int = 2,
+                 gust_vertical_m_s: float | None = None, dt_s: float = DT_S, n_strips: int = 8, n_chord: int = 2,
                  force_law: str = "exact") -> None:
         self.n = checks.whole("the number of butterflies", n, 1, 500)
         self.controller = controller if isinstance(controller, c3.Controller3D) else c3.load_controller(controller)

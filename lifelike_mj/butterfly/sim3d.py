@@ -54,6 +54,8 @@ STATE_UNITS = {
 }
 
 _NO_PATH = np.empty((0, 7))
+#: The 3D flight's time step (s): 120 steps per 10 Hz wing beat.
+DT_S = 1.0 / 1200.0
 #: The fewest time steps per wing beat a 3D flight accepts.
 MIN_STEPS_PER_BEAT = 8
 #: A speed above this (m/s) is a runaway: the flight has diverged.
@@ -101,7 +103,7 @@ class Flight3D(StepCounter):
     def __init__(self, command: KinematicsCommand | None = None, params: ButterflyParams | None = None, *,
                  controller=None, task=None, control_every: int = 1, wind_m_s=None,
                  start_m=(0.0, 0.0, 0.0), force_law: str = "exact", drag_frame: str = "body",
-                 body_areas_m2=None, masses: str = "animal", dt_s: float = 1.0 / 1200.0, n_strips: int = 8,
+                 body_areas_m2=None, masses: str = "animal", dt_s: float = DT_S, n_strips: int = 8,
                  n_chord: int = 2, drive_hz: float = 50.0, omega_c: float | None = None, assist: str = "none",
                  pitch_law: Callable | None = None, _model: mujoco.MjModel | None = None) -> None:
         from lifelike_mj.butterfly import control3d, evolve3d
@@ -292,7 +294,7 @@ class Flight3D(StepCounter):
     def _check_alive(self) -> None:
         if self._diverged:
             raise Diverged(f"{self._diverged} the likely cause is the time step ({self.dt:g} s), the constants or "
-                           "the controller's commands.")
+                           "the controller's commands.", self._k)
 
     @property
     def reward(self) -> float:
@@ -337,7 +339,11 @@ class Flight3D(StepCounter):
             raise UserError("give either n_steps or duration_s.")
         every = checks.whole("every", every, 1)
         n = (checks.whole("the number of steps", n_steps, 1) if n_steps is not None
-             else max(1, int(round(checks.positive("duration", duration_s, "s") / self.dt))))
+             else checks.steps_of(checks.positive("duration", duration_s, "s"), self.dt))
+        checks.work(f"a 3D flight of {n:,} steps", n, checks.MAX_BODY_STEPS, "time steps",
+                    "a shorter flight or a larger time step")
+        checks.work(f"recording {n:,} steps every {every}", n / every, checks.MAX_RECORD_ROWS, "rows",
+                    "recording less often")
         rows, times = [self.state()], [self.time]
         for _ in range(n // every):
             self.step(every)

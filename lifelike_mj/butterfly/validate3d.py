@@ -12,8 +12,10 @@ import math
 
 import numpy as np
 
+from lifelike_mj import checks
 from lifelike_mj.butterfly.controllers import ButterflyController
 from lifelike_mj.butterfly.flight import pitch_command
+from lifelike_mj.errors import UserError
 
 
 def kinematics_of(controller: ButterflyController):
@@ -75,6 +77,20 @@ def _beat_means(t: np.ndarray, x: np.ndarray, period_s: float) -> tuple[np.ndarr
     return ts, xs
 
 
+#: The longest flight a check flies (s).
+MAX_CHECK_S = 3600.0
+
+
+def check_window(what: str, duration_s: float, settle_s: float, least_s: float, why: str) -> None:
+    """Before a check flies: :class:`UserError` unless its ``duration_s`` is finite, at most :data:`MAX_CHECK_S`,
+    and leaves at least ``least_s`` after its own settling time ``settle_s`` (``why``: what it measures then)."""
+    checks.number(f"{what}'s settling time", settle_s, 0.0, MAX_CHECK_S, unit="s")
+    d = checks.number(f"{what}'s duration", duration_s, 0.0, MAX_CHECK_S, lo_open=True, unit="s")
+    if d < settle_s + least_s:
+        raise UserError(f"{what} needs a duration of at least {settle_s + least_s:g} s ({settle_s:g} s of settling "
+                        f"and {least_s:g} s to measure{'; ' + why if why else ''}), got {d:g} s.")
+
+
 def level_check(controller, speed_m_s: float = 1.5, duration_s: float = 60.0, settle_s: float = 5.0, **flight) -> dict:
     """Fly ``controller`` level at ``speed_m_s`` for ``duration_s`` and measure it: the speed over ground
     each second after ``settle_s`` (m/s), the altitude throughout (m; the reference is the start, 0 m), and
@@ -82,6 +98,7 @@ def level_check(controller, speed_m_s: float = 1.5, duration_s: float = 60.0, se
     from lifelike_mj.butterfly import evolve3d
     from lifelike_mj.butterfly.sim3d import Flight3D
 
+    check_window("the level check", duration_s, settle_s, 1.0, "it measures the speed each second after settling")
     f = Flight3D(controller=controller, task=evolve3d.level(speed_m_s), **flight)
     rec = f.record(duration_s=duration_s, every=12)
     t, pos, att = rec["t_s"], rec["position_m"], rec["attitude_rad"]
@@ -109,6 +126,8 @@ def turn_check(controller, angle_deg: float, at_s: float = 2.0, hold_s: float = 
     from lifelike_mj.butterfly import evolve3d
     from lifelike_mj.butterfly.sim3d import Flight3D
 
+    checks.number("at_s", at_s, 0.0, MAX_CHECK_S, unit="s")
+    check_window("the turn check", at_s + hold_s, at_s, 1.0, "it measures the course over the hold after the command")
     f = Flight3D(controller=controller, task=evolve3d.turn(angle_deg, at_s, speed_m_s), **flight)
     period = 1.0 / f.command.frequency_hz
     rec = f.record(duration_s=at_s + hold_s, every=12)
@@ -145,6 +164,8 @@ def course_check(controller, seed: int, n: int = 10, max_s: float = 60.0, weathe
     from lifelike_mj.butterfly import evolve3d
     from lifelike_mj.butterfly.sim3d import Flight3D
 
+    checks.whole("the waypoints n", n, 1, 10_000)
+    check_window("the course check", max_s, 0.0, 0.1, "")
     task = evolve3d.course(seed, n)
     if weather:
         task = task.with_weather(**weather)
@@ -169,6 +190,8 @@ def kinematics_check(controller, speed_m_s: float = 1.5, settle_s: float = 5.0, 
     from lifelike_mj.butterfly import evolve3d
     from lifelike_mj.butterfly.sim3d import Flight3D
 
+    check_window("the kinematics check", settle_s + window_s, settle_s, 0.5, "it measures whole wing beats in the "
+                 "window after settling")
     f = Flight3D(controller=controller, task=evolve3d.level(speed_m_s), force_law=force_law, **flight)
     f.step(int(round(settle_s / f.dt)))
     rec = f.record(duration_s=window_s, every=1)
@@ -200,6 +223,7 @@ def target_check(controller, duration_s: float = 40.0, catch_s: float = 10.0, **
     from lifelike_mj.butterfly.control3d import R_WP
     from lifelike_mj.butterfly.sim3d import Flight3D
 
+    check_window("the target check", duration_s, catch_s, 0.1, "it measures the distance after the catch time")
     task = evolve3d.moving_target(**target)
     f = Flight3D(controller=controller, task=task)
     dist, times = [], []

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from lifelike_mj.cli.common import (
@@ -19,10 +20,11 @@ from lifelike_mj.cli.common import (
 from lifelike_mj.errors import UserError
 
 NAME = "boids"
-#: Bounds of the command line: agents, steps, and agents x steps of one run (about an hour here).
+#: Bounds of the command line: agents, steps, and values of a sweep axis (agents x steps:
+#: :data:`~lifelike_mj.checks.MAX_AGENT_STEPS` per run, :data:`~lifelike_mj.checks.MAX_SWEEP_AGENT_STEPS` per sweep).
 MAX_AGENTS = 1_000_000
 MAX_STEPS = 1_000_000
-MAX_AGENT_STEPS = 2_000_000_000
+MAX_AXIS_VALUES = 1_000
 RUN_FILES = ("trajectories.npz", "trajectories.csv", "measures.json")
 HELP = "the heterogeneous boids of Nakamura 2013"
 
@@ -36,13 +38,15 @@ def _add_boids(p) -> None:
     p.add_argument("--dims", type=int, default=3, choices=(3, 2), help="3 or 2 (section 4.3)")
 
 
-def _check_size(n: int, steps: int | None) -> None:
+def _check_size(n: int, steps: int | None) -> int:
+    """The agent-steps of one run of ``n`` agents for ``steps`` (default the paper's), refused above
+    :data:`~lifelike_mj.checks.MAX_AGENT_STEPS`."""
+    from lifelike_mj import checks
     from lifelike_mj.boids.metrics import RUN_STEPS
 
-    total = n * (steps or RUN_STEPS)
-    if total > MAX_AGENT_STEPS:
-        raise UserError(f"--n {n:,} for {steps or RUN_STEPS:,} steps is {total:,} agent-steps; at most "
-                        f"{MAX_AGENT_STEPS:,} per run (fewer agents or steps).")
+    steps = steps or RUN_STEPS
+    return checks.work(f"--n {n:,} for {steps:,} steps", n * steps, checks.MAX_AGENT_STEPS, "agent-steps",
+                       "fewer agents or steps")
 
 
 def _params(args):
@@ -64,25 +68,31 @@ def _params(args):
 def _axis(spec: str) -> tuple[str, list[float]]:
     import numpy as np
 
+    from lifelike_mj import checks
+
     try:
         name, rng = spec.split("=")
         a, b, k = rng.split(":")
-        values = [float(x) for x in np.linspace(float(a), float(b), int(k))]
+        lo, hi, n = float(a), float(b), int(k)
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            raise ValueError
     except ValueError:
-        raise UserError(f"a sweep axis looks like wa_cross=-0.3:0.5:9 (name=start:stop:count), got {spec!r}.") from None
-    if len(values) < 1:
+        raise UserError(f"a sweep axis looks like wa_cross=-0.3:0.5:9 (name=start:stop:count, finite numbers and a "
+                        f"whole count), got {spec!r}.") from None
+    if n < 1:
         raise UserError(f"a sweep axis needs at least one value, got {spec!r}.")
-    return name, values
+    checks.work(f"sweep axis {spec!r}", n, MAX_AXIS_VALUES, "values")
+    return name, [float(x) for x in np.linspace(lo, hi, n)]
 
 
 def cmd_run(args) -> None:
     from lifelike_mj.boids.experiments import measured_run, write_run
 
-    check_outputs(args, files={"--plot": (".png",)}, folders={"--out": RUN_FILES})
     _check_size(args.n, args.steps)
     params = _params(args)
     if args.record_every is not None and not args.out:
         raise UserError("--record-every only applies with --out (it chooses what the trajectory files keep).")
+    check_outputs(args, files={"--plot": (".png",)}, folders={"--out": RUN_FILES})
     run, out = measured_run(params, args.n, args.seed, args.steps, progress=True, record_every=args.record_every)
     if args.plot:
         from lifelike_mj.boids.figures import pattern_figure
@@ -99,12 +109,12 @@ def cmd_run(args) -> None:
 def cmd_sweep(args) -> None:
     import numpy as np
 
+    from lifelike_mj import checks
     from lifelike_mj.boids.experiments import Sweep, run_sweep, write_sweep
     from lifelike_mj.boids.presets import homogeneous, load_grid
 
-    check_outputs(args, folders={"--out": ("sweep.json", "phase_diagram.png")})
     check_executor(args)
-    _check_size(args.n, args.steps)
+    per_run = _check_size(args.n, args.steps)
     seed_list = seeds(args.seeds)
     if args.grid:
         g = load_grid(args.grid)
@@ -121,8 +131,11 @@ def cmd_sweep(args) -> None:
         sweep = Sweep(_params(args), tuple(axes), args.n, args.steps)
     from lifelike_mj.progress import stage
 
-    sweep.check_cells(values)  # bad axes or weights: one sentence before the progress bar starts
     n_runs = len(seed_list) * int(np.prod([len(v) for v in values]))
+    checks.work(f"a sweep of {n_runs:,} runs of --n {args.n:,}", n_runs * per_run, checks.MAX_SWEEP_AGENT_STEPS,
+                "agent-steps", "fewer cells, seeds, agents or steps")
+    sweep.check_cells(values)  # bad axes or weights: one sentence before the progress bar starts
+    check_outputs(args, folders={"--out": ("sweep.json", "phase_diagram.png")})
     with stage(f"sweep: {n_runs} runs on {args.executor}"):
         res = run_sweep(sweep, values, seed_list, executor=args.executor, workers=args.workers,
                         ray_address=args.ray_address)
@@ -228,12 +241,15 @@ def add_export_args(p: argparse.ArgumentParser) -> None:
 
 
 def export_poses(args):
+    from lifelike_mj import checks
     from lifelike_mj.boids.sim import Flock
-    from lifelike_mj.cli.export import parameters_of, run_window
+    from lifelike_mj.cli.export import check_window, parameters_of, run_window
 
     _check_size(args.n, args.start + args.steps)
     if args.steps < args.steps_per_frame:
         raise UserError(f"--steps {args.steps} is fewer than one frame of --steps-per-frame {args.steps_per_frame}.")
+    check_window(args.start, args.steps, 1.0 / args.steps_per_frame, 1.0, unit="steps", bodies=args.n,
+                 limit=checks.MAX_AGENT_STEPS, body_unit="agent-steps")
     flock = Flock(_params(args), args.n, args.seed)
     return (run_window(flock, args.start, args.steps, 1.0 / args.steps_per_frame,
                        1.0 / (args.steps_per_frame * args.fps), unit="steps"), parameters_of(args))

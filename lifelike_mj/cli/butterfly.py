@@ -421,8 +421,9 @@ def add_export_args(p: argparse.ArgumentParser) -> None:
 
 def export_poses(args):
     from lifelike_mj.butterfly import Flight
-    from lifelike_mj.cli.export import parameters_of, run_window
+    from lifelike_mj.cli.export import check_window, parameters_of, run_window
 
+    check_window(args.start, args.duration, args.fps, 1.0 / 1200.0)
     flight = Flight(_controller(args), params(args), _condition(args), backend="mujoco", config=args.config,
                     force_mode=args.force_mode)
     return run_window(flight, args.start, args.duration, args.fps), parameters_of(args)

@@ -13,6 +13,9 @@ from lifelike_mj.progress import stage
 #: The files of ``fly3d --out``.
 FLY3D_FILES = ("path.npz", "path.csv", "paths.png", "summary.json")
 MAX_DURATION_S = 3600.0
+#: The settling time of assess3d's level flight (s), and the most courses it flies.
+LEVEL_SETTLE_S = 5.0
+MAX_COURSES = 1000
 
 
 def _vector3(text: str) -> tuple[float, float, float]:
@@ -44,8 +47,8 @@ def cmd_fly3d(args) -> None:
     from lifelike_mj.butterfly.control3d import load_controller
     from lifelike_mj.butterfly.sim3d import Flight3D
 
-    check_outputs(args, folders={"--out": FLY3D_FILES})
     ctrl = load_controller(args.controller)
+    check_outputs(args, folders={"--out": FLY3D_FILES})
     flight = Flight3D(controller=ctrl, task=_task(args))
     with stage(f"3D flight, {args.duration:g} s"):
         rec = flight.record(duration_s=args.duration, every=12)
@@ -97,11 +100,13 @@ def cmd_evolve3d(args) -> None:
 
 def cmd_assess3d(args) -> None:
     from lifelike_mj.butterfly.control3d import load_controller
-    from lifelike_mj.butterfly.validate3d import course_check, level_check, turn_check
+    from lifelike_mj.butterfly.validate3d import check_window, course_check, level_check, turn_check
 
+    check_window("the level flight (--duration)", args.duration, LEVEL_SETTLE_S, 1.0,
+                 "it measures the speed each second after settling")
     ctrl = load_controller(args.controller)
     with stage("level flight, turns of 90 and 180 deg, courses"):
-        level = level_check(ctrl, args.speed, args.duration)
+        level = level_check(ctrl, args.speed, args.duration, LEVEL_SETTLE_S)
         turns = [turn_check(ctrl, a, speed_m_s=args.speed) for a in (90.0, -90.0, 180.0)]
         weather = {"wind_m_s": args.wind, "gust_m_s": args.gusts, "gust_vertical_m_s": args.vertical_gusts}
         courses = [course_check(ctrl, s, weather=weather) for s in args.courses]
@@ -120,11 +125,18 @@ def cmd_assess3d(args) -> None:
 def cmd_garden(args) -> None:
     import numpy as np
 
+    from lifelike_mj import checks
     from lifelike_mj.butterfly.control3d import load_controller
     from lifelike_mj.butterfly.garden import Garden, film_garden
+    from lifelike_mj.butterfly.sim3d import DT_S
 
-    check_outputs(args, files={"--out": (".mp4", ".gif"), "--paths": (".png",)})
+    checks.work(f"a garden of {args.n} butterflies for {args.duration:g} s",
+                args.n * checks.steps_of(args.duration, DT_S), checks.MAX_BODY_STEPS, "butterfly-steps")
+    if args.out:
+        checks.work(f"a video of {args.duration:g} s at {args.fps} frames/s", checks.steps_of(args.duration, 1 / args.fps),
+                    checks.MAX_FRAMES, "frames", "a shorter garden or fewer frames per second")
     ctrl = load_controller(args.controller)
+    check_outputs(args, files={"--out": (".mp4", ".gif"), "--paths": (".png",)})
     garden = Garden(args.n, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_m_s=args.wind,
                     gust_vertical_m_s=args.vertical_gusts)
     d: dict = {"butterflies": args.n, "seed": args.seed, "controller": ctrl.name or args.controller}
@@ -169,7 +181,7 @@ def _seeds(text: str) -> list[int]:
     from lifelike_mj.cli.common import seeds
 
     try:
-        return seeds(text)
+        return seeds(text, "the range", MAX_COURSES)
     except UserError as exc:
         raise argparse.ArgumentTypeError(str(exc).rstrip(".")) from None
 
@@ -273,8 +285,10 @@ def add_export_args(p: argparse.ArgumentParser) -> None:
 
 def export_poses(args):
     from lifelike_mj.butterfly.control3d import load_controller
-    from lifelike_mj.cli.export import parameters_of, run_window
+    from lifelike_mj.butterfly.sim3d import DT_S
+    from lifelike_mj.cli.export import check_window, parameters_of, run_window
 
+    check_window(args.start, args.duration, args.fps, DT_S, bodies=args.garden or 1)
     ctrl = load_controller(args.controller)
     if args.garden:
         from lifelike_mj.butterfly.garden import Garden

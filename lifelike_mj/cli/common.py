@@ -111,19 +111,26 @@ def add_run_files(p: argparse.ArgumentParser, out_help: str) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
-def seeds(text: str) -> list[int]:
-    """``0-4`` or ``0,3,7`` as a list of seeds."""
+def seeds(text: str, what: str = "--seeds", limit: int | None = None) -> list[int]:
+    """``0-4`` or ``0,3,7`` as a list of seeds (at most ``limit``, :data:`~lifelike_mj.checks.MAX_SEEDS` by default,
+    refused before the list is built)."""
+    from lifelike_mj import checks
+
+    limit = checks.MAX_SEEDS if limit is None else limit
+    bad = UserError(f"{what} must look like 0-4 or 0,1,2 (seeds from 0 to 2^32-1, a range low to high), got {text!r}.")
     try:
-        if "-" in text:
+        if "-" in text.lstrip("-"):
             a, b = (int(x) for x in text.split("-"))
-            out = list(range(a, b + 1))
+            ends = [a, b]
         else:
-            out = [int(x) for x in text.split(",")]
+            ends = [int(x) for x in text.split(",")]
     except ValueError:
-        raise UserError(f"--seeds must look like 0-4 or 0,1,2, got {text!r}.") from None
-    if not out or min(out) < 0:
-        raise UserError(f"--seeds must name non-negative seeds, got {text!r}.")
-    return out
+        raise bad from None
+    if not ends or min(ends) < 0 or max(ends) > 2**32 - 1 or ("-" in text and ends[1] < ends[0]):
+        raise bad
+    n = ends[1] - ends[0] + 1 if "-" in text else len(ends)
+    checks.work(f"{what} {text}", n, limit, "seeds", "a shorter range" if "-" in text else "")
+    return list(range(ends[0], ends[1] + 1)) if "-" in text else ends
 
 
 def add_executor(p: argparse.ArgumentParser) -> None:

@@ -86,10 +86,24 @@ def parameters_of(args: argparse.Namespace) -> dict:
     return {k: (list(v) if isinstance(v, tuple) else v) for k, v in vars(args).items() if k not in skip}
 
 
+def check_window(start: float, duration: float, per_unit: float, dt: float, unit: str = "s", bodies: int = 1,
+                 limit: int | None = None, body_unit: str = "body-steps") -> None:
+    """Before the simulation is built: the window's frames (:func:`~lifelike_mj.export.poses.frames_of`: at least
+    2, at most :data:`~lifelike_mj.checks.MAX_FRAMES`) and the steps of ``dt`` of ``bodies`` simulated bodies over
+    ``start + duration`` (at most ``limit``, :data:`~lifelike_mj.checks.MAX_BODY_STEPS` by default)."""
+    from lifelike_mj import checks
+    from lifelike_mj.export.poses import frames_of
+
+    frames_of(duration, per_unit, unit)
+    total = checks.steps_of(start + duration, dt) * bodies
+    checks.work(f"simulating {start + duration:g} {unit} of {bodies:,} {'bodies' if bodies > 1 else 'body'}",
+                total, checks.MAX_BODY_STEPS if limit is None else limit, body_unit, "a shorter --start or --duration")
+
+
 def run_window(stepper, start: float, duration: float, per_unit: float, time_scale: float = 1.0, unit: str = "s"):
     """Simulate ``start`` units of the stepper's time unrecorded, then record ``duration`` of them with
     ``per_unit`` frames per unit (:func:`~lifelike_mj.export.poses.record_poses`; ``time_scale``: seconds
-    of playback per unit)."""
+    of playback per unit). Each creature checks its window first (:func:`check_window`)."""
     from lifelike_mj.export.poses import record_poses
     from lifelike_mj.progress import stage
 

@@ -45,11 +45,18 @@ def cmd_swim(args) -> None:
     from lifelike_mj.fish.experiments import swim_summary, write_swim
     from lifelike_mj.fish.sim import swim
 
-    check_outputs(args, files={"--video": (".mp4", ".gif")}, folders={"--out": SWIM_FILES})
     if args.video_duration != 10.0 and not args.video:
         raise UserError("--video-duration only applies with --video.")
     params = _preset(args)
     n = args.fish
+    from lifelike_mj import checks
+    from lifelike_mj.fish.sim import check_swim_work
+
+    check_swim_work(params, n, checks.steps_of(args.duration, params.control_dt_s))
+    if args.video:
+        checks.work("--video", checks.steps_of(min(args.duration, args.video_duration), 1.0 / 30), checks.MAX_FRAMES,
+                    "frames")
+    check_outputs(args, files={"--video": (".mp4", ".gif")}, folders={"--out": SWIM_FILES})
     r = swim(params, n, positive("--duration", args.duration), args.seed, _tank(args), progress=True)
     summary = swim_summary(r)
     if args.out:
@@ -159,8 +166,11 @@ def add_export_args(p: argparse.ArgumentParser) -> None:
 
 
 def export_poses(args):
-    from lifelike_mj.cli.export import parameters_of, run_window
+    from lifelike_mj.cli.export import check_window, parameters_of, run_window
     from lifelike_mj.fish.sim import Tank
 
-    tank = Tank(_preset(args), args.fish, args.seed, _tank(args))
+    params = _preset(args)
+    check_window(args.start, args.duration, args.fps, params.control_dt_s, bodies=args.fish * params.substeps,
+                 body_unit="fish-steps (substeps included)")
+    tank = Tank(params, args.fish, args.seed, _tank(args))
     return run_window(tank, args.start, args.duration, args.fps), parameters_of(args)

@@ -113,6 +113,22 @@ class _SigtermAsInterrupt:
             signal.signal(signal.SIGTERM, self._old)
 
 
+def check_work(problem: Any, budget: Budget, population: int) -> None:
+    """Before an evolution starts: a problem that says what one candidate costs (``steps_per_candidate``,
+    simulation steps) is refused, in one sentence, when the whole budget would take more than
+    :data:`~lifelike_mj.checks.MAX_EVOLUTION_STEPS` steps."""
+    from lifelike_mj import checks
+
+    per = getattr(problem, "steps_per_candidate", None)
+    if per is None:
+        return
+    n = budget.value if budget.kind == "evaluations" else budget.value * population
+    what = (f"an evolution of {n:,} evaluations" if budget.kind == "evaluations"
+            else f"an evolution of {budget.value:,} generations of {population:,}")
+    checks.work(f"{what} (each {per:,} simulation steps)", float(n) * per, checks.MAX_EVOLUTION_STEPS, "steps",
+                "fewer generations, a smaller population or shorter flights")
+
+
 def optimize(problem: Any, optimizer: str, *, seed: int, population: int | None = None, generations: int | None = None,
              evaluations: int | None = None, evaluator: Evaluator | Callable[[np.ndarray], np.ndarray] | None = None,
              checkpoint: str | Path | None = None, resume: bool = False, progress: bool = True,
@@ -155,6 +171,7 @@ def optimize(problem: Any, optimizer: str, *, seed: int, population: int | None 
     elif population < least:
         raise UserError(f"population {population} is below the minimum {least} for {name}.")
     population = int(population)
+    check_work(problem, budget, population)
     if resume and checkpoint is None:
         raise UserError("resume=True needs a checkpoint path.")
     if checkpoint is not None:

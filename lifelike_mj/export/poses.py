@@ -58,6 +58,20 @@ def animated_bodies(model: mujoco.MjModel) -> np.ndarray:
     return bodies[bodies > 0]
 
 
+def frames_of(duration_s: float, fps: float, unit: str = "s") -> int:
+    """The frames :func:`record_poses` samples over ``duration_s`` (of the stepper's time unit ``unit``) at ``fps``
+    frames per unit, the first and the last included: checked before any simulation (at least 2, at most
+    :data:`~lifelike_mj.checks.MAX_FRAMES`)."""
+    fps = checks.positive("fps", fps, f"frames/{unit}")
+    duration_s = checks.positive("the duration", duration_s, unit)
+    n = float(np.floor(duration_s * fps + 1e-9)) + 1
+    if n < 2:
+        raise UserError(f"a window of {duration_s:g} {unit} at {fps:g} frames per {unit} holds a single frame; give "
+                        "more time or frames.")
+    return checks.work(f"a window of {duration_s:g} {unit} at {fps:g} frames per {unit}", n, checks.MAX_FRAMES,
+                       "frames", "a shorter window or fewer frames per second")
+
+
 def record_poses(stepper, duration_s: float, fps: float = 30.0, time_scale: float = 1.0) -> Poses:
     """Run ``stepper`` on for ``duration_s`` of its time from where it is, sampling its drawn bodies' poses
     ``fps`` times per unit of its time (the first frame is the state now). Each frame lies on the nearest
@@ -65,13 +79,9 @@ def record_poses(stepper, duration_s: float, fps: float = 30.0, time_scale: floa
     stepper's time (1 for the creatures that live in seconds; a flock's time is counted in steps, so
     ``time_scale = 1 / (steps per frame x frames per second)`` plays it at a frame rate). ``stepper``: anything
     in the stepper shape (``model``, ``data``, ``step``, ``sync``, ``dt``, ``time``)."""
-    fps = checks.positive("fps", fps, "frames/s")
-    duration_s = checks.positive("duration_s", duration_s, "s")
     time_scale = checks.positive("time_scale", time_scale, "s per unit")
+    n_frames = frames_of(duration_s, fps)
     dt = float(stepper.dt)
-    n_frames = int(np.floor(duration_s * fps + 1e-9)) + 1
-    if n_frames < 2:
-        raise UserError(f"a {duration_s:g} s run at {fps:g} frames/s has a single frame; give more time or frames.")
     t0 = float(stepper.time)
     done = 0
     times, pos, quat = [], [], []

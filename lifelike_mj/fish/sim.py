@@ -585,6 +585,10 @@ class Tank(StepCounter):
         self._k += k
         return pos, quat, mu
 
+    def check_work(self, steps: int, recorded: bool = True) -> None:
+        """:func:`check_swim_work` for this tank."""
+        check_swim_work(self.params, self.n_fish, steps, recorded)
+
     def record(self, n_steps: int | None = None, *, duration_s: float | None = None, chunk_steps: int = 60,
                progress: bool = False) -> SwimResult:
         """Swim on ``n_steps`` control steps (or ``duration_s`` s) and return the tracks at every control
@@ -594,7 +598,8 @@ class Tank(StepCounter):
         if (n_steps is None) == (duration_s is None):
             raise UserError("give either n_steps or duration_s.")
         total = (checks.whole("the number of steps", n_steps, 1) if n_steps is not None
-                 else int(round(checks.positive("duration", duration_s, "s") * self.params.control_hz)))
+                 else checks.steps_of(checks.positive("duration", duration_s, "s"), self.params.control_dt_s))
+        self.check_work(total)
         t0 = time.perf_counter()
         k0 = self._k
         p0, q0 = self.snapshot()
@@ -673,6 +678,18 @@ class Tank(StepCounter):
 
 def _check_seed(seed) -> int:
     return checks.whole("seed", seed, 0)
+
+
+def check_swim_work(params: FishParams, n_fish: int, steps: int, recorded: bool = True) -> None:
+    """Before ``steps`` control steps of ``n_fish`` fish: refused in one sentence when their MuJoCo steps would pass
+    :data:`~lifelike_mj.checks.MAX_BODY_STEPS` or, ``recorded``, the tracks' rows (one per fish and step)
+    :data:`~lifelike_mj.checks.MAX_RECORD_ROWS`."""
+    what = f"{n_fish:,} fish for {steps:,} control steps"
+    checks.work(what, float(steps) * n_fish * params.substeps, checks.MAX_BODY_STEPS, "fish-steps (substeps included)",
+                "fewer fish or a shorter swim")
+    if recorded:
+        checks.work(f"recording {what}", float(steps) * n_fish, checks.MAX_RECORD_ROWS, "track rows",
+                    "fewer fish or a shorter swim")
 
 
 def swim(params: FishParams, n_fish: int = 10, duration_s: float = 30.0, seed: int = 0, size=None,

@@ -87,6 +87,8 @@ def write_frames(out: Path, suffix: str, fps: float, n_frames: int, advance: Cal
     """Write ``n_frames`` frames to ``out`` (atomically; nothing left on an error): frame ``j`` is
     ``advance(j)`` (the simulation) then ``draw(j)`` (an RGB image), then encoding. Returns the wall
     seconds of each part: ``{"sim_s", "render_s", "encode_s"}``."""
+    checks.work(f"a video of {n_frames:,} frames", n_frames, checks.MAX_FRAMES, "frames", "a shorter video or fewer "
+                "frames per second")
     sim_s = render_s = encode_s = 0.0
     bar = None
     if progress:
@@ -178,6 +180,8 @@ def film(out_path: str | Path, stepper: Any, frames: Sequence[int] | Sequence[Se
     """
     out, suffix = video_target(out_path, renderer.width, renderer.height)
     fps = checks.positive("fps", fps)
+    checks.work(f"a video of {len(frames):,} frames", len(frames), checks.MAX_FRAMES, "frames",
+                "a shorter video or fewer frames per second")
     t_start = time.perf_counter()
     steps = [list(f) if isinstance(f, (list, tuple, np.ndarray)) else [int(f)] for f in frames]
 
