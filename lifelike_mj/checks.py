@@ -113,3 +113,32 @@ def steps_of(duration_s: float, dt_s: float) -> int:
     building anything (a huge count is for :func:`work` to refuse)."""
     n = float(duration_s) / float(dt_s)
     return max(1, int(round(n))) if math.isfinite(n) and n < 1e18 else int(1e18)
+
+
+# ---- names a user types -----------------------------------------------------------------------------------
+
+
+def known_keywords(func):
+    """Decorator: a keyword argument ``func`` does not take is an :class:`~lifelike_mj.errors.UnknownName` (a
+    ``TypeError``, as Python's own) naming the closest one it takes, instead of Python's bare "unexpected keyword
+    argument". Names starting with ``_`` are accepted but never suggested."""
+    import functools
+    import inspect
+
+    from lifelike_mj.errors import unknown_name
+
+    params = inspect.signature(func).parameters.values()
+    if any(p.kind is p.VAR_KEYWORD for p in params):
+        return func
+    names = [p.name for p in params if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+    shown = [n for n in names if not n.startswith("_") and n != "self"]
+    owner = func.__qualname__.removesuffix(".__init__")
+
+    @functools.wraps(func)
+    def checked(*args, **kwargs):
+        for key in kwargs:
+            if key not in names:
+                raise unknown_name(f"{owner} has no option", key, shown)
+        return func(*args, **kwargs)
+
+    return checked

@@ -41,6 +41,7 @@ class Flock(StepCounter):
     the paper's 5a weights) started from ``seed`` (:func:`~lifelike_mj.boids.engine.initial_state`).
     One step is one engine step (eq. 1-2 with ``dt = 1``)."""
 
+    @checks.known_keywords
     def __init__(self, params: BoidParams | None = None, n: int = N_AGENTS, seed: int = 0) -> None:
         if params is None:
             from lifelike_mj.boids.presets import load_preset

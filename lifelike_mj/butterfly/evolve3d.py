@@ -297,6 +297,7 @@ def pd_prior(layers) -> np.ndarray:
     return w
 
 
+@checks.known_keywords
 def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str = "cmaes", seed: int = 0,
            layers=(10, 9), population: int | None = 16, generations: int = 300, duration_s: float = 4.0,
            gene_bound: float = 0.4, checkpoint: str | Path | None = None, resume: bool = False, progress: bool = True,

@@ -105,6 +105,7 @@ class Garden(StepCounter):
     (:class:`~lifelike_mj.butterfly.evolve3d.Task3D`); ``speed_m_s``: the cruise speed; ``dt_s`` the time step.
     """
 
+    @checks.known_keywords
     def __init__(self, n: int = 20, controller="steer", *, seed: int = 0, n_flowers: int = 10, size_m: float = 6.0,
                  speed_m_s: float = 1.5, flutter: float = 0.1, gust_m_s: float = 0.0, wind_m_s=(0.0, 0.0, 0.0),
                  gust_vertical_m_s: float | None = None, dt_s: float = DT_S, n_strips: int = 8, n_chord: int = 2,

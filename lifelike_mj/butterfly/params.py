@@ -12,6 +12,11 @@ from lifelike_mj.physics.fluid import CD_PAPER, RHO_AIR
 GRAVITY: float = 9.8
 
 
+#: Each constant's largest value (SI): far beyond a butterfly, and finite in the compiled code.
+PARAM_MAX = {"mass_kg": 1.0, "span_m": 1.0, "width_m": 1.0, "rho": 2000.0, "cd": 10.0, "body_area_m2": 1.0,
+             "gravity": 100.0}
+
+
 @dataclass(frozen=True)
 class ButterflyParams:
     """Constants of the swallowtail model (Oe 2010 sections 3, 4.3), SI units.
@@ -29,9 +34,10 @@ class ButterflyParams:
     gravity: float = GRAVITY  #: g, m/s^2
 
     def __post_init__(self) -> None:
+        from lifelike_mj import checks
+
         for name, value in asdict(self).items():
-            if not (math.isfinite(value) and value > 0.0):
-                raise UserError(f"butterfly parameter {name} must be a positive number, got {value}.")
+            checks.number(f"butterfly parameter {name}", value, 0.0, PARAM_MAX[name], lo_open=True)
 
     @property
     def alpha(self) -> float:
@@ -53,7 +59,11 @@ class ButterflyParams:
             "rho": ("rho", 1.0),
             "cd": ("cd", 1.0),
         }
-        changes = {conv[k][0]: float(v) * conv[k][1] for k, v in cgs.items() if v is not None}
+        from lifelike_mj import checks
+        from lifelike_mj.errors import check_names
+
+        check_names(cgs, conv, "unknown butterfly parameter")
+        changes = {conv[k][0]: checks.number(k, v) * conv[k][1] for k, v in cgs.items() if v is not None}
         return replace(self, **changes)
 
 

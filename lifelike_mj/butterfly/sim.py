@@ -101,6 +101,7 @@ class Flight(StepCounter):
     docstring) instead of the controller's; the controller still gives the flap pattern.
     """
 
+    @checks.known_keywords
     def __init__(self, controller: ButterflyController | str | Path = "simple_rule",
                  params: ButterflyParams | None = None, condition: Condition | None = None, *,
                  backend: str = "paper", config: str = "paper", force_mode: str | None = None,

@@ -100,6 +100,7 @@ class Flight3D(StepCounter):
     and yaw 0: the reduction check to the planar model, not free flight.
     """
 
+    @checks.known_keywords
     def __init__(self, command: KinematicsCommand | None = None, params: ButterflyParams | None = None, *,
                  controller=None, task=None, control_every: int = 1, wind_m_s=None,
                  start_m=(0.0, 0.0, 0.0), force_law: str = "exact", drag_frame: str = "body",

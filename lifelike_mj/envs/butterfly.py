@@ -28,10 +28,43 @@ def as_condition(value: Any) -> Condition:
         return value
     try:
         y0, w = value
-        y0, a, b = float(y0), float(w[0]), float(w[1])
-    except (TypeError, ValueError, IndexError):
+        a, b = w
+    except (TypeError, ValueError):
         raise UserError(f"a flight condition is a (y0_m, (a, b)) pair in m and m/s, got {value!r}.") from None
-    return Condition(y0, (a, b))  # which says what is out of range
+    return Condition(y0, (a, b))  # which checks each number and says what is out of range
+
+
+#: The options ``reset`` takes.
+RESET_OPTIONS = ("condition",)
+
+
+def check_options(options: Any, known) -> None:
+    """``reset``'s ``options``: ``None`` or a mapping of known names (:class:`~lifelike_mj.errors.UnknownName`
+    naming the closest otherwise)."""
+    from lifelike_mj.errors import check_names
+
+    if options is None:
+        return
+    if not isinstance(options, dict):
+        raise UserError(f"reset's options must be a dict (known: {', '.join(known)}), got {options!r}.")
+    check_names(options, known, "unknown reset option")
+
+
+def check_actions(actions: Any, n: int) -> np.ndarray:
+    """``n`` actions as a float64 array of shape ``(n,)``: accepted as shape ``(n,)`` or ``(n, 1)`` (one per copy),
+    or, for ``n = 1``, a scalar; real numbers only (no bools, strings or objects), finite. Anything else is a
+    :class:`~lifelike_mj.errors.UserError` (a ``ValueError``) giving the expected shape."""
+    a = np.asarray(actions)
+    want = "(1,)" if n == 1 else f"({n},) or ({n}, 1), one per copy"
+    if a.dtype.kind not in "fiu":
+        raise UserError(f"an action is a real number (the pitch, rad), got {actions!r} (dtype {a.dtype}); expected "
+                        f"shape {want}.")
+    if a.shape not in ((n,), (n, 1)) and not (n == 1 and a.shape == ()):
+        raise UserError(f"expected an action array of shape {want}, got shape {a.shape}.")
+    a = np.ascontiguousarray(a, dtype=np.float64).reshape(n)
+    if not np.isfinite(a).all():
+        raise UserError(f"every action must be a finite number, got {actions!r}.")
+    return a
 
 
 class ButterflyPitchEnv(gym.Env):
@@ -104,6 +137,7 @@ class ButterflyPitchEnv(gym.Env):
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 30}
 
+    @checks.known_keywords
     def __init__(self, backend: str = "paper", inputs: str = "relative", action_mode: str = "dphi",
                  wind_m_s: tuple[float, float] = (0.0, 0.0), y0_m: float = 0.0, duration_s: float = 20.0,
                  dt_s: float = 1.0 / 1200.0, frame_skip: int = 1, max_dphi_deg: float = 3.0,
@@ -158,6 +192,7 @@ class ButterflyPitchEnv(gym.Env):
     # ---- the Gymnasium API ----------------------------------------------------------------------
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        check_options(options, RESET_OPTIONS)
         super().reset(seed=seed)
         chosen = (options or {}).get("condition")
         self.condition = self._episode_condition() if chosen is None else as_condition(chosen)
@@ -168,9 +203,7 @@ class ButterflyPitchEnv(gym.Env):
     def step(self, action):
         if self.flight is None:
             raise RuntimeError("call reset() before step()")
-        a = float(np.asarray(action, dtype=np.float64).reshape(-1)[0])
-        if not math.isfinite(a):
-            raise ValueError(f"the action must be a finite number, got {action!r}")
+        a = float(check_actions(action, 1)[0])
         target = self._phi + float(np.clip(a, -self.max_dphi, self.max_dphi)) if self.action_mode == "dphi" else a
         self._phi = min(self.phi_limit, max(-self.phi_limit, target))
         before = self.flight.fitness

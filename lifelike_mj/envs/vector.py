@@ -14,7 +14,14 @@ from numba import njit
 
 from lifelike_mj.butterfly import PAPER_FLAP, ButterflyParams, Condition
 from lifelike_mj.butterfly.backends import paper
-from lifelike_mj.envs.butterfly import OBSERVATION_NAMES, ButterflyPitchEnv, ButterflyPitchWindEnv, as_condition
+from lifelike_mj.envs.butterfly import (
+    OBSERVATION_NAMES,
+    ButterflyPitchEnv,
+    ButterflyPitchWindEnv,
+    as_condition,
+    check_actions,
+    check_options,
+)
 from lifelike_mj.errors import UserError
 
 
@@ -65,6 +72,8 @@ def _finish(live, cols, phis, airs, relative, before, after, reset, diverged, ks
         truncated[b] = live[b] and not term and ks[b] >= n_steps
 
 
+#: The options ``reset`` takes.
+RESET_OPTIONS = ("conditions",)
 #: Butterfly-steps per call from which the paper backend's batch runs on threads (measured crossover).
 PARALLEL_FROM = 256
 
@@ -215,6 +224,7 @@ class ButterflyPitchVectorEnv(VectorEnv):
     # ---- the VectorEnv API ----------------------------------------------------------------------
 
     def reset(self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None):
+        check_options(options, RESET_OPTIONS)
         if seed is not None:
             seeds = list(seed) if isinstance(seed, (list, tuple)) else [int(seed) + i for i in range(self.num_envs)]
             if len(seeds) != self.num_envs:
@@ -232,12 +242,7 @@ class ButterflyPitchVectorEnv(VectorEnv):
 
     def step(self, actions):
         n, s, b = self.num_envs, self.single, self._batch
-        a = np.asarray(actions, dtype=np.float64)
-        if a.size != n:
-            raise ValueError(f"expected {n} actions (one per copy), got an array of shape {a.shape}")
-        a = np.ascontiguousarray(a.reshape(n))
-        if not np.isfinite(a).all():
-            raise ValueError("every action must be a finite number")
+        a = check_actions(actions, n)
         live, all_live = self._all_live, True
         if self._ended.any():  # NEXT_STEP autoreset of the copies whose episode ended on the last step
             live, all_live = ~self._ended, False

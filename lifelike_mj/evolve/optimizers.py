@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from lifelike_mj.checks import known_keywords
 from lifelike_mj.errors import UserError
 from lifelike_mj.evolve import cmaes, nloptalgs, rcga
 from lifelike_mj.evolve.checkpoint import check_checkpoint_path
@@ -129,6 +130,7 @@ def check_work(problem: Any, budget: Budget, population: int) -> None:
                 "fewer generations, a smaller population or shorter flights")
 
 
+@known_keywords
 def optimize(problem: Any, optimizer: str, *, seed: int, population: int | None = None, generations: int | None = None,
              evaluations: int | None = None, evaluator: Evaluator | Callable[[np.ndarray], np.ndarray] | None = None,
              checkpoint: str | Path | None = None, resume: bool = False, progress: bool = True,

@@ -424,6 +424,7 @@ class Tank(StepCounter):
     With a policy the control steps run one by one from Python (tens of microseconds each).
     """
 
+    @checks.known_keywords
     def __init__(self, params: FishParams | None = None, n_fish: int = 10, seed: int = 0, size=None,
                  scene: FishScene | None = None, mu_policy=None, push_policy=None):
         from lifelike_mj.fish.params import load_preset

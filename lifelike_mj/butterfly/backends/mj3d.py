@@ -51,10 +51,11 @@ import mujoco
 import numpy as np
 from numba import njit
 
+from lifelike_mj import checks
 from lifelike_mj.butterfly.aero import strip_nodes
 from lifelike_mj.butterfly.kinematics3d import JOINTS, N_PARAMS, Kinematics, filter_at, joint_refs
 from lifelike_mj.butterfly.model import CP_FRACTION
-from lifelike_mj.butterfly.params import ButterflyParams
+from lifelike_mj.butterfly.params import PARAM_MAX, ButterflyParams
 from lifelike_mj.errors import UserError
 from lifelike_mj.physics import mjabi
 from lifelike_mj.physics.drive import native_torques, prescribed_torques
@@ -585,9 +586,11 @@ def panels(params: ButterflyParams, n_strips: int = 8, n_chord: int = 2) -> np.n
     each panel of one wing: the planform-2 triangle (Oe 2010 eq. 3, chord ``W r / L`` at span ``r``)
     cut into ``n_strips`` strips (three Gauss points each) and each strip into ``n_chord`` Gauss-Legendre
     panels. The areas add up to the wing's ``W L / 2``."""
-    if not 1 <= n_strips or not 1 <= n_chord or 3 * n_strips * n_chord > MAX_PANELS:
+    checks.whole("n_strips (strips per wing)", n_strips, 1, MAX_PANELS // 3)
+    checks.whole("n_chord (chordwise panels per strip)", n_chord, 1, MAX_PANELS // 3)
+    if 3 * n_strips * n_chord > MAX_PANELS:
         raise UserError(f"a wing has at most {MAX_PANELS} panels (3 per strip and chordwise panel); "
-                        f"got {n_strips} strips of {n_chord} panels.")
+                        f"{n_strips} strips of {n_chord} panels make {3 * n_strips * n_chord}.")
     r, dr = strip_nodes(params.span_m, n_strips, "gauss3")
     g, w = np.polynomial.legendre.leggauss(n_chord)
     chord = params.width_m * r / params.span_m
@@ -622,6 +625,12 @@ def setup_data(m: mujoco.MjModel, kinematics: Kinematics, params: ButterflyParam
         raise UserError(f"unknown assist {assist!r}; choose one of: {', '.join(ASSISTS)}.")
     if m.nuserdata < N_USERDATA or m.nv > MAX_NV:
         raise ValueError(f"model needs <size nuserdata='{N_USERDATA}'/> and at most {MAX_NV} dofs")
+    air_m_s = checks.vector("the air's velocity air_m_s", air_m_s, 3, "m/s")
+    if body_areas_m2 is not None:
+        body_areas_m2 = checks.vector("body_areas_m2 (the body's drag areas along x, y, z)", body_areas_m2, 3, "m^2")
+        for a in body_areas_m2:
+            checks.number("each of body_areas_m2", a, 0.0, PARAM_MAX["body_area_m2"], unit="m^2")
+    drive_hz = checks.number("drive_hz", drive_hz, 0.0, 10_000.0, lo_open=True, unit="Hz")
     d = mujoco.MjData(m)
     mjabi.verify_offsets(d)
     ud = d.userdata
