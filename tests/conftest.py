@@ -63,6 +63,9 @@ def stand_in_viewer(monkeypatch):
         def __exit__(self, *exc):
             return False
 
+        def close(self):
+            pass
+
         def lock(self):
             return contextlib.nullcontext()
 

@@ -199,7 +199,7 @@ def view_boids(params: BoidParams, n: int = 300, seed: int = 0, steps_per_s: flo
     down rather than freezes when the engine cannot keep up. Raises :class:`UserError` when there is
     no display (use :func:`render_boids` instead); on macOS run it under ``mjpython``. ``web``:
     :class:`~lifelike_mj.render.web.WebOptions` to serve MuJoCo's web viewer instead (no display needed).
-    Keys ``1`` ... ``8`` change the weights live (:func:`weight_controls`).
+    Right and Left change the weights live (:func:`weight_controls`).
     """
     if web is None:
         require_display("boids")
@@ -235,21 +235,35 @@ def view_boids(params: BoidParams, n: int = 300, seed: int = 0, steps_per_s: flo
     view(flock, rate, end, setup, web=web, controls=weight_controls(flock))
 
 
+#: The flock's keys in the desktop viewer and what each does (none of them is one of MuJoCo's viewer's own; the web
+#: viewer also has a button per pattern).
+KEYS = (("Right", "the next pattern's weights (4a, 4b, ... 5d)"), ("Left", "the previous pattern's weights"))
+
+
 def weight_controls(flock: Flock) -> list:
-    """Keys ``1`` ... ``8`` (buttons in the web viewer): the flock takes pattern 4a, 4b, 4c, 4d, 5a, 5b, 5c or 5d's
-    weight matrices ``W_a``, ``W_c`` (Nakamura 2013 Fig. 4-5) from the next step on (:meth:`Flock.set_weights`),
-    the agents where they are."""
+    """The flock's keys and buttons (:data:`KEYS`; :class:`~lifelike_mj.render.viewer.Control`): Right and Left step
+    through patterns 4a, 4b, 4c, 4d, 5a, 5b, 5c and 5d (Nakamura 2013 Fig. 4-5), and the web viewer has one button
+    per pattern; the flock takes that pattern's weight matrices ``W_a``, ``W_c`` from the next step on
+    (:meth:`Flock.set_weights`), the agents where they are. Each press prints the pattern now flown."""
     from lifelike_mj.boids.presets import PATTERNS, load_preset
     from lifelike_mj.render.viewer import Control
 
-    def switch(name: str):
-        def act() -> None:
-            p = load_preset(name, flock.params.dims)
-            flock.set_weights(wa=p.wa, wc=p.wc)
+    at = [-1]  # the pattern flown through these controls (none yet: the flock's own weights)
 
-        return act
+    def take(i: int) -> None:
+        at[0] = i % len(PATTERNS)
+        p = load_preset(PATTERNS[at[0]], flock.params.dims)
+        flock.set_weights(wa=p.wa, wc=p.wc)
+        print(f"now the weights of pattern {PATTERNS[at[0]]}", flush=True)
 
-    return [Control(str(i + 1), f"weights of pattern {name}", switch(name)) for i, name in enumerate(PATTERNS)]
+    def switch(i: int):
+        return lambda: take(i)
+
+    def back() -> None:
+        take(at[0] - 1 if at[0] >= 0 else -1)
+
+    return [Control("Right", KEYS[0][1], lambda: take(at[0] + 1)), Control("Left", KEYS[1][1], back),
+            *(Control("", f"weights of pattern {name}", switch(i)) for i, name in enumerate(PATTERNS))]
 
 
 __all__ = ["CAMERAS", "DEFAULT_STEPS", "DEFAULT_STEPS_PER_FRAME", "VIEW_STEPS_PER_S", "film_flock", "frame_png",

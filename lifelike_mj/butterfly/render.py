@@ -312,11 +312,18 @@ HEADING_STEP_RAD = math.pi / 4
 WIND_KEY_M_S = 1.0
 
 
+#: The 3D viewer's keys and what each does (none of them is one of MuJoCo's viewer's own).
+FLIGHT3D_KEYS = (("Up", "climb 0.5 m"), ("Down", "descend 0.5 m"), ("Left", "turn left 45 deg"),
+                 ("Right", "turn right 45 deg"), ("6", "wind 1 m/s toward +x"), ("7", "wind 1 m/s toward +y"),
+                 ("8", "wind 1 m/s toward -x"), ("9", "wind 1 m/s toward -y"), ("Space", "calm"))
+
+
 def flight3d_controls(flight) -> list:
-    """The 3D butterfly's keys (buttons in the web viewer; :class:`~lifelike_mj.render.viewer.Control`): ``W``/``S``
-    raise or lower the target altitude by :data:`ALTITUDE_STEP_M`, ``A``/``D`` turn the course left or right by
-    45 deg, ``1``-``4`` blow a :data:`WIND_KEY_M_S` wind toward +x, +y, -x, -y and ``0`` calms it
-    (:meth:`~lifelike_mj.butterfly.sim3d.Flight3D.set_reference`, :meth:`~lifelike_mj.butterfly.sim3d.Flight3D.set_wind`)."""
+    """The 3D butterfly's keys (:data:`FLIGHT3D_KEYS`; buttons in the web viewer;
+    :class:`~lifelike_mj.render.viewer.Control`): the arrows raise or lower the target altitude by
+    :data:`ALTITUDE_STEP_M` and turn the course left or right by 45 deg, ``6``-``9`` blow a :data:`WIND_KEY_M_S`
+    wind toward +x, +y, -x, -y and Space calms it (:meth:`~lifelike_mj.butterfly.sim3d.Flight3D.set_reference`,
+    :meth:`~lifelike_mj.butterfly.sim3d.Flight3D.set_wind`)."""
     from lifelike_mj.render.viewer import Control
 
     def climb(dz: float):
@@ -329,12 +336,9 @@ def flight3d_controls(flight) -> list:
         return lambda: flight.set_wind((x, y, 0.0))
 
     w = WIND_KEY_M_S
-    return [Control("W", "climb 0.5 m", climb(ALTITUDE_STEP_M)), Control("S", "descend 0.5 m", climb(-ALTITUDE_STEP_M)),
-            Control("A", "turn left 45 deg", turn(HEADING_STEP_RAD)),
-            Control("D", "turn right 45 deg", turn(-HEADING_STEP_RAD)),
-            Control("1", "wind 1 m/s toward +x", blow(w, 0.0)), Control("2", "wind 1 m/s toward +y", blow(0.0, w)),
-            Control("3", "wind 1 m/s toward -x", blow(-w, 0.0)), Control("4", "wind 1 m/s toward -y", blow(0.0, -w)),
-            Control("0", "calm", blow(0.0, 0.0))]
+    acts = (climb(ALTITUDE_STEP_M), climb(-ALTITUDE_STEP_M), turn(HEADING_STEP_RAD), turn(-HEADING_STEP_RAD),
+            blow(w, 0.0), blow(0.0, w), blow(-w, 0.0), blow(0.0, -w), blow(0.0, 0.0))
+    return [Control(key, label, act) for (key, label), act in zip(FLIGHT3D_KEYS, acts, strict=True)]
 
 
 def view_flight3d(controller="wind", speed_m_s: float = 1.5, duration_s: float | None = None, flight=None,

@@ -36,7 +36,11 @@ def _verb(sub, name: str, helptext: str, add: str, extra=None, creatures=CREATUR
     per = p.add_subparsers(dest="what", required=True, parser_class=Parser, metavar="CREATURE")
     for c in creatures:
         mod = creature(c)
-        q = per.add_parser(c, help=mod.HELP)
+        if name == "view":  # what the live scene is, and its keys, listed by view CREATURE --help
+            text = getattr(mod, "VIEW_HELP", mod.HELP)
+            q = per.add_parser(c, help=text, description=text, epilog=getattr(mod, "view_keys", None))
+        else:
+            q = per.add_parser(c, help=mod.HELP)
         getattr(mod, add)(q)
         if extra is not None:
             extra(q)

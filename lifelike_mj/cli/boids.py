@@ -27,6 +27,18 @@ MAX_STEPS = 1_000_000
 MAX_AXIS_VALUES = 1_000
 RUN_FILES = ("trajectories.npz", "trajectories.csv", "measures.json")
 HELP = "the heterogeneous boids of Nakamura 2013"
+VIEW_HELP = "a flock, live, whose weights you can change while it flies"
+#: What the viewer's flock shows after each pattern's key (measured: docs/results.md).
+VIEW_PATTERNS_NOTE = ""
+
+
+def view_keys() -> str:
+    """The flock's keys, for ``view boids --help``."""
+    from lifelike_mj.boids.render import KEYS
+    from lifelike_mj.render.viewer import keys_text
+
+    return ("keys in the window: " + keys_text(KEYS) + " (the web viewer with --web has a button per pattern). "
+            + VIEW_PATTERNS_NOTE)
 
 
 def _add_boids(p) -> None:
@@ -182,6 +194,8 @@ def add_commands(sub) -> None:
 def add_view_args(p: argparse.ArgumentParser) -> None:
     _add_boids(p)
     p.add_argument("--camera", default="overview", choices=("overview", "top"), help="viewer camera")
+    p.add_argument("--steps", type=count(1, 10**9), default=None,
+                   help="stop after this many steps (default: run until the window is closed)")
 
 
 def view(args) -> None:
@@ -189,7 +203,7 @@ def view(args) -> None:
     from lifelike_mj.cli import web_options
 
     web = web_options(args)
-    view_boids(_params(args), n=args.n, seed=args.seed, camera=args.camera, web=web)
+    view_boids(_params(args), n=args.n, seed=args.seed, camera=args.camera, web=web, duration_steps=args.steps)
 
 
 def add_render_args(p: argparse.ArgumentParser) -> None:

@@ -265,6 +265,16 @@ def add_commands(bf) -> None:
 
 
 HELP = "the butterfly in three dimensions: one on a task, or a garden of them"
+VIEW_HELP = ("one 3D butterfly flying level at --speed with --controller, the camera following it; steer it and "
+             "change the wind with the keys below")
+
+
+def view_keys() -> str:
+    """The 3D scene's keys, for ``view butterfly3d --help``."""
+    from lifelike_mj.butterfly.render import FLIGHT3D_KEYS
+    from lifelike_mj.render.viewer import keys_text
+
+    return "keys in the window (buttons in the web viewer with --web): " + keys_text(FLIGHT3D_KEYS) + "."
 
 
 def add_export_args(p: argparse.ArgumentParser) -> None:

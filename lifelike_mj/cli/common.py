@@ -27,6 +27,11 @@ class Parser(argparse.ArgumentParser):
         kwargs.setdefault("formatter_class", HelpFormatter)
         super().__init__(*args, **kwargs)
 
+    def format_help(self) -> str:
+        if callable(self.epilog):  # made when asked for (it may import the creature), not when the parser is built
+            self.epilog = self.epilog()
+        return super().format_help()
+
     def error(self, message: str):  # one sentence, exit 2 (argparse prints usage otherwise)
         raise UserError(f"{message} (see '{self.prog} --help').")
 

@@ -16,6 +16,15 @@ MAX_DURATION_S = 3600.0
 MIN_TANK_SCALE = 0.35
 SWIM_FILES = ("tracks.npz", "tracks.csv", "tracks.png", "accel_histogram.png", "measures.json")
 HELP = "the tropical fish of Satoi et al. 2015"
+VIEW_HELP = "a tank of fish, live: a virtual aquarium whose fish flee a tap on the glass and go for food"
+
+
+def view_keys() -> str:
+    """The aquarium's keys, for ``view fish --help``."""
+    from lifelike_mj.fish.aquarium import KEYS
+    from lifelike_mj.render.viewer import keys_text
+
+    return "keys in the window (buttons in the web viewer with --web): " + keys_text(KEYS) + "."
 
 
 def _preset(args):

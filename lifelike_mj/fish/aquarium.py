@@ -178,10 +178,14 @@ class Aquarium:
         self.pellets_m = self.pellets_m[~gone]
 
 
+#: The aquarium's keys and what each does (none of them is one of MuJoCo's viewer's own).
+KEYS = (("Space", "tap the front glass"), ("Enter", "drop a food pellet"))
+
+
 def controls(aquarium: Aquarium, seed: int = 0) -> list:
-    """The aquarium's keys and buttons (:class:`lifelike_mj.render.viewer.Control`): ``T`` taps the front glass
-    (the side the viewers look from, y < 0) level with a fish drawn at random, ``F`` drops a pellet at a random
-    place along the middle of the surface. ``seed`` draws the places."""
+    """The aquarium's keys and buttons (:data:`KEYS`; :class:`lifelike_mj.render.viewer.Control`): Space taps the
+    front glass (the side the viewers look from, y < 0) level with a fish drawn at random, Enter drops a pellet at
+    a random place along the middle of the surface. ``seed`` draws the places."""
     from lifelike_mj.render.viewer import Control
 
     rng = np.random.default_rng(seed)
@@ -195,4 +199,4 @@ def controls(aquarium: Aquarium, seed: int = 0) -> list:
     def food() -> None:
         aquarium.drop_food(float(rng.uniform(-0.4 * L, 0.4 * L)), 0.0)
 
-    return [Control("T", "tap the front glass", tap), Control("F", "drop a food pellet", food)]
+    return [Control(key, label, act) for (key, label), act in zip(KEYS, (tap, food), strict=True)]

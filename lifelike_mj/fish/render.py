@@ -308,7 +308,7 @@ def view_fish(params: FishParams, n_fish: int = 10, seed: int = 0, size=None, du
     :class:`UserError` when there is no display (use :func:`render_fish` instead); on macOS run it
     under ``mjpython``. ``web``: :class:`~lifelike_mj.render.web.WebOptions` to serve MuJoCo's web viewer
     instead of opening a window (no display needed). The tank is a virtual aquarium
-    (:mod:`lifelike_mj.fish.aquarium`, unless it has policies of its own): ``T`` taps the front glass, ``F``
+    (:mod:`lifelike_mj.fish.aquarium`, unless it has policies of its own): Space taps the front glass, Enter
     drops a food pellet (keys in the window, buttons in the web viewer).
     """
     if web is None:
@@ -344,7 +344,7 @@ def view_fish(params: FishParams, n_fish: int = 10, seed: int = 0, size=None, du
 
     from lifelike_mj.fish.aquarium import Aquarium, controls
 
-    if tank.mu_policy is None and tank.push_policy is None:  # the virtual aquarium: T taps, F feeds
+    if tank.mu_policy is None and tank.push_policy is None:  # the virtual aquarium: Space taps, Enter feeds
         aquarium = Aquarium(tank)
         view(aquarium, 1.0 / tank.dt, end, setup, web=web, controls=controls(aquarium, seed))
     else:

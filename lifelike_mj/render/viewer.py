@@ -48,14 +48,57 @@ def require_display(creature: str) -> None:
                         f"window; use `lifelike-mj view {creature} --web` (a browser){video} instead.")
 
 
+#: The keys a scene may use, by name, with their GLFW key codes (what the desktop viewer's key callback gets).
+KEY_CODES = {"Space": 32, "Enter": 257, "Right": 262, "Left": 263, "Down": 264, "Up": 265,
+             **{str(d): ord(str(d)) for d in range(10)}}
+
+
+def mujoco_viewer_keys() -> dict[int, str]:
+    """The keys MuJoCo's desktop viewer acts on itself in a passive window, by GLFW key code, with what each does:
+    every visualisation and rendering flag's shortcut (``mjVISSTRING``, ``mjRNDSTRING``: all 26 letters and some
+    punctuation), the geom groups' ``0``-``5``, the help and panels' F1-F7, Tab, Escape, ``[`` ``]``, Page Up and
+    Backspace (reset). A scene key must be none of these (:class:`Control`): pressed in the window, it would change
+    the viewer as well as the scene."""
+    import mujoco
+
+    taken: dict[int, str] = {}
+    for name, _default, key in [*mujoco.mjVISSTRING, *mujoco.mjRNDSTRING]:
+        if key:
+            taken[ord(key.upper())] = f"MuJoCo's {name} toggle"
+    for g in range(6):
+        taken[ord(str(g))] = f"MuJoCo's geom group {g} toggle"
+    for code, what in ((258, "Tab: the side panels"), (256, "Escape: the free camera"), (ord("["), "the cameras"),
+                       (ord("]"), "the cameras"), (266, "Page Up: select the parent body"), (259, "Backspace: reset"),
+                       *((290 + i, f"F{i + 1}: panels and labels") for i in range(7))):
+        taken[code] = f"MuJoCo's {what}"
+    return taken
+
+
 @dataclass(frozen=True)
 class Control:
-    """One interaction of a live scene: ``key`` (a letter or digit: the desktop viewer's key), ``label`` (the
+    """One interaction of a live scene: ``key`` (a name of :data:`KEY_CODES`: the desktop viewer's key, never one
+    MuJoCo's viewer uses itself, :func:`mujoco_viewer_keys`; ``""`` for a web viewer button alone), ``label`` (the
     web viewer's button, and the list of keys printed at the start) and ``act()``, run between two steps."""
 
     key: str
     label: str
     act: Callable[[], object]
+
+    def __post_init__(self) -> None:
+        if self.key and self.key not in KEY_CODES:
+            raise UserError(f"a scene key is one of {', '.join(KEY_CODES)}, got {self.key!r}.")
+        if self.key and KEY_CODES[self.key] in mujoco_viewer_keys():
+            raise UserError(f"key {self.key!r} is {mujoco_viewer_keys()[KEY_CODES[self.key]]}; choose another.")
+
+    @property
+    def code(self) -> int:
+        """The GLFW key code of :attr:`key`."""
+        return KEY_CODES[self.key]
+
+
+def keys_text(pairs) -> str:
+    """``(key, label)`` pairs as the viewers list them: ``"Up climb 0.5 m; Down descend 0.5 m"``."""
+    return "; ".join(f"{k} {label}" for k, label in pairs if k)
 
 
 def _mark(geom, pos, radius_m: float, rgba) -> None:
@@ -85,10 +128,34 @@ def launch_viewer(m, d, key_callback: Callable[[int], None] | None = None):
     that cannot start (macOS outside ``mjpython``) is a :class:`UserError`."""
     import mujoco.viewer
 
+    before = set(threading.enumerate())
     try:
-        return mujoco.viewer.launch_passive(m, d, show_left_ui=False, show_right_ui=False, key_callback=key_callback)
+        handle = mujoco.viewer.launch_passive(m, d, show_left_ui=False, show_right_ui=False, key_callback=key_callback)
     except RuntimeError as exc:
         raise UserError(f"the MuJoCo viewer cannot start here ({str(exc).strip()}).") from None
+    return _Joined(handle, [t for t in threading.enumerate() if t not in before])
+
+
+class _Joined:
+    """A passive viewer's handle whose close also waits for the viewer's thread to end: a process that exits while
+    that thread still tears its window down crashes (a segmentation fault, seen under Xvfb in most such exits)."""
+
+    def __init__(self, handle, threads) -> None:
+        self._handle, self._threads = handle, threads
+
+    def __getattr__(self, name: str):
+        return getattr(self._handle, name)
+
+    def close(self) -> None:
+        self._handle.close()
+        for t in self._threads:
+            t.join(timeout=10.0)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
 
 def _show_marks(viewer, marks) -> None:
@@ -121,19 +188,19 @@ def view(stepper: Any, steps_per_s: float, end_step: int | None = None,
     those spheres drawn too (:func:`mark_geoms`).
     """
     pending: queue.SimpleQueue = queue.SimpleQueue()
-    by_key = {ord(c.key.upper()): c for c in controls}
-    if controls:
-        print("keys: " + "; ".join(f"{c.key} {c.label}" for c in controls), flush=True)
+    by_key = {c.code: c for c in controls if c.key}
+    if by_key:
+        print("keys: " + keys_text((c.key, c.label) for c in controls), flush=True)
     if web is not None:
         from lifelike_mj.render.web import launch_web
 
         opened = launch_web(stepper.model, stepper.data, web, setup=setup, controls=controls, pending=pending)
     else:
-        def on_key(key: int) -> None:  # GLFW's key codes: a letter's or digit's is its upper-case character
+        def on_key(key: int) -> None:  # GLFW's key codes (KEY_CODES)
             if key in by_key:
                 pending.put(by_key[key])
 
-        opened = launch_viewer(stepper.model, stepper.data, key_callback=on_key if controls else None)
+        opened = launch_viewer(stepper.model, stepper.data, key_callback=on_key if by_key else None)
     stop = threading.Event()  # Ctrl+C ends the loop between two frames, never inside MuJoCo's viewer code
     with opened as viewer, _ctrl_c_sets(stop):
         with viewer.lock():

@@ -156,7 +156,7 @@ def _buttons(controls, pending, shown: _Shown) -> list:
         def on_gui(self, event) -> None:
             imgui.Begin("lifelike-mj")
             for c in controls:
-                if imgui.Button(f"{c.label} [{c.key}]"):
+                if imgui.Button(f"{c.label} [{c.key}]" if c.key else c.label):
                     pending.put(c)
             imgui.End()
 

@@ -89,7 +89,7 @@ def test_the_web_viewer_draws_the_live_creature_on_localhost_only(chromium, tmp_
     assert chromium.changed_pixels(first, later) > 20  # and moves
     if scene != "fish":
         return
-    assert keys == "keys: T tap the front glass; F drop a food pellet"
+    assert keys == "keys: Space tap the front glass; Enter drop a food pellet"
     assert "drop a food pellet\ntap the front glass" in out  # the buttons reached the aquarium, in order
 
 

@@ -171,13 +171,14 @@ def test_view_fish_loop_with_a_stand_in_viewer(monkeypatch, params, stand_in_vie
 
 
 def test_the_aquariums_keys_in_the_window(monkeypatch, params, stand_in_viewer, capsys):
-    """F and T pressed in the (stand-in) window reach the tank between two steps; the pellet is drawn."""
+    """Enter and Space pressed in the (stand-in) window reach the tank between two steps; the pellet is drawn."""
     monkeypatch.setattr(viewer, "has_display", lambda: True)
-    monkeypatch.setattr(stand_in_viewer.viewer_class, "presses", {3: ord("F"), 4: ord("T"), 5: ord("Q")})
+    codes = viewer.KEY_CODES
+    monkeypatch.setattr(stand_in_viewer.viewer_class, "presses", {3: codes["Enter"], 4: codes["Space"], 5: ord("Q")})
     fish_video.view_fish(params, n_fish=3, seed=0, duration_s=0.3)
     (v,) = stand_in_viewer
     out = capsys.readouterr().out
-    assert out.startswith("keys: T tap the front glass; F drop a food pellet")
+    assert out.startswith("keys: Space tap the front glass; Enter drop a food pellet")
     assert "drop a food pellet\ntap the front glass" in out  # Q is no key of the scene: nothing happens
     assert v.user_scn.ngeom == 1 and v.user_scn.geoms[0].size[0] > 0  # the pellet, drawn
 

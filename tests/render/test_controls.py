@@ -16,6 +16,26 @@ from lifelike_mj.fish import Tank
 from lifelike_mj.fish.aquarium import Aquarium, controls
 
 
+def test_no_scene_key_is_one_of_mujocos_viewers_own():
+    """MuJoCo's viewer takes every letter (its flags' shortcuts) and 0-5 (the geom groups): a scene key on one of
+    them would change the viewer too, so a Control refuses it; the shipped scenes' keys are all free."""
+    import pytest
+
+    from lifelike_mj.errors import UserError
+    from lifelike_mj.render.viewer import Control, mujoco_viewer_keys
+
+    taken = mujoco_viewer_keys()
+    assert all(ord(c) in taken for c in "ABCDEFGHIJKLMNOPQRSTUVWXYZ012345")
+    for key in ("T", "0", "W"):
+        with pytest.raises(UserError, match="MuJoCo's"):
+            Control(key, "x", lambda: None)
+    f = Flight3D(controller="wind", task=evolve3d.level(1.5))
+    scenes = [flight3d_controls(f), weight_controls(Flock(load_preset("5a"), n=10, seed=0)),
+              controls(Aquarium(Tank(n_fish=2, seed=0)))]
+    for scene in scenes:
+        assert all(c.code not in taken for c in scene if c.key)
+
+
 def _press(controls, key):
     next(c for c in controls if c.key == key).act()
 
@@ -23,17 +43,17 @@ def _press(controls, key):
 def test_the_butterflys_keys_change_its_course_altitude_and_wind():
     f = Flight3D(controller="wind", task=evolve3d.level(1.5))
     keys = flight3d_controls(f)
-    assert sorted(c.key for c in keys) == sorted("WSAD12340")
-    _press(keys, "W")
-    _press(keys, "W")
-    _press(keys, "A")
+    assert [c.key for c in keys] == ["Up", "Down", "Left", "Right", "6", "7", "8", "9", "Space"]
+    _press(keys, "Up")
+    _press(keys, "Up")
+    _press(keys, "Left")
     assert f.reference == (math.pi / 4, 1.0, 1.5)
-    _press(keys, "2")
+    _press(keys, "7")
     np.testing.assert_array_equal(f.wind_m_s, [0.0, 1.0, 0.0])
     f.step(int(4.0 / f.dt))
     s = f.state()
     assert abs(s["position_m"][2] - 1.0) < 0.15 and abs(math.degrees(s["attitude_rad"][2]) - 45.0) < 15.0
-    _press(keys, "0")
+    _press(keys, "Space")
     np.testing.assert_array_equal(f.wind_m_s, [0.0, 0.0, 0.0])
 
 
@@ -41,8 +61,9 @@ def test_the_boids_keys_switch_the_weights_live():
     flock = Flock(load_preset("5a"), n=50, seed=1)
     flock.step(10)
     keys = weight_controls(flock)
-    assert [c.key for c in keys] == list("12345678")
-    _press(keys, "2")  # pattern 4b
+    assert [c.key for c in keys if c.key] == ["Right", "Left"] and len(keys) == 10  # and a web button per pattern
+    _press(keys, "Right")
+    _press(keys, "Right")  # pattern 4b
     p = load_preset("4b")
     np.testing.assert_array_equal(flock.params.wa, p.wa)
     np.testing.assert_array_equal(flock.params.wc, p.wc)
@@ -53,7 +74,7 @@ def test_the_boids_keys_switch_the_weights_live():
 def test_the_aquariums_keys_tap_and_feed():
     a = Aquarium(Tank(n_fish=10, seed=2))
     keys = controls(a, seed=0)
-    _press(keys, "T")
+    _press(keys, "Space")
     assert a.startled.any()
-    _press(keys, "F")
+    _press(keys, "Enter")
     assert len(a.pellets_m) == 1 and len(a.marks()) == 1
