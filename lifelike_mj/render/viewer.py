@@ -50,7 +50,7 @@ def require_display(creature: str) -> None:
 
 #: The keys a scene may use, by name, with their GLFW key codes (what the desktop viewer's key callback gets).
 KEY_CODES = {"Space": 32, "Enter": 257, "Right": 262, "Left": 263, "Down": 264, "Up": 265,
-             **{str(d): ord(str(d)) for d in range(10)}}
+             **{str(d): ord(str(d)) for d in range(10)}}  # 0-5 are here to be refused by name (MuJoCo's groups)
 
 
 def mujoco_viewer_keys() -> dict[int, str]:
