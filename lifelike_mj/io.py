@@ -165,6 +165,32 @@ def claim(path: str | Path, what: str = "output", *, overwrite: bool = False) ->
     return c
 
 
+def check_unclaimed(path: str | Path, what: str = "output") -> None:
+    """A :class:`~lifelike_mj.errors.UserError` naming the process that holds ``path``'s claim, if one does; this
+    touches nothing (a lock file is only opened where it exists), so a command can check all of its outputs
+    before it claims the first."""
+    import fcntl
+
+    from lifelike_mj.errors import UserError
+
+    target = Path(path)
+    if _key(target) in _claims:
+        return
+    try:
+        fd = os.open(lock_path(target), os.O_RDWR)
+    except OSError:
+        return
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        except BlockingIOError:
+            other = os.pread(fd, 400, 0).decode(errors="replace").strip()
+            raise UserError(f"another run is writing {what} {target} (process {other or 'unknown'}); wait for it or "
+                            "choose another name.") from None
+    finally:
+        os.close(fd)
+
+
 def release_claims(keep: Iterable[str] = ()) -> None:
     """Give up every claim this process holds but those of the paths ``keep`` (:func:`held_claims`); the
     command line gives up those its command made when it ends."""

@@ -161,6 +161,9 @@ def check_output_file(path: str | Path, what: str, *, suffixes: Iterable[str] = 
     if suffixes and p.suffix.lower() not in suffixes:
         raise UserError(f"{what} must end in {' or '.join(suffixes)}, got {str(p)!r}.")
     check_writable(p, what)
+    from lifelike_mj.io import check_unclaimed
+
+    check_unclaimed(p, what)
     for claimed in (False, True) if claim else (False,):  # checked again once claimed: another run may just have written it
         if claimed:
             from lifelike_mj.io import claim as _claim
@@ -182,6 +185,9 @@ def check_output_dir(path: str | Path, what: str, names: Iterable[str] = (), *, 
     if p.exists() and not p.is_dir():
         raise UserError(f"{what} {p} is a file; give a folder.")
     _probe(parent, p, what, "made")
+    from lifelike_mj.io import check_unclaimed
+
+    check_unclaimed(p, what)
     names = tuple(names)
     for claimed in (False, True) if claim else (False,):  # checked again once claimed, as a file is
         if claimed:

@@ -290,6 +290,17 @@ def _flight_numbers(tr: Trajectory, phi_up_deg: float) -> dict:
     }
 
 
+def check_trim_work(backend: str = "paper", dt_s: float = 1.0 / 12000.0, duration_s: float = 20.0, lo_deg: float = 10.0,
+                    hi_deg: float = 16.0, tol_deg: float = 1e-3) -> None:
+    """Before E4's search: its flights (a bound on their number: the paper backend's rounds of 16, the MuJoCo
+    backend's regula falsi, then 3 recorded flights) times their steps, refused above
+    :data:`~lifelike_mj.checks.MAX_BODY_STEPS`."""
+    rounds = math.ceil(math.log(max((hi_deg - lo_deg) / tol_deg, 2.0), 17 if backend == "paper" else 2)) + 1
+    flights = (16 * rounds if backend == "paper" else 5 + 2 * rounds) + 3
+    checks.work(f"E4's search ({flights} flights of {duration_s:g} s at {dt_s:g} s)",
+                flights * checks.steps_of(duration_s, dt_s), checks.MAX_BODY_STEPS, "time steps", "a larger time step")
+
+
 def e4_trim(
     params: ButterflyParams | None = None,
     backend: str = "paper",
@@ -319,10 +330,7 @@ def e4_trim(
         raise UserError(f"trim range must satisfy lo < hi, got [{lo_deg}, {hi_deg}] deg.")
     if not (math.isfinite(tol_deg) and tol_deg > 0):
         raise UserError(f"trim tolerance must be positive, got {tol_deg} deg.")
-    rounds = math.ceil(math.log((hi_deg - lo_deg) / tol_deg, 17 if backend == "paper" else 2)) + 1
-    flights = (16 * rounds if backend == "paper" else 5 + 2 * rounds) + 3  # the search, then 3 recorded flights
-    checks.work(f"E4's search ({flights} flights of {duration_s:g} s at {dt_s:g} s)",
-                flights * checks.steps_of(duration_s, dt_s), checks.MAX_BODY_STEPS, "time steps", "a larger time step")
+    check_trim_work(backend, dt_s, duration_s, lo_deg, hi_deg, tol_deg)
     base = controllers.load("simple_rule").with_parameters(phi_down_deg=0.0)
     # the search needs the climb-rate slope only: sample about every millisecond
     search_every = max(1, int(round(1e-3 / dt_s)))

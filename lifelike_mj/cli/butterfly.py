@@ -137,6 +137,7 @@ def cmd_trim(args) -> None:
     from lifelike_mj.butterfly import experiments
 
     opts = _backend_options(args)
+    experiments.check_trim_work(args.backend, positive("--dt", args.dt))
     with stage("E4: bisection on phi_up for level flight (20 s flights)"):
         r = experiments.e4_trim(params(args), backend=args.backend, dt_s=positive("--dt", args.dt), **opts)
     d = r.to_dict()
@@ -241,8 +242,10 @@ def cmd_assess(args) -> None:
 
 def cmd_compare(args) -> None:
     from lifelike_mj.butterfly.compare import compare
+    from lifelike_mj.butterfly.flight import check_timing
 
     ctrl = _controller(args)
+    check_timing(args.duration, args.dt)
     with stage("the same flight on both backends"):
         r = compare(ctrl, args.config, params(args), duration_s=positive("--duration", args.duration),
                     dt_s=positive("--dt", args.dt), force_mode=args.force_mode)

@@ -162,7 +162,7 @@ def guarded_run_files(out: str | Path, checkpoint: str | Path | None, *, resume:
     existing ``out`` or checkpoint is refused unless ``resume`` or ``overwrite``, a checkpoint equal to
     ``out`` is refused, and both files are locked for the whole block, so a second run on the same files
     stops at once with a sentence."""
-    from lifelike_mj.io import exclusive
+    from lifelike_mj.io import check_unclaimed, exclusive
     from lifelike_mj.paths import check_output_file, check_writable
 
     out = Path(out)
@@ -171,6 +171,7 @@ def guarded_run_files(out: str | Path, checkpoint: str | Path | None, *, resume:
         raise UserError(f"the checkpoint and the controller file are the same file ({out}); give another --checkpoint.")
     check_output_file(out, "--out", suffixes=(".json",), overwrite=True, claim=False)
     check_writable(ckpt, "checkpoint")
+    check_unclaimed(ckpt, "checkpoint")
     with exclusive(out, "--out", overwrite=overwrite or resume), exclusive(ckpt, "checkpoint",
                                                                            overwrite=overwrite or resume):
         check_output_file(out, "--out", suffixes=(".json",), overwrite=overwrite or resume)

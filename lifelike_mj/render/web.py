@@ -42,9 +42,13 @@ class WebOptions:
         if not 0 <= int(self.port) <= 65535:
             raise UserError(f"--port must be a whole number from 0 to 65,535, got {self.port}.")
         try:
-            socket.getaddrinfo(self.host, None)
+            infos = socket.getaddrinfo(self.host, None, type=socket.SOCK_STREAM)
         except (socket.gaierror, UnicodeError):
             raise UserError(f"--host {self.host!r} is not an address or a name this machine can resolve.") from None
+        if not any(_can_bind(family, addr) for family, _t, _p, _c, addr in infos):
+            shown = ", ".join(sorted({str(a[0]) for *_x, a in infos}))
+            raise UserError(f"--host {self.host!r} ({shown}) is not an address of this machine, so nothing can listen "
+                            "on it; give localhost, one of this machine's addresses, or 0.0.0.0 for every one.")
         return self
 
     @property
@@ -55,6 +59,17 @@ class WebOptions:
             return ipaddress.ip_address(self.host).is_loopback
         except ValueError:
             return False
+
+
+def _can_bind(family: int, addr: tuple) -> bool:
+    """Whether a socket can be bound to ``addr`` (port 0: none is taken) here: false for an address that is not one
+    of this machine's."""
+    try:
+        with socket.socket(family, socket.SOCK_STREAM) as sock:
+            sock.bind((addr[0], 0, *addr[2:]))
+        return True
+    except OSError:
+        return False
 
 
 class _Shown:

@@ -16,14 +16,18 @@ def test_without_taps_or_food_the_tank_swims_as_before():
     assert np.array_equal(a.tank.snapshot()[0], b.snapshot()[0])
 
 
-def test_a_tap_startles_the_fish_near_it_away_from_it():
-    a, b = Aquarium(Tank(n_fish=10, seed=3)), Tank(n_fish=10, seed=3)
+def _tap_outcome(seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """A tank of 10 (``seed``) tapped on the front glass level with a fish drawn at random, as the viewer's key does,
+    after 2 s: how much farther from the tap each startled fish is 0.5 s later (m), and the same fish in the
+    untapped tank."""
+    a, b = Aquarium(Tank(n_fish=10, seed=seed)), Tank(n_fish=10, seed=seed)
     a.step(120)
     b.step(120)
     pos, _ = a.tank.snapshot()
-    tap = np.array([pos[0, 0], -a.tank.scene.size[1] / 2, pos[0, 2]])  # the front glass, level with fish 0
+    k = int(np.random.default_rng(seed).integers(10))
+    tap = np.array([pos[k, 0], -a.tank.scene.size[1] / 2, pos[k, 2]])
     near = np.linalg.norm(pos - tap, axis=1) <= TAP_RADIUS_M
-    assert a.tap(tap) == near.sum() and 0 < near.sum() < 10
+    assert a.tap(tap) == near.sum() and 0 < near.sum() <= 10
     assert np.array_equal(a.startled, near)
     a.step(int(round(0.5 / a.dt)))
     b.step(int(round(0.5 / b.dt)))
@@ -31,25 +35,48 @@ def test_a_tap_startles_the_fish_near_it_away_from_it():
     d0 = np.linalg.norm(pos - tap, axis=1)
     moved = np.linalg.norm(a.tank.snapshot()[0] - tap, axis=1) - d0
     calm = np.linalg.norm(b.snapshot()[0] - tap, axis=1) - d0
-    assert np.all(moved[near] > 0.02)  # every startled fish fled
-    assert moved[near].mean() > calm[near].mean() + 0.05  # much farther than it would have swum
+    return moved[near], calm[near]
 
 
-def test_a_pellet_is_found_and_eaten_where_no_fish_would_have_passed():
-    a, b = Aquarium(Tank(n_fish=10, seed=3)), Tank(n_fish=10, seed=3)
+def test_taps_startle_the_fish_near_them_away_over_twenty_seeds():
+    """docs/results.md's figures of a tap, over 20 taps (seeds 0-19): of the 86 startled fish, 0.5 s later the median
+    is 0.083 m farther than the same fish untapped; 69 (80 %) moved more than 2 cm away, 80 (93 %) ended farther than
+    untapped. (Not every one: a fish swimming toward the tap is not always turned by 0.25 s of push.)"""
+    moved, calm = (np.concatenate(x) for x in zip(*[_tap_outcome(s) for s in range(20)]))
+    gain = moved - calm
+    assert len(moved) == 86
+    assert abs(np.median(gain) - 0.083) < 0.002 and abs(np.median(moved) - 0.084) < 0.002
+    assert (moved > 0.02).sum() == 69 and (gain > 0).sum() == 80
+
+
+def _food_outcome(seed: int) -> tuple[float, float]:
+    """A pellet dropped mid-tank 1 s into a tank of 10 (``seed``): when it was eaten (s after the drop; inf: not within
+    20 s), and how close the same tank's fish without food came to where it sank until then (m)."""
+    a, b = Aquarium(Tank(n_fish=10, seed=seed)), Tank(n_fish=10, seed=seed)
     a.step(60)
     b.step(60)
     x = float(np.clip(a.tank.snapshot()[0][:, 0].mean(), -2.0, 2.0))
     a.drop_food(x, 0.0)
     H = a.tank.scene.size[2]
     closest = np.inf  # the untouched tank's closest fish to where the pellet would have been
-    for k in range(1, 601):
+    for k in range(1, 1201):
         a.step(1)
         b.step(1)
         pellet = np.array([x, 0.0, max(H - FOOD_SINK_M_S * k * b.dt, 0.0)])
         closest = min(closest, float(np.min(np.linalg.norm(b.snapshot()[0] - pellet, axis=1))))
-    assert a.eaten == 1 and len(a.pellets_m) == 0
-    assert closest > EAT_RADIUS_M
+        if a.eaten:
+            assert len(a.pellets_m) == 0
+            return k * a.dt, closest
+    return np.inf, closest
+
+
+def test_a_pellet_is_found_and_eaten_where_no_fish_would_have_passed_over_twenty_seeds():
+    """docs/results.md's figures of food, over 20 pellets (seeds 0-19): every one eaten, after 1.4-10.8 s (median
+    4.7 s, 19 within 10 s), and in none of the same tanks without food did a fish come within the 4 cm eating
+    distance of where it sank before then."""
+    times, closest = np.array([_food_outcome(s) for s in range(20)]).T
+    assert np.all(np.isfinite(times)) and abs(np.median(times) - 4.7) < 0.1 and (times <= 10.0).sum() == 19
+    assert np.all(closest > EAT_RADIUS_M)
 
 
 def test_taps_and_food_outside_the_tank_are_refused():
