@@ -153,7 +153,7 @@ def from_dict(data: object, name: str = "") -> ButterflyController:
     """Validate plain data and build a controller; malformed data raises :class:`UserError`."""
     where = f"controller {name}" if name else "controller"
     check_header(data, FORMAT, where, kind="butterfly controller file")
-    if data.get("type") not in PITCH_LAWS:  # the clearest sentence for an unknown law, before the schema's
+    if not isinstance(data.get("type"), str) or data["type"] not in PITCH_LAWS:  # clearer than the schema's
         raise UserError(f"{where}: unknown controller type {data.get('type')!r}; known types: "
                         f"{', '.join(sorted(PITCH_LAWS))}.")
     validate(data, json_schema(), where)
