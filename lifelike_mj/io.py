@@ -50,17 +50,17 @@ def _publish(tmp: str, target: Path) -> None:
     else:
         from lifelike_mj.errors import UserError
 
+        appeared = UserError(f"{c.what} {target} appeared while this run was working (another program wrote it); "
+                             "it is kept, and this run's result is not written (add --overwrite to replace it).")
         try:
             os.link(tmp, target)
         except FileExistsError:
-            raise UserError(f"{c.what} {target} appeared while this run was working (another program wrote it); "
-                            "it is kept, and this run's result is not written (add --overwrite to replace it).") from None
+            raise appeared from None
         except OSError:  # a file system without hard links: create the name exclusively, then fill it
             try:
                 os.close(os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
             except FileExistsError:
-                raise UserError(f"{c.what} {target} appeared while this run was working (another program wrote "
-                                "it); it is kept, and this run's result is not written.") from None
+                raise appeared from None
             os.replace(tmp, target)
         else:
             os.unlink(tmp)
@@ -105,8 +105,21 @@ def _key(path: Path) -> str:
 
 
 def _claim_of(target: Path) -> Claim | None:
-    """The claim that covers ``target``: its own, or its folder's."""
-    return _claims.get(_key(target)) or _claims.get(_key(target.parent))
+    """The claim that covers ``target``: its own, or that of a folder it lies in."""
+    if _claims:
+        for p in (target, *target.absolute().parents):
+            if (c := _claims.get(_key(p))) is not None:
+                return c
+    return None
+
+
+def _held(what: str, target: Path, fd: int) -> Exception:
+    """The error for ``target``, whose lock (open on ``fd``) another process holds: it names that process."""
+    from lifelike_mj.errors import UserError
+
+    other = os.pread(fd, 400, 0).decode(errors="replace").strip()
+    return UserError(f"another run is writing {what} {target} (process {other or 'unknown'}); wait for it or choose "
+                     "another name.")
 
 
 def lock_path(path: str | Path) -> Path:
@@ -142,11 +155,9 @@ def claim(path: str | Path, what: str = "output", *, overwrite: bool = False) ->
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
-            other = os.pread(fd, 400, 0).decode(errors="replace").strip()
+            err = _held(what, target, fd)
             os.close(fd)
-            holder = f"process {other}" if other else "another process"
-            raise UserError(f"another run is writing {what} {target} ({holder}); wait for it or choose another "
-                            "name.") from None
+            raise err from None
         try:
             same = os.fstat(fd).st_ino == os.stat(lock).st_ino
         except FileNotFoundError:
@@ -171,7 +182,6 @@ def check_unclaimed(path: str | Path, what: str = "output") -> None:
     before it claims the first."""
     import fcntl
 
-    from lifelike_mj.errors import UserError
 
     target = Path(path)
     if _key(target) in _claims:
@@ -184,9 +194,7 @@ def check_unclaimed(path: str | Path, what: str = "output") -> None:
         try:
             fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
         except BlockingIOError:
-            other = os.pread(fd, 400, 0).decode(errors="replace").strip()
-            raise UserError(f"another run is writing {what} {target} (process {other or 'unknown'}); wait for it or "
-                            "choose another name.") from None
+            raise _held(what, target, fd) from None
     finally:
         os.close(fd)
 

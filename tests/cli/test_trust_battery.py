@@ -141,6 +141,21 @@ CASES = [
     (["render", "butterfly", "--out", "v.mp4", "--duration", "600", "--fps", "61"], "asks for 36,600 frames", {}),
     (["render", "fish", "--out", "v.mp4", "--duration", "600", "--fps", "61"], "control", {}),
     (["render", "boids", "--out", "v.mp4", "--steps", "100001"], "--steps", {}),
+    # --- the commands the first battery left out
+    (["butterfly", "timestep", "--cd", "0"], "--cd", {}),
+    (["butterfly", "timestep", "--backend", "paper", "--config", "rich"], "only apply to --backend mujoco", {}),
+    (["butterfly", "assess", "--controller", "c.json"], "is not a butterfly controller", {"c.json": STEER}),
+    (["butterfly", "speed-limit", "--rho", "-1"], "--rho", {}),
+    (["fish", "drag-check", "--fish", "3"], "unrecognized arguments", {}),
+    (["bench", "fish", "--long-minutes", "601"], "--long-minutes", {}),
+    (["bench", "boids", "--repeats", "4"], "--repeats", {}),
+    (["bench", "boids", "--max-n", "999"], "--max-n", {}),
+    (["view", "butterfly", "--duration", "-1"], "--duration", {}),
+    (["view", "butterfly", "--controller", "c.json"], "nested too deeply", {"c.json": DEEP}),
+    (["reproduce", "fish", "--out", "afile"], "is a file", {"afile": "x"}),
+    (["reproduce", "boids", "--out", "r"], "already holds report.md", {"r/report.md": "mine"}),
+    (["export", "butterfly", "--out", "a.glb", "--duration", "601"], "--duration", {}),
+    (["export", "butterfly", "--out", "a.glb", "--duration", "0.01"], "holds a single frame", {}),
 ]
 
 
