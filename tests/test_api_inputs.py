@@ -78,6 +78,12 @@ def _env(**kw):
     return gym.make("lifelike_mj/ButterflyPitch-v0", **kw)
 
 
+def _task(**kw):
+    from lifelike_mj.butterfly import evolve3d
+
+    return evolve3d.Task3D(**{"kind": "schedule", "rows": ((0.0, 0.0, 0.0, 1.5),), **kw})
+
+
 def _record3d(dt_s, duration_s):
     from lifelike_mj.butterfly.sim3d import Flight3D
 
@@ -110,6 +116,9 @@ BAD = [
     (_tank, {"seed": -1}, UserError, "seed"),
     (_flock, {"seed": 1.5}, UserError, "seed"),
     (_flight, {"dt_s": 1e-12}, UserError, "at most 1,000,000,000"),
+    (lambda **kw: _task(speed_m_s=1e300), {}, UserError, "speed_m_s must be a number in (0, 100]"),
+    (lambda **kw: _task(wind_m_s=(1e9, 0, 0)), {}, UserError, "wind_m_s must be a number in [-100, 100]"),
+    (lambda **kw: _task(rows=((0.0, 0.0, 1e300, 1.5),)), {}, UserError, "a task's number must be a number in"),
     (lambda **kw: _record3d(1e-9, 100.0), {}, UserError, "asks for 100,000,000,000 time steps"),
     # unknown names: the closest one is named
     (_flight3d, {"forcelaw": "exact"}, UnknownName, "did you mean 'force_law'"),

@@ -23,6 +23,10 @@ from lifelike_mj.butterfly import control3d as c3
 from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.errors import UserError
 
+#: A task's most rows, and the largest number in a row (m, s, rad, m/s): far beyond a garden, finite in the loop.
+MAX_TASK_ROWS = 10_000
+MAX_TASK_NUMBER = 1.0e6
+
 
 @dataclass(frozen=True)
 class Task3D:
@@ -56,22 +60,24 @@ class Task3D:
         if self.kind not in ("schedule", "waypoints", "target"):
             raise UserError(f"a task is a schedule, waypoints or a target, got {self.kind!r}.")
         width = 3 if self.kind == "waypoints" else 4
-        if not self.rows or any(len(r) != width for r in self.rows):
-            raise UserError(f"a {self.kind} task needs rows of {width} numbers.")
+        if not self.rows or len(self.rows) > MAX_TASK_ROWS or any(len(r) != width for r in self.rows):
+            raise UserError(f"a {self.kind} task needs 1 to {MAX_TASK_ROWS:,} rows of {width} numbers.")
         for r in self.rows:
             for v in r:
-                checks.number("a task's number", v)
+                checks.number("a task's number", v, -MAX_TASK_NUMBER, MAX_TASK_NUMBER)
         if self.kind == "schedule" and self.rows[0][0] != 0.0:
             raise UserError("a schedule's first row starts at 0 s.")
-        checks.positive("radius_m", self.radius_m, "m")
-        checks.positive("speed_m_s", self.speed_m_s, "m/s")
+        checks.number("radius_m", self.radius_m, 0.0, 1000.0, lo_open=True, unit="m")
+        checks.number("speed_m_s", self.speed_m_s, 0.0, 100.0, lo_open=True, unit="m/s")
         object.__setattr__(self, "wind_m_s", checks.vector("wind_m_s", self.wind_m_s, 3, "m/s"))
+        for w in self.wind_m_s:
+            checks.number("each component of wind_m_s", w, -100.0, 100.0, unit="m/s")
         checks.number("gust_m_s", self.gust_m_s, 0.0, 10.0, unit="m/s")
-        checks.positive("gust_tau_s", self.gust_tau_s, "s")
+        checks.number("gust_tau_s", self.gust_tau_s, 0.0, 1e4, lo_open=True, unit="s")
         if self.gust_vertical_m_s is not None:
             checks.number("gust_vertical_m_s", self.gust_vertical_m_s, 0.0, 10.0, unit="m/s")
         checks.number("flutter", self.flutter, 0.0, 1.0)
-        checks.positive("flutter_tau_s", self.flutter_tau_s, "s")
+        checks.number("flutter_tau_s", self.flutter_tau_s, 0.0, 1e4, lo_open=True, unit="s")
         checks.whole("seed", self.seed, 0, 2**32 - 1)
 
     def with_weather(self, wind_m_s=(0.0, 0.0, 0.0), gust_m_s: float = 0.0, gust_tau_s: float = 1.0,
