@@ -237,14 +237,17 @@ def view_boids(params: BoidParams, n: int = 300, seed: int = 0, steps_per_s: flo
 
 #: The flock's keys in the desktop viewer and what each does (none of them is one of MuJoCo's viewer's own; the web
 #: viewer also has a button per pattern).
-KEYS = (("Right", "the next pattern's weights (4a, 4b, ... 5d)"), ("Left", "the previous pattern's weights"))
+KEYS = (("Right", "the next pattern's weights (4a, 4b, ... 5d)"), ("Left", "the previous pattern's weights"),
+        ("Enter", "scatter the flock: a new mixed start under the weights flown now"))
 
 
 def weight_controls(flock: Flock) -> list:
     """The flock's keys and buttons (:data:`KEYS`; :class:`~lifelike_mj.render.viewer.Control`): Right and Left step
     through patterns 4a, 4b, 4c, 4d, 5a, 5b, 5c and 5d (Nakamura 2013 Fig. 4-5), and the web viewer has one button
     per pattern; the flock takes that pattern's weight matrices ``W_a``, ``W_c`` from the next step on
-    (:meth:`Flock.set_weights`), the agents where they are. Each press prints the pattern now flown."""
+    (:meth:`Flock.set_weights`), the agents where they are. Each press prints the pattern now flown. Enter
+    scatters the agents afresh (:meth:`Flock.scatter`, a new seed each time): some patterns grow only from a
+    mixed start, not from the groups another pattern has formed (measured: ``docs/models/boids.md``)."""
     from lifelike_mj.boids.presets import PATTERNS, load_preset
     from lifelike_mj.render.viewer import Control
 
@@ -262,7 +265,14 @@ def weight_controls(flock: Flock) -> list:
     def back() -> None:
         take(at[0] - 1 if at[0] >= 0 else -1)
 
+    scattered = [0]
+
+    def scatter() -> None:
+        scattered[0] += 1
+        flock.scatter(flock.seed + scattered[0])
+
     return [Control("Right", KEYS[0][1], lambda: take(at[0] + 1)), Control("Left", KEYS[1][1], back),
+            Control("Enter", KEYS[2][1], scatter),
             *(Control("", f"weights of pattern {name}", switch(i)) for i, name in enumerate(PATTERNS))]
 
 

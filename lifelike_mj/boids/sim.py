@@ -97,6 +97,9 @@ class Flock(StepCounter):
         the flock's step numbers."""
         n_steps = checks.whole("the number of steps", n_steps, 1)
         every = checks.whole("record_every", every, 1)
+        frames = (n_steps - min(max(int(record_from), 0), n_steps)) // every + 1 + len(extra_steps)
+        checks.work(f"recording {self.n:,} agents every {every} steps over {n_steps:,} steps", float(frames) * self.n,
+                    checks.MAX_RECORD_ROWS, "agent rows", "fewer agents, or recording less often or less")
         t0 = time.perf_counter()
         k0, D, n = self._k, self.params.dims, self.n
         rec = sorted({s for s in range(0, n_steps + 1, every) if s >= record_from}
@@ -130,6 +133,15 @@ class Flock(StepCounter):
                        V[:, :, :D].copy(), time.perf_counter() - t0)
 
     # ---- changing the flock between steps -------------------------------------------------------
+
+    def scatter(self, seed: int) -> None:
+        """The agents placed afresh at random, as a new start drawn with ``seed`` would place them
+        (:func:`~lifelike_mj.boids.engine.initial_state`: positions away from the walls, tiny velocities), each
+        keeping its type; the weights and the step count go on. What the viewer's restart key does: a mixed flock
+        again, under the weights flown now."""
+        x, v, _types = initial_state(self.params, self.n, checks.whole("seed", seed, 0))
+        self._x[:] = _as3(x)
+        self._v[:] = _as3(v)
 
     def set_weights(self, wa=None, wc=None) -> None:
         """Replace the alignment and/or cohesion matrix (``k x k``, rows: own type) from the next step on;

@@ -63,7 +63,7 @@ def test_the_boids_keys_switch_the_weights_live():
     flock = Flock(load_preset("5a"), n=50, seed=1)
     flock.step(10)
     keys = weight_controls(flock)
-    assert [c.key for c in keys if c.key] == ["Right", "Left"] and len(keys) == 10  # and a web button per pattern
+    assert [c.key for c in keys if c.key] == ["Right", "Left", "Enter"] and len(keys) == 11  # and a button per pattern
     _press(keys, "Right")
     _press(keys, "Right")  # pattern 4b
     p = load_preset("4b")
@@ -71,6 +71,15 @@ def test_the_boids_keys_switch_the_weights_live():
     np.testing.assert_array_equal(flock.params.wc, p.wc)
     assert flock.steps == 10  # the agents stay where they are
     flock.step(5)
+    before = flock.state()
+    _press(keys, "Enter")  # scattered afresh: new places, the same types, weights and step count
+    after = flock.state()
+    assert not np.allclose(after["position_box"], before["position_box"])
+    np.testing.assert_array_equal(after["type"], before["type"])
+    np.testing.assert_array_equal(flock.params.wa, p.wa)
+    assert flock.steps == 15 and flock.model is not None
+    x = after["position_box"]
+    assert x.min() >= flock.params.r_c - 1e-12 and x.max() <= flock.params.box - flock.params.r_c + 1e-12
 
 
 def test_the_aquariums_keys_tap_and_feed():
