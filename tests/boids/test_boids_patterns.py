@@ -51,3 +51,21 @@ def test_fig2_regimes_of_one_type():
         want[(wa, 0.01)] = "swarm" if wa >= 0.01 else "spread"
         want[(wa, 0.1)] = "compact flock" if wa >= 0.01 else "spread"
     assert got == want
+
+
+def test_the_viewers_key_for_5b_shows_it_only_after_a_fresh_start():
+    """docs/models/boids.md's table of what the viewer's keys show (benchmarks/viewer_patterns.py, seeds 20-39),
+    recomputed for one entry: the viewer's flock (5a for 1,500 steps) given 5b's weights at seed 22 forms 4d's
+    picture, and 5b's own once scattered afresh (the Enter key); the benchmark's file holds the same labels."""
+    import importlib.util
+    import json
+    from pathlib import Path
+
+    bench = Path(__file__).resolve().parents[2] / "benchmarks"
+    spec = importlib.util.spec_from_file_location("viewer_patterns", bench / "viewer_patterns.py")
+    vp = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(vp)
+    table = json.loads((bench / "results" / "viewer_patterns.json").read_text())
+    i = table["seeds"].index(22)
+    got = (vp.switched("5b", 22, 1500), vp.switched("5b", 22, 1500, scatter=True))
+    assert got == ("4d", "5b") == (table["patterns"]["5b"]["viewer_labels"][i], table["patterns"]["5b"]["enter_labels"][i])
