@@ -36,6 +36,10 @@ STATE_UNITS = {
 }
 
 
+#: The most agents a flock holds (the scaling benchmark's largest run).
+MAX_FLOCK = 10_000_000
+
+
 class Flock(StepCounter):
     """``n`` agents with parameters ``params`` (:class:`~lifelike_mj.boids.engine.BoidParams`; default
     the paper's 5a weights) started from ``seed`` (:func:`~lifelike_mj.boids.engine.initial_state`).
@@ -48,7 +52,7 @@ class Flock(StepCounter):
 
             params = load_preset("5a")
         self.params = params
-        self._n0 = checks.whole("the number of agents", n, 2)
+        self._n0 = checks.whole("the number of agents", n, 2, MAX_FLOCK)
         self._seed = checks.whole("seed", seed, 0)
         self.reset()
 

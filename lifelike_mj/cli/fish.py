@@ -11,7 +11,6 @@ from lifelike_mj.errors import UserError
 
 NAME = "fish"
 #: Bounds of the command line: fish in a tank, simulated seconds, the smallest tank (2.5 body lengths a side).
-MAX_FISH = 5000
 MAX_DURATION_S = 3600.0
 MIN_TANK_SCALE = 0.35
 SWIM_FILES = ("tracks.npz", "tracks.csv", "tracks.png", "accel_histogram.png", "measures.json")
@@ -42,6 +41,8 @@ def _tank(args):
 def _add_fish(p) -> None:
     p.add_argument("--preset", default="default",
                    help="fish motion preset: NB-ND, NB-D, B-ND, B-D, default (= B-D), or a JSON file")
+    from lifelike_mj.fish.params import MAX_FISH
+
     p.add_argument("--n", "--fish", dest="fish", type=count(1, MAX_FISH), default=10,
                    help=f"number of fish, 1 to {MAX_FISH:,} (--n as for boids; --fish is the older spelling)")
     add_seed(p)

@@ -61,6 +61,8 @@ FORMAT = "lifelike-mj/fish-preset"
 #: The paper's four patterns (section 5.1.1) and the calibrated default.
 PRESETS = ("NB-ND", "NB-D", "B-ND", "B-D", "default")
 MU_NAMES = ("accelerate", "coast", "cruise", "brake")
+#: The most fish a tank holds (a tank of 5,000 compiles in seconds; each fish is a MuJoCo body).
+MAX_FISH = 5000
 ACCELERATE, COAST, CRUISE, BRAKE = 0, 1, 2, 3
 
 

@@ -22,6 +22,7 @@ import numpy as np
 
 from lifelike_mj import checks
 from lifelike_mj.errors import UserError
+from lifelike_mj.fish.params import MAX_FISH
 from lifelike_mj.paths import model_path
 
 #: The filmed tank (section 4): length (x, m), depth (y, m), height (z, m).
@@ -105,8 +106,8 @@ def build_scene(n_fish: int, size=None, spec: mujoco.MjSpec | None = None, nuser
     The fish are attached in groups of 32 (MjSpec's attach slows down as the target grows; groups
     keep 1,000 fish under a second). Fish ``i`` is body ``s<i // 32>/f<i>/fish``. ``nuserdata``: size of
     ``mjData.userdata`` (the simulation's per-model parameters)."""
-    if not checks.is_whole(n_fish) or n_fish < 1:
-        raise UserError(f"the number of fish must be a whole number of at least 1, got {n_fish!r}.")
+    if not checks.is_whole(n_fish) or not 1 <= n_fish <= MAX_FISH:
+        raise UserError(f"the number of fish must be a whole number from 1 to {MAX_FISH:,}, got {n_fish!r}.")
     n_fish = int(n_fish)
     if spec is None:
         spec = base_spec(size)
