@@ -38,33 +38,6 @@ def check_header(data: object, fmt: str, where: str, versions: Iterable[int] = (
     return data
 
 
-def check_keys(obj: dict, allowed: Iterable[str], where: str, required: Iterable[str] = ()) -> None:
-    """Unknown keys of ``obj`` are an error naming the closest allowed key; so are missing ``required`` ones."""
-    from lifelike_mj.errors import check_names
-
-    check_names(obj, allowed, f"{where} has an unknown key")
-    missing = [k for k in required if k not in obj]
-    if missing:
-        raise UserError(f"{where} lacks {', '.join(repr(k) for k in missing)}.")
-
-
-def finite(value: object, name: str, where: str) -> float:
-    """A finite JSON number (not a string, a bool or a list) as a float."""
-    if not checks.is_number(value) or not math.isfinite(float(value)):
-        raise UserError(f"{where}: {name} must be a finite number, got {value!r}.")
-    return float(value)
-
-
-def number_list(value: object, name: str, where: str, length: int | None = None, min_length: int = 1) -> list[float]:
-    """A list of finite numbers (of ``length`` items, or at least ``min_length``)."""
-    if not isinstance(value, list):
-        raise UserError(f"{where}: {name} must be a list of numbers, got {value!r}.")
-    if (length is not None and len(value) != length) or len(value) < min_length:
-        want = f"{length}" if length is not None else f"at least {min_length}"
-        raise UserError(f"{where}: {name} must have {want} numbers, got {len(value)}.")
-    return [finite(v, f"{name}[{i}]", where) for i, v in enumerate(value)]
-
-
 def document_schema(fmt: str, title: str, properties: dict, required: list[str], description: str = "") -> dict:
     """A JSON Schema (draft 2020-12) of a file with ``format``/``version`` headers and ``properties``,
     unknown keys refused (``additionalProperties: false``), as the loaders refuse them."""
