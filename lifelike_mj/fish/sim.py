@@ -586,10 +586,6 @@ class Tank(StepCounter):
         self._k += k
         return pos, quat, mu
 
-    def check_work(self, steps: int, recorded: bool = True) -> None:
-        """:func:`check_swim_work` for this tank."""
-        check_swim_work(self.params, self.n_fish, steps, recorded)
-
     def record(self, n_steps: int | None = None, *, duration_s: float | None = None, chunk_steps: int = 60,
                progress: bool = False) -> SwimResult:
         """Swim on ``n_steps`` control steps (or ``duration_s`` s) and return the tracks at every control
@@ -600,7 +596,7 @@ class Tank(StepCounter):
             raise UserError("give either n_steps or duration_s.")
         total = (checks.whole("the number of steps", n_steps, 1) if n_steps is not None
                  else checks.steps_of(checks.positive("duration", duration_s, "s"), self.params.control_dt_s))
-        self.check_work(total)
+        check_swim_work(self.params, self.n_fish, total)
         t0 = time.perf_counter()
         k0 = self._k
         p0, q0 = self.snapshot()
