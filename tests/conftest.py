@@ -114,27 +114,37 @@ from lifelike_mj.export.poses import record_poses  # noqa: E402
 CREATURES = ("butterfly3d", "butterfly2d", "fish", "boids")
 
 
-def _run(creature: str):
+def _fresh(creature: str):
+    """A new simulation of ``creature`` and its recording window: ``(sim, fps, time_scale, duration)``."""
     if creature == "butterfly3d":
         from lifelike_mj.butterfly import evolve3d
         from lifelike_mj.butterfly.sim3d import Flight3D
 
-        sim = Flight3D(controller="steer", task=evolve3d.course(100))
-        return sim, record_poses(sim, 1.0, fps=30.0)
+        return Flight3D(controller="steer", task=evolve3d.course(100)), 30.0, 1.0, 1.0
     if creature == "butterfly2d":
         from lifelike_mj.butterfly import Flight
 
-        sim = Flight(controller="simple_rule", backend="mujoco", config="rich")
-        return sim, record_poses(sim, 1.0, fps=30.0)
+        return Flight(controller="simple_rule", backend="mujoco", config="rich"), 30.0, 1.0, 1.0
     if creature == "fish":
         from lifelike_mj.fish import Tank
 
-        sim = Tank(n_fish=10, seed=1)
-        return sim, record_poses(sim, 1.0, fps=30.0)
+        return Tank(n_fish=10, seed=1), 30.0, 1.0, 1.0
     from lifelike_mj.boids import Flock
 
-    sim = Flock(n=300, seed=1)  # a flock's steps have no seconds: a frame every 5 steps, 30 frames a second
-    return sim, record_poses(sim, 150.0, fps=0.2, time_scale=1.0 / 150.0)
+    # a flock's steps have no seconds: a frame every 5 steps, 30 frames a second
+    return Flock(n=300, seed=1), 0.2, 1.0 / 150.0, 150.0
+
+
+def _run(creature: str):
+    sim, fps, scale, duration = _fresh(creature)
+    return sim, record_poses(sim, duration, fps=fps, time_scale=scale)
+
+
+@pytest.fixture(scope="session")
+def fresh():
+    """``fresh(creature)``: a new simulation of the creature ``runs`` records, and its window: ``(sim, fps,
+    time_scale, duration)``."""
+    return _fresh
 
 
 @pytest.fixture(scope="session")

@@ -252,8 +252,9 @@ def add_export_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--start", type=count(0, MAX_STEPS), default=0, help="steps run before the exported window starts")
     p.add_argument("--steps", type=count(1, MAX_STEPS), default=3000, help="steps exported")
     p.add_argument("--steps-per-frame", type=count(1, 1000), default=DEFAULT_STEPS_PER_FRAME,
-                   help="steps between keyframes")
-    p.add_argument("--fps", type=count(1, 240), default=30, help="keyframes per second of playback")
+                   help="steps per playback frame")
+    p.add_argument("--fps", type=count(1, 240), default=30,
+                   help="playback frames per second (keys fall where the motion needs them, --key-tolerance)")
 
 
 def export_poses(args):

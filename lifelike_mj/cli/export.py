@@ -12,6 +12,8 @@ from __future__ import annotations
 import argparse
 import time
 
+import numpy as np
+
 from lifelike_mj.cli.common import Parser, add_json, add_overwrite, count, emit
 
 #: The creatures that export, in the order of the help.
@@ -39,6 +41,9 @@ def add_export_verb(sub) -> None:
                        help="glb, gltf, usd or html (default: from the file's ending)")
         q.add_argument("--rotations", default="short", choices=("short", "float"),
                        help="glTF and web keyframes' rotations: 16-bit (within 6e-5 rad, half the bytes) or 32-bit")
+        q.add_argument("--key-tolerance", default="0.5mm,0.5deg", metavar="DIST,ANGLE",
+                       help="how far the interpolated keys may stray from the simulation, sampled at every step: a "
+                            "distance (um, mm, cm, m) and an angle (deg, rad)")
         add_overwrite(q)
         add_json(q)
         q.set_defaults(func=cmd_export)
@@ -52,14 +57,18 @@ def add_window(p: argparse.ArgumentParser, max_s: float, default_s: float) -> No
                    help="seconds simulated before the exported window starts")
     p.add_argument("--duration", type=num(0, max_s, lo_open=True, unit="s"), default=default_s,
                    help=f"seconds exported, at most {max_s:g}")
-    p.add_argument("--fps", type=count(1, 240), default=30, help="keyframes per second, 1 to 240")
+    p.add_argument("--fps", type=count(1, 240), default=30,
+                   help="playback frames per second, 1 to 240: the scene's frame rate (keys fall where the motion "
+                        "needs them, --key-tolerance)")
 
 
 def cmd_export(args) -> None:
     from lifelike_mj.export import format_of, write_poses
+    from lifelike_mj.export.keys import key_counts, tolerance_of
     from lifelike_mj.paths import check_output_file
 
     fmt = format_of(args.out, args.format)
+    tolerance = tolerance_of(args.key_tolerance)
     check_output_file(args.out, "--out", overwrite=args.overwrite)
     if fmt == "usd":  # usd-core is an extra: say so before the simulation, not after
         from lifelike_mj.export.usd import require_usd
@@ -69,20 +78,36 @@ def cmd_export(args) -> None:
     t0 = time.perf_counter()
     poses, parameters = mod.export_poses(args)
     t_sim = time.perf_counter() - t0
-    parameters = {"creature": args.what, **parameters, "format": fmt, "rotations": args.rotations}
+    parameters = {"creature": args.what, **parameters, "format": fmt, "rotations": args.rotations,
+                  "key_tolerance": {"m": tolerance[0], "deg": tolerance[1]}}
     path = write_poses(poses, args.out, fmt, name=f"lifelike-mj {args.what}", parameters=parameters,
-                       rotations=args.rotations)
+                       rotations=args.rotations, tolerance=tolerance)
     t_write = time.perf_counter() - t0 - t_sim
     size = path.stat().st_size
-    info = {"out": str(path), "format": fmt, "bytes": size, "frames": poses.n_frames, "bodies": len(poses.body_ids),
-            "span_s": float(poses.t_s[-1] - poses.t_s[0]), "simulate_s": t_sim, "write_s": t_write}
-    emit(args, info, f"wrote {poses.n_frames} frames of {len(poses.body_ids)} bodies ({size / 1e6:.2f} MB) to {path} "
-         f"in {t_sim + t_write:.1f} s")
+    counts = key_counts(poses.tracks(tolerance, "float" if fmt == "usd" else args.rotations), poses.body_names)
+    info = {"out": str(path), "format": fmt, "bytes": size, "frames": poses.n_frames, "fps": poses.fps,
+            "samples": poses.n_samples, "bodies": len(poses.body_ids), "span_s": float(poses.t_s[-1] - poses.t_s[0]),
+            "key_tolerance": {"m": tolerance[0], "deg": tolerance[1]}, "keys": counts, "simulate_s": t_sim,
+            "write_s": t_write}
+    emit(args, info, f"wrote {len(poses.body_ids)} bodies, {poses.n_frames} frames at {poses.fps:g}/s "
+         f"({size / 1e6:.2f} MB) to {path} in {t_sim + t_write:.1f} s\n" + keys_text(counts, poses.n_samples))
+
+
+def keys_text(counts: dict[str, dict[str, int]], samples: int) -> str:
+    """The keys kept per body, in a few lines: each body for a few, a summary for a crowd."""
+    rows = [(name, c["translation"], c["rotation"]) for name, c in counts.items()]
+    head = f"keys kept of {samples:,} samples (translation, rotation):"
+    if len(rows) <= 8:
+        return head + "".join(f"\n  {n}: {t:,}, {r:,}" for n, t, r in rows)
+    t = np.array([r[1] for r in rows])
+    r = np.array([r[2] for r in rows])
+    return (head + f"\n  {len(rows):,} bodies: translation {t.min():,}-{t.max():,} (median {int(np.median(t)):,}), "
+            f"rotation {r.min():,}-{r.max():,} (median {int(np.median(r)):,}); --json lists each")
 
 
 def parameters_of(args: argparse.Namespace) -> dict:
     """The creature's options as given (what made the run), for the file's provenance."""
-    skip = {"func", "out", "format", "overwrite", "json", "command", "what", "rotations"}
+    skip = {"func", "out", "format", "overwrite", "json", "command", "what", "rotations", "key_tolerance"}
     return {k: (list(v) if isinstance(v, tuple) else v) for k, v in vars(args).items() if k not in skip}
 
 
@@ -104,9 +129,10 @@ def run_window(stepper, start: float, duration: float, per_unit: float, time_sca
     """Simulate ``start`` units of the stepper's time unrecorded, then record ``duration`` of them with
     ``per_unit`` frames per unit (:func:`~lifelike_mj.export.poses.record_poses`; ``time_scale``: seconds
     of playback per unit). Each creature checks its window first (:func:`check_window`)."""
-    from lifelike_mj.export.poses import record_poses
+    from lifelike_mj.export.poses import plan_recording, record_poses
     from lifelike_mj.progress import stage
 
+    plan_recording(stepper, duration, per_unit)
     skip = int(round(start / stepper.dt))
     with stage(f"simulating {start + duration:g} {unit}"):
         if skip:

@@ -3,9 +3,10 @@
 Layout of the file:
 
 * one root node, ``lifelike-mj``, turning MuJoCo's Z-up world into glTF's Y-up (-90 deg about X); metres;
-* under it, one node per exported body, animated (translation and rotation, linear, at the recorded
-  frames; rotations as normalized 16-bit integers by default, within 6e-5 rad), and one still node per
-  drawn geom of the world body (ground, tank, flowers);
+* under it, one node per exported body, animated (translation and rotation, linear, each channel at its own
+  keys: the samples of the simulation's steps that interpolation needs to stay within the key tolerance,
+  :mod:`lifelike_mj.export.keys`; rotations as normalized 16-bit integers by default, within 6e-5 rad), and
+  one still node per drawn geom of the world body (ground, tank, flowers);
 * under each body node, one still node per drawn geom, at the geom's place in the body, holding its mesh;
 * under it too, the cameras of :mod:`lifelike_mj.export.cameras`: ``camera overview`` (still, seeing the
   whole run) and, for a single creature, ``camera follow`` (moving with it);
@@ -31,6 +32,7 @@ import pygltflib as g
 from lifelike_mj import __version__
 from lifelike_mj.errors import UserError
 from lifelike_mj.export.cameras import FOV_DEG, framing
+from lifelike_mj.export.keys import DEFAULT_TOLERANCE, Track, key_counts, tolerance_of
 from lifelike_mj.export.poses import Poses, drawn_geoms, geom_rgba
 from lifelike_mj.export.shapes import geom_shape, shape_key
 from lifelike_mj.io import atomic_path, strict
@@ -80,23 +82,29 @@ def quantize_rotations(q_xyzw: np.ndarray) -> np.ndarray:
 
 
 def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | None = None,
-               rotations: str = "short") -> g.GLTF2:
+               rotations: str = "short", tolerance=DEFAULT_TOLERANCE) -> g.GLTF2:
     """The glTF document (module docstring) of ``poses``; :func:`write_gltf` writes it. The asset's
     ``extras`` hold the provenance: the versions, the command, the time and ``parameters`` (what made the
-    run), with the frames' count, rate and times.
+    run), with the frames' count, rate and times, the samples' and the keys kept per body.
 
-    ``rotations``: ``"short"`` stores the keyframes' quaternions as normalized 16-bit integers
-    (:func:`quantize_rotations`, half the bytes; core glTF 2.0), ``"float"`` as 32-bit floats. Positions
-    are always 32-bit floats (glTF allows nothing else for translation keys). A body that does not move or
-    turn over the whole run gets no channel for it: its node holds the still pose."""
+    Keys: each body's translation and rotation keys are the samples that interpolation needs to stay within
+    ``tolerance`` (m, deg) of every sample (:mod:`lifelike_mj.export.keys`), at their own times.
+    ``rotations``: ``"short"`` stores the quaternions as normalized 16-bit integers (:func:`quantize_rotations`,
+    half the bytes; core glTF 2.0), ``"float"`` as 32-bit floats. Positions are always 32-bit floats (glTF
+    allows nothing else for translation keys). A body that does not move or turn over the whole run gets no
+    channel for it: its node holds the still pose."""
     if rotations not in ("short", "float"):
         raise UserError(f"rotations are stored as 'short' or 'float', got {rotations!r}.")
+    tolerance = tolerance_of(tolerance)
+    tracks = poses.tracks(tolerance, rotations)
     m = poses.model
-    fps = (poses.n_frames - 1) / (poses.t_s[-1] - poses.t_s[0]) if poses.t_s[-1] > poses.t_s[0] else 0.0
     prov = provenance(**(parameters or {}))
-    prov["frames"] = {"count": poses.n_frames, "per_s": float(fps), "start_s": float(poses.t_s[0]),
-                      "end_s": float(poses.t_s[-1]), "bodies": len(poses.body_ids),
-                      "rotations": rotations}
+    span = float(poses.t_s[-1] - poses.t_s[0])
+    prov["frames"] = {"count": poses.n_frames, "per_s": float(poses.fps), "start_s": float(poses.t_s[0]),
+                      "end_s": float(poses.t_s[-1]), "bodies": len(poses.body_ids), "rotations": rotations}
+    prov["keys"] = {"tolerance_m": tolerance[0], "tolerance_deg": tolerance[1], "samples": poses.n_samples,
+                    "samples_per_s": (poses.n_samples - 1) / span if span > 0 else 0.0,
+                    "per_body": key_counts(tracks, poses.body_names)}
     gl = g.GLTF2(asset=g.Asset(version="2.0", generator=f"lifelike-mj {__version__}", extras=strict(prov)))
     gl.scenes = [g.Scene(name=name, nodes=[0])]
     gl.scene = 0
@@ -140,8 +148,21 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
     drawn = drawn_geoms(m)
     for geom in drawn[m.geom_bodyid[drawn] == 0]:  # the world's still geoms
         root.children.append(geom_node(int(geom)))
-    times = None  # the keyframes' times, shared by every channel
     anim = g.Animation(name=name, samplers=[], channels=[])
+    inputs: dict[bytes, int] = {}  # key times, shared by the channels that have the same keys
+
+    def times_of(keys: np.ndarray) -> int:
+        if keys.tobytes() not in inputs:
+            inputs[keys.tobytes()] = buf.add((poses.t_s[keys] - poses.t_s[0]).astype(np.float32), g.SCALAR,
+                                             minmax=True)
+        return inputs[keys.tobytes()]
+
+    def channel(node: int, path: str, keys: np.ndarray, values: np.ndarray, kind: str) -> None:
+        anim.samplers.append(g.AnimationSampler(input=times_of(keys), output=buf.add(values, kind),
+                                                interpolation="LINEAR"))
+        anim.channels.append(g.AnimationChannel(sampler=len(anim.samplers) - 1,
+                                                target=g.AnimationChannelTarget(node=node, path=path)))
+
     for b, (body, bname) in enumerate(zip(poses.body_ids, poses.body_names)):
         node = g.Node(name=bname, translation=[float(v) for v in poses.position_m[0, b]],
                       rotation=_xyzw(poses.quat_wxyz[0, b]), children=[], extras={"mujoco_body": bname})
@@ -150,27 +171,25 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
         root.children.append(idx)
         for geom in drawn[m.geom_bodyid[drawn] == body]:
             node.children.append(geom_node(int(geom)))
-        trans = poses.position_m[:, b].astype(np.float32)
-        rot = poses.quat_wxyz[:, b][:, [1, 2, 3, 0]]
-        rot = quantize_rotations(rot) if rotations == "short" else rot.astype(np.float32)
-        for path, keys, kind in (("translation", trans, g.VEC3), ("rotation", rot, g.VEC4)):
-            if np.all(keys == keys[0]):
-                continue  # still over the whole run: the node's own pose says it
-            if times is None:
-                times = buf.add(poses.t_s.astype(np.float32) - np.float32(poses.t_s[0]), g.SCALAR, minmax=True)
-            anim.samplers.append(g.AnimationSampler(input=times, output=buf.add(keys, kind), interpolation="LINEAR"))
-            anim.channels.append(g.AnimationChannel(sampler=len(anim.samplers) - 1,
-                                                    target=g.AnimationChannelTarget(node=idx, path=path)))
-    _add_cameras(gl, root, anim, buf, poses, times)
+        track = tracks[b]
+        if track.translation is not None:
+            channel(idx, "translation", track.translation,
+                    poses.position_m[track.translation, b].astype(np.float32), g.VEC3)
+        if track.rotation is not None:
+            rot = poses.quat_wxyz[track.rotation, b][:, [1, 2, 3, 0]]
+            channel(idx, "rotation", track.rotation,
+                    quantize_rotations(rot) if rotations == "short" else rot.astype(np.float32), g.VEC4)
+    _add_cameras(gl, root, poses, tracks, channel)
     gl.animations = [anim] if anim.channels else []
     gl.buffers = [g.Buffer(byteLength=len(buf.data))]
     gl.set_binary_blob(bytes(buf.data))
     return gl
 
 
-def _add_cameras(gl: g.GLTF2, root: g.Node, anim: g.Animation, buf: _Buffer, poses: Poses, times: int | None) -> None:
+def _add_cameras(gl: g.GLTF2, root: g.Node, poses: Poses, tracks: list[Track], channel) -> None:
     """The overview camera and, for one creature, the follow camera (:mod:`lifelike_mj.export.cameras`), as
-    nodes under the root (MuJoCo's world)."""
+    nodes under the root (MuJoCo's world); the follow camera keeps its body's translation keys (it moves by
+    the same path, shifted)."""
     f = framing(poses)
     look = _xyzw(f.look_quat_wxyz())
     yfov = math.radians(FOV_DEG)
@@ -186,22 +205,20 @@ def _add_cameras(gl: g.GLTF2, root: g.Node, anim: g.Animation, buf: _Buffer, pos
                                perspective=g.Perspective(yfov=yfov, znear=max(f.follow_m / 1000.0, 1e-4))))
     gl.nodes.append(g.Node(name="camera follow", camera=1, rotation=look, translation=[float(v) for v in path[0]]))
     root.children.append(len(gl.nodes) - 1)
-    if times is not None and not np.all(path == path[0]):
-        anim.samplers.append(g.AnimationSampler(input=times, output=buf.add(path.astype(np.float32), g.VEC3),
-                                                interpolation="LINEAR"))
-        anim.channels.append(g.AnimationChannel(sampler=len(anim.samplers) - 1, target=g.AnimationChannelTarget(
-            node=len(gl.nodes) - 1, path="translation")))
+    keys = tracks[f.follow].translation
+    if keys is not None:
+        channel(len(gl.nodes) - 1, "translation", keys, path[keys].astype(np.float32), g.VEC3)
 
 
 def write_gltf(poses: Poses, path: str | Path, name: str = "lifelike-mj run", parameters: dict | None = None,
-               rotations: str = "short") -> Path:
+               rotations: str = "short", tolerance=DEFAULT_TOLERANCE) -> Path:
     """Write ``poses`` as animated glTF 2.0: binary (``.glb``) or JSON with the buffer inside (``.gltf``),
     atomically, with the provenance (:func:`build_gltf`; ``parameters``: what made the run; ``rotations``:
-    ``"short"`` or ``"float"`` keys). Returns the path."""
+    ``"short"`` or ``"float"`` keys; ``tolerance``: the keys' (m, deg)). Returns the path."""
     path = Path(path)
     if path.suffix.lower() not in (".glb", ".gltf"):
         raise UserError(f"a glTF file ends in .glb or .gltf, got {path.name!r}.")
-    gl = build_gltf(poses, name, parameters, rotations)
+    gl = build_gltf(poses, name, parameters, rotations, tolerance)
     with atomic_path(path) as tmp:
         if path.suffix.lower() == ".glb":
             gl.save_binary(str(tmp))

@@ -22,6 +22,7 @@ import numpy as np
 from lifelike_mj.errors import UserError
 from lifelike_mj.export.cameras import FOV_DEG, framing
 from lifelike_mj.export.gltf import Z_UP_TO_Y_UP_MATRIX, build_gltf
+from lifelike_mj.export.keys import DEFAULT_TOLERANCE
 from lifelike_mj.export.poses import Poses
 from lifelike_mj.io import atomic_path
 
@@ -121,9 +122,9 @@ def _inline(text: str) -> str:
 
 
 def build_html(poses: Poses, name: str = "lifelike-mj run", parameters: dict | None = None,
-               rotations: str = "short") -> str:
+               rotations: str = "short", tolerance=DEFAULT_TOLERANCE) -> str:
     """The page (module docstring) of ``poses`` as text; :func:`write_html` writes it."""
-    gl = build_gltf(poses, name, parameters, rotations)
+    gl = build_gltf(poses, name, parameters, rotations, tolerance)
     f = framing(poses)
     y_up = Z_UP_TO_Y_UP_MATRIX
     d = y_up @ f.direction  # model-viewer's orbit: theta about +Y from +Z, phi from +Y
@@ -132,7 +133,7 @@ def build_html(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
     centre = y_up @ f.centre_m
     frame = {"theta": round(theta, 3), "phi": round(phi, 3), "overview_m": f.overview_m, "follow_m": f.follow_m,
              "centre": [float(v) for v in centre], "span_s": float(poses.t_s[-1] - poses.t_s[0]),
-             "follow_path": (np.round(poses.position_m[:, f.follow] @ y_up.T, 5).tolist() if follow else None)}
+             "follow_path": (np.round(poses.frames().position_m[:, f.follow] @ y_up.T, 5).tolist() if follow else None)}
     glb = b"".join(gl.save_to_bytes())
     prov = json.dumps(gl.asset.extras, allow_nan=False)
     return _PAGE.format(generator=html.escape(gl.asset.generator), title=html.escape(name),
@@ -146,12 +147,12 @@ def build_html(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
 
 
 def write_html(poses: Poses, path: str | Path, name: str = "lifelike-mj run", parameters: dict | None = None,
-               rotations: str = "short") -> Path:
+               rotations: str = "short", tolerance=DEFAULT_TOLERANCE) -> Path:
     """Write the page of ``poses`` (module docstring) to ``path`` (``.html``), atomically. Returns the path."""
     path = Path(path)
     if path.suffix.lower() != ".html":
         raise UserError(f"a web page ends in .html, got {path.name!r}.")
-    text = build_html(poses, name, parameters, rotations)
+    text = build_html(poses, name, parameters, rotations, tolerance)
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
     return path

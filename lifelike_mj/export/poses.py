@@ -1,4 +1,5 @@
-"""A run's body poses sampled at a frame rate: what every exporter writes.
+"""A run's body poses sampled at every step of the simulation, with the frames of its playback: what every
+exporter writes (keyed by :mod:`lifelike_mj.export.keys`).
 
 A body is exported when it carries a geom that is drawn by default (MuJoCo's visible groups 0, 1 and 2,
 and not fully transparent): the looks of the creature, not its mass or fluid geoms. The world body's
@@ -14,6 +15,7 @@ import numpy as np
 
 from lifelike_mj import checks
 from lifelike_mj.errors import UserError
+from lifelike_mj.export.keys import DEFAULT_TOLERANCE, Track, body_tracks, tolerance_of
 
 #: Geom groups drawn by default (MuJoCo's ``mjvOption.geomgroup`` starts with groups 0, 1 and 2 on).
 DRAWN_GROUPS = (0, 1, 2)
@@ -36,9 +38,11 @@ def geom_rgba(model: mujoco.MjModel) -> np.ndarray:
 
 @dataclass
 class Poses:
-    """Body poses over time, in MuJoCo's world frame (m, Z up): ``t_s`` (frames), ``position_m``
-    ``(frames, bodies, 3)``, ``quat_wxyz`` ``(frames, bodies, 4)`` (unit, sign-continuous from frame to frame)
-    of the bodies ``body_ids`` (names ``body_names``); ``model``: the MuJoCo model they belong to."""
+    """Body poses over time, in MuJoCo's world frame (m, Z up): ``t_s`` (the samples' playback times, s),
+    ``position_m`` ``(samples, bodies, 3)``, ``quat_wxyz`` ``(samples, bodies, 4)`` (unit, sign-continuous from
+    sample to sample) of the bodies ``body_ids`` (names ``body_names``); ``model``: the MuJoCo model they belong
+    to. The samples are the simulation's steps (or only its frames, when recorded so); ``frame_samples``: the
+    sample shown by each playback frame, ``fps`` frames per second of playback."""
 
     model: mujoco.MjModel
     body_ids: np.ndarray
@@ -46,10 +50,39 @@ class Poses:
     t_s: np.ndarray
     position_m: np.ndarray
     quat_wxyz: np.ndarray
+    frame_samples: np.ndarray | None = None
+    fps: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.frame_samples is None:  # every sample is a frame
+            self.frame_samples = np.arange(len(self.t_s))
+        if not self.fps:
+            span = float(self.t_s[-1] - self.t_s[0]) if len(self.t_s) else 0.0
+            self.fps = (self.n_frames - 1) / span if span > 0 else 0.0
 
     @property
     def n_frames(self) -> int:
+        """Playback frames."""
+        return len(self.frame_samples)
+
+    @property
+    def n_samples(self) -> int:
         return len(self.t_s)
+
+    def tracks(self, tolerance=DEFAULT_TOLERANCE, rotations: str = "short") -> list[Track]:
+        """Each body's keys within ``tolerance`` (m, deg) for ``rotations`` ("short" or "float") storage
+        (:func:`~lifelike_mj.export.keys.body_tracks`), computed once per tolerance."""
+        key = (tolerance_of(tolerance), rotations)
+        cache = self.__dict__.setdefault("_tracks", {})
+        if key not in cache:
+            cache[key] = body_tracks(self.t_s, self.position_m, self.quat_wxyz, key[0], rotations)
+        return cache[key]
+
+    def frames(self) -> Poses:
+        """The same run at its playback frames only."""
+        k = self.frame_samples
+        return Poses(self.model, self.body_ids, self.body_names, self.t_s[k], self.position_m[k], self.quat_wxyz[k],
+                     None, self.fps)
 
 
 def animated_bodies(model: mujoco.MjModel) -> np.ndarray:
@@ -72,39 +105,50 @@ def frames_of(duration_s: float, fps: float, unit: str = "s") -> int:
                        "frames", "a shorter window or fewer frames per second")
 
 
-def record_poses(stepper, duration_s: float, fps: float = 30.0, time_scale: float = 1.0) -> Poses:
-    """Run ``stepper`` on for ``duration_s`` of its time from where it is, sampling its drawn bodies' poses
-    ``fps`` times per unit of its time (the first frame is the state now). Each frame lies on the nearest
-    whole step; its time is that step's, times ``time_scale``: the seconds of playback per unit of the
-    stepper's time (1 for the creatures that live in seconds; a flock's time is counted in steps, so
-    ``time_scale = 1 / (steps per frame x frames per second)`` plays it at a frame rate). ``stepper``: anything
-    in the stepper shape (``model``, ``data``, ``step``, ``sync``, ``dt``, ``time``)."""
-    time_scale = checks.positive("time_scale", time_scale, "s per unit")
+def plan_recording(stepper, duration_s: float, fps: float, every_step: bool = True):
+    """What :func:`record_poses` will record, checked before any simulation: the exported bodies, each frame's
+    step and the steps sampled (at most :data:`~lifelike_mj.checks.MAX_RECORD_ROWS` body poses)."""
     n_frames = frames_of(duration_s, fps)
+    dt = float(stepper.dt)
+    frame_steps = np.array([int(round(k / fps / dt)) for k in range(n_frames)])
+    bodies = animated_bodies(stepper.model)
+    if len(bodies) == 0:
+        raise UserError("the model has no drawn body to export (no geom in groups 0-2).")
+    targets = np.arange(frame_steps[-1] + 1) if every_step else frame_steps
+    checks.work(f"recording {len(targets):,} poses of {len(bodies):,} bodies", float(len(targets)) * len(bodies),
+                checks.MAX_RECORD_ROWS, "body poses", "a shorter window, fewer frames per second or fewer creatures")
+    return bodies, frame_steps, targets
+
+
+def record_poses(stepper, duration_s: float, fps: float = 30.0, time_scale: float = 1.0,
+                 every_step: bool = True) -> Poses:
+    """Run ``stepper`` on for ``duration_s`` of its time from where it is, recording its drawn bodies' poses at
+    every step (``every_step``; else only at the frames), with playback frames ``fps`` times per unit of its
+    time (the first is the state now). Each frame lies on the nearest whole step; a sample's time is its step's,
+    times ``time_scale``: the seconds of playback per unit of the stepper's time (1 for the creatures that live
+    in seconds; a flock's time is counted in steps, so ``time_scale = 1 / (steps per frame x frames per
+    second)`` plays it at a frame rate). Stepping one step at a time or many changes nothing in the run.
+    ``stepper``: anything in the stepper shape (``model``, ``data``, ``step``, ``sync``, ``dt``, ``time``)."""
+    time_scale = checks.positive("time_scale", time_scale, "s per unit")
+    bodies, frame_steps, targets = plan_recording(stepper, duration_s, fps, every_step)
+    m = stepper.model
     dt = float(stepper.dt)
     t0 = float(stepper.time)
     done = 0
-    times, pos, quat = [], [], []
-    bodies = None
-    for k in range(n_frames):
-        target = int(round(k / fps / dt))
+    n = len(targets)
+    pos = np.empty((n, len(bodies), 3))
+    quat = np.empty((n, len(bodies), 4))
+    for k, target in enumerate(targets):
         if target > done:
-            stepper.step(target - done)
-            done = target
+            stepper.step(int(target - done))
+            done = int(target)
         stepper.sync()
-        m, d = stepper.model, stepper.data
-        if bodies is None:
-            bodies = animated_bodies(m)
-            if len(bodies) == 0:
-                raise UserError("the model has no drawn body to export (no geom in groups 0-2).")
-        times.append(t0 + done * dt)
-        pos.append(d.xpos[bodies].copy())
-        quat.append(d.xquat[bodies].copy())
-    q = np.array(quat)
-    q /= np.linalg.norm(q, axis=2, keepdims=True)
-    for k in range(1, len(q)):  # q and -q are the same rotation: keep neighbours on one side for slerp
-        flip = np.sum(q[k] * q[k - 1], axis=1) < 0.0
-        q[k, flip] *= -1.0
-    m = stepper.model
+        d = stepper.data
+        pos[k] = d.xpos[bodies]
+        quat[k] = d.xquat[bodies]
+    q = quat / np.linalg.norm(quat, axis=2, keepdims=True)
+    flip = np.cumsum(np.sum(q[1:] * q[:-1], axis=2) < 0.0, axis=0) % 2 == 1  # q and -q are one rotation:
+    q[1:][flip] *= -1.0  # keep neighbours on one side for slerp
     names = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(b)) or f"body{int(b)}" for b in bodies]
-    return Poses(m, bodies, names, np.array(times) * time_scale, np.array(pos), q)
+    frames = np.searchsorted(targets, frame_steps)
+    return Poses(m, bodies, names, (t0 + targets * dt) * time_scale, pos, q, frames, fps / time_scale)

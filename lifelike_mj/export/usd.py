@@ -6,8 +6,9 @@ Layout of the stage (Z up, metres, as MuJoCo's world; ``timeCodesPerSecond`` is 
 
 * ``/World``: one ``Xform`` per exported body (its MuJoCo name in ``customData["mujoco_body"]`` and in the
   attribute ``userProperties:mujoco_body``, which Blender shows as a custom property), animated
-  (``xformOp:translate`` and ``xformOp:orient`` time samples at every frame, 32-bit floats; a body that never
-  moves holds one still value), and the world body's drawn geoms as still meshes;
+  (``xformOp:translate`` and ``xformOp:orient`` time samples at each channel's keys, which may fall between
+  frames, 32-bit floats; a body that never moves holds one still value), and the world body's drawn geoms as
+  still meshes;
 * under each body, one ``Mesh`` per drawn geom at its place in the body;
 * ``/Shapes`` (a class, not drawn): one mesh per distinct shape, which the geoms reference, so a flock of
   hundreds stores one bird; ``/Looks``: one ``UsdPreviewSurface`` material per colour.
@@ -30,6 +31,7 @@ import mujoco
 import numpy as np
 
 from lifelike_mj.errors import UserError
+from lifelike_mj.export.keys import DEFAULT_TOLERANCE, key_counts, tolerance_of
 from lifelike_mj.export.poses import Poses, drawn_geoms, geom_rgba
 from lifelike_mj.export.shapes import geom_shape, shape_key
 from lifelike_mj.io import atomic_path, strict
@@ -58,13 +60,19 @@ def _ident(text: str, used: set[str]) -> str:
     return name
 
 
-def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | None = None):
-    """The USD stage (module docstring) of ``poses``, in memory; :func:`write_usd` writes it."""
+def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | None = None,
+                tolerance=DEFAULT_TOLERANCE):
+    """The USD stage (module docstring) of ``poses``, in memory; :func:`write_usd` writes it. Each body's
+    translation and orientation have their own time samples: the keys that keep interpolation (linear, and
+    slerp, which USD uses for quaternions) within ``tolerance`` (m, deg) of every sample
+    (:mod:`lifelike_mj.export.keys`), at fractional time codes where they fall between frames."""
     Gf, Sdf, Usd, UsdGeom, UsdShade, Vt = require_usd()
     m = poses.model
     n = poses.n_frames
     span = float(poses.t_s[-1] - poses.t_s[0])
-    fps = (n - 1) / span if span > 0 else 1.0
+    fps = poses.fps if poses.fps > 0 else 1.0
+    tolerance = tolerance_of(tolerance)
+    tracks = poses.tracks(tolerance, "float")
     stage = Usd.Stage.CreateInMemory()
     UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
     UsdGeom.SetStageMetersPerUnit(stage, 1.0)
@@ -75,6 +83,9 @@ def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | 
     prov = provenance(**(parameters or {}))
     prov["frames"] = {"count": n, "per_s": float(fps), "start_s": float(poses.t_s[0]), "end_s": float(poses.t_s[-1]),
                       "bodies": len(poses.body_ids)}
+    prov["keys"] = {"tolerance_m": tolerance[0], "tolerance_deg": tolerance[1], "samples": poses.n_samples,
+                    "samples_per_s": (poses.n_samples - 1) / span if span > 0 else 0.0,
+                    "per_body": key_counts(tracks, poses.body_names)}
     stage.GetRootLayer().customLayerData = {"lifelike_mj": json.dumps(strict(prov), allow_nan=False)}
     world = UsdGeom.Xform.Define(stage, "/World")
     stage.SetDefaultPrim(world.GetPrim())
@@ -141,27 +152,28 @@ def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | 
             still(xf.GetPath(), int(geom), inner)
     pos = poses.position_m.astype(np.float32).astype(float)  # the values the file holds
     quat = poses.quat_wxyz.astype(np.float32).astype(float)
+    codes = (poses.t_s - poses.t_s[0]) * fps  # each sample's time code: frame k at code k
     with Sdf.ChangeBlock():  # the prims exist: only values change from here
         for b, (translate, orient) in enumerate(ops):
-            p, q = pos[:, b], quat[:, b]
-            if np.all(p == p[0]) and np.all(q == q[0]):  # still over the whole run: one value, no samples
-                translate.Set(Gf.Vec3f(*p[0]))
-                orient.Set(Gf.Quatf(*q[0]))
-                continue
-            for k in range(n):
-                code = Usd.TimeCode(k)
-                translate.Set(Gf.Vec3f(*p[k]), code)
-                orient.Set(Gf.Quatf(*q[k]), code)
+            track = tracks[b]
+            for op, keys, values, kind in ((translate, track.translation, pos[:, b], Gf.Vec3f),
+                                           (orient, track.rotation, quat[:, b], Gf.Quatf)):
+                if keys is None:  # still over the whole run: one value, no samples
+                    op.Set(kind(*values[0]))
+                    continue
+                for k in keys:
+                    op.Set(kind(*values[k]), Usd.TimeCode(float(codes[k])))
     return stage
 
 
-def write_usd(poses: Poses, path: str | Path, name: str = "lifelike-mj run", parameters: dict | None = None) -> Path:
+def write_usd(poses: Poses, path: str | Path, name: str = "lifelike-mj run", parameters: dict | None = None,
+              tolerance=DEFAULT_TOLERANCE) -> Path:
     """Write ``poses`` as an animated USD stage (module docstring): ``.usda`` as text, ``.usdc`` or ``.usd``
     binary (crate), atomically, with the provenance. Returns the path."""
     path = Path(path)
     if path.suffix.lower() not in (".usda", ".usdc", ".usd"):
         raise UserError(f"a USD file ends in .usda, .usdc or .usd, got {path.name!r}.")
-    stage = build_stage(poses, name, parameters)
+    stage = build_stage(poses, name, parameters, tolerance)
     with atomic_path(path) as tmp:  # the temporary file has the same ending, from which USD picks the format
         if not stage.GetRootLayer().Export(str(tmp)):
             raise UserError(f"USD could not write {path}.")

@@ -1,9 +1,10 @@
-"""Run by Blender: ``blender -b --python blender_pose.py -- FILE OUT.json K1 K2 ...``, or by a Python that has
-Blender as a module (PyPI's ``bpy``): ``python blender_pose.py -- FILE OUT.json K1 K2 ...``.
+"""Run by Blender: ``blender -b --python blender_pose.py -- FILE OUT.json FPS T1 T2 ...``, or by a Python that
+has Blender as a module (PyPI's ``bpy``): ``python blender_pose.py -- FILE OUT.json FPS T1 T2 ...``.
 
-Imports FILE (.glb/.gltf with Blender's glTF importer, .usd* with its USD importer) into an empty scene and
-writes, for each sampled keyframe index K, every imported body's world matrix as Blender evaluates it there:
-``{"frames": {K: {body: 4x4}}, "blender": version}`` (or ``{"error": ...}`` where it cannot import the format).
+Imports FILE (.glb/.gltf with Blender's glTF importer, .usd* with its USD importer) into an empty scene at FPS
+frames per second and writes, for each time T (s from the start), every imported body's world matrix as
+Blender evaluates it at frame ``T x FPS`` (a subframe where it falls between frames):
+``{"frames": {T: {body: 4x4}}, "blender": version}`` (or ``{"error": ...}`` where it cannot import the format).
 Bodies are found by their ``mujoco_body`` custom property (glTF: the node's extras; USD: the Xform's
 ``userProperties:mujoco_body``).
 """
@@ -18,20 +19,15 @@ if not hasattr(numpy, "bool"):
     numpy.bool = bool  # Blender 3.4's glTF importer still uses numpy.bool, which numpy 1.24 lacks
 
 argv = sys.argv[sys.argv.index("--") + 1:]
-path, out, ks = argv[0], argv[1], [int(k) for k in argv[2:]]
+path, out, fps, ts = argv[0], argv[1], float(argv[2]), argv[3:]
 bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
+frames = {t: float(t) * fps for t in ts}
 if path.lower().endswith((".glb", ".gltf")):
-    scene.render.fps = 30
+    scene.render.fps = round(fps)  # the importer turns the keys' seconds into frames at the scene's rate
+    scene.render.fps_base = round(fps) / fps
     bpy.ops.import_scene.gltf(filepath=path)
     bodies = {o.name: o["mujoco_body"] for o in bpy.data.objects if "mujoco_body" in o.keys()}
-    # the frame of keyframe k: the k-th key of the body's first animated channel
-    frames = {}
-    for o in bpy.data.objects:
-        if o.name in bodies and o.animation_data and o.animation_data.action:
-            keys = sorted({kp.co[0] for fc in o.animation_data.action.fcurves for kp in fc.keyframe_points})
-            frames = {k: keys[k] for k in ks}
-            break
 else:
     if "usd_import" not in dir(bpy.ops.wm):  # Debian's Blender is built without USD
         with open(out, "w") as fh:
@@ -40,8 +36,7 @@ else:
     # every Xform its own object (Blender merges a body with its only mesh by default: the object is then the
     # mesh, at the geom's place in the body)
     bpy.ops.wm.usd_import(filepath=path, merge_parent_xform=False)
-    bodies = {o.name: o["mujoco_body"] for o in bpy.data.objects if "mujoco_body" in o.keys()}
-    frames = {k: float(k) for k in ks}  # USD time code k is Blender frame k
+    bodies = {o.name: o["mujoco_body"] for o in bpy.data.objects if "mujoco_body" in o.keys()}  # code k: frame k
 result = {"blender": bpy.app.version_string, "frames": {}}
 for k, frame in frames.items():
     whole = int(frame // 1)

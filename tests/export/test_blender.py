@@ -26,13 +26,20 @@ needs_bpy = pytest.mark.skipif(not BPY.exists(), reason="Blender's bpy module is
 Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
 
 
-def _in_blender(path: Path, frames: list[int]) -> dict:
-    """``blender_pose.py`` on ``path``: in Debian's Blender for glTF, in the bpy module for USD."""
+#: Keys this tight put Blender's interpolation (which may fall between keys) within the check's 1e-4 m and
+#: 1e-3 rad of the simulation.
+TIGHT = (2e-5, 0.02)
+
+
+def _in_blender(path: Path, fps: float, times: list[str]) -> dict:
+    """``blender_pose.py`` on ``path`` at ``times`` (s from the start): in Debian's Blender for glTF, in the bpy
+    module for USD."""
     out = path.with_suffix(".json")
     script = Path(__file__).with_name("blender_pose.py")
     run = ([str(BPY), str(script)] if path.suffix.startswith(".usd")
            else [BLENDER, "-b", "--factory-startup", "--python-exit-code", "1", "--python", str(script)])
-    subprocess.run([*run, "--", str(path), str(out), *map(str, frames)], check=True, capture_output=True, timeout=300)
+    subprocess.run([*run, "--", str(path), str(out), repr(fps), *times], check=True, capture_output=True,
+                   timeout=300)
     return json.loads(out.read_text())
 
 
@@ -40,13 +47,16 @@ def _in_blender(path: Path, frames: list[int]) -> dict:
                                     pytest.param(".usdc", marks=needs_bpy)])
 def test_blender_puts_every_body_where_the_simulation_had_it(runs, creature, suffix, tmp_path):
     _, poses = runs(creature)
-    path = write_poses(poses, tmp_path / f"{creature}{suffix}")
-    frames = [0, poses.n_frames // 2 - 1, poses.n_frames - 1]
-    got = _in_blender(path, frames)
+    path = write_poses(poses, tmp_path / f"{creature}{suffix}", tolerance=TIGHT)
+    samples = poses.frame_samples[[0, poses.n_frames // 2 - 1, poses.n_frames - 1]]
+    samples[1] += 1  # a sample between frames (every creature here is sampled more often than its frames)
+    assert samples[1] not in poses.frame_samples
+    times = {k: repr(float(poses.t_s[k] - poses.t_s[0])) for k in samples}
+    got = _in_blender(path, poses.fps, list(times.values()))
     if "error" in got:
         pytest.skip(f"Blender {got['blender']}: {got['error']}")
-    for k in frames:
-        seen = got["frames"][str(k)]
+    for k in samples:
+        seen = got["frames"][times[k]]
         assert sorted(seen) == sorted(poses.body_names)
         for b, name in enumerate(poses.body_names):
             M = np.array(seen[name])

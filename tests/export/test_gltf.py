@@ -49,39 +49,82 @@ def flight():
     return f, poses
 
 
+def _slerp(times, keys_xyzw, t):
+    """Spherical interpolation of unit quaternions ``keys_xyzw`` at ``times`` to the times ``t`` (glTF 2.0's
+    LINEAR rotation sampler), written here apart from the exporter's own."""
+    k = np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 2)
+    u = np.clip((t - times[k]) / (times[k + 1] - times[k]), 0.0, 1.0)[:, None]
+    a, b = keys_xyzw[k], keys_xyzw[k + 1].copy()
+    dot = np.sum(a * b, axis=1)
+    b[dot < 0] *= -1.0
+    theta = np.arccos(np.clip(np.abs(dot), -1.0, 1.0))[:, None]
+    small = theta < 1e-6
+    sin = np.where(small, 1.0, np.sin(theta))
+    wa = np.where(small, 1.0 - u, np.sin((1.0 - u) * theta) / sin)
+    wb = np.where(small, u, np.sin(u * theta) / sin)
+    q = wa * a + wb * b
+    return q / np.linalg.norm(q, axis=1, keepdims=True)
+
+
+def _turn(q1_wxyz, q2_wxyz):
+    """The angle (rad) between rotations, row by row."""
+    apart = np.where((np.sum(q1_wxyz * q2_wxyz, axis=1) < 0)[:, None], q1_wxyz + q2_wxyz, q1_wxyz - q2_wxyz)
+    return 4.0 * np.arcsin(np.clip(np.linalg.norm(apart, axis=1) / 2.0, 0.0, 1.0))
+
+
+def played(gl, blob, node: int, poses, b: int):
+    """Node ``node``'s translation and rotation (wxyz) as a player interpolates them, at every sample of
+    ``poses``; a channel without keys holds the node's own value."""
+    anim = gl.animations[0]
+    t = poses.t_s - poses.t_s[0]
+    out = {"translation": np.tile(gl.nodes[node].translation, (len(t), 1)),
+           "rotation": np.tile(np.array(gl.nodes[node].rotation)[[3, 0, 1, 2]], (len(t), 1)), "keys": {}}
+    for ch in (c for c in anim.channels if c.target.node == node):
+        s = anim.samplers[ch.sampler]
+        assert s.interpolation == "LINEAR"
+        times, values = _accessor(gl, s.input, blob).astype(float), _accessor(gl, s.output, blob).astype(float)
+        assert times[0] == 0.0 and times[-1] == pytest.approx(t[-1], abs=1e-6) and np.all(np.diff(times) > 0)
+        out["keys"][ch.target.path] = (times, values)
+        if ch.target.path == "translation":
+            out["translation"] = np.stack([np.interp(t, times, values[:, j]) for j in range(3)], axis=1)
+        else:
+            values /= np.linalg.norm(values, axis=1, keepdims=True)  # as a reader does with 16-bit keys
+            out["rotation"] = _slerp(times, values, t)[:, [3, 0, 1, 2]]
+    return out
+
+
+def body_nodes(gl, poses) -> dict[str, int]:
+    root = gl.nodes[gl.scenes[0].nodes[0]]
+    return {gl.nodes[c].name: c for c in root.children if gl.nodes[c].name in poses.body_names}
+
+
 @pytest.mark.parametrize("suffix", [".glb", ".gltf"])
 def test_the_file_read_back_puts_every_geom_where_the_simulation_had_it(flight, tmp_path, suffix):
     f, poses = flight
     assert poses.n_frames == 31 and poses.t_s[-1] == pytest.approx(1.0, abs=f.dt)
-    path = write_gltf(poses, tmp_path / f"run{suffix}")
+    assert poses.n_samples == 1201  # every step of 1/1200 s
+    path = write_gltf(poses, tmp_path / f"run{suffix}", tolerance=(1e-4, 0.05))
     gl = pygltflib.GLTF2().load(str(path))
     blob = _blob(gl)
     root = gl.nodes[gl.scenes[0].nodes[0]]
     assert root.rotation == pytest.approx(list(Z_UP_TO_Y_UP))
     R_root = _rot(root.rotation)
     np.testing.assert_allclose(R_root @ [0.0, 0.0, 1.0], [0.0, 1.0, 0.0], atol=1e-12)  # Z up -> Y up
-    anim = gl.animations[0]
-    outputs = {}
-    for ch in anim.channels:
-        s = anim.samplers[ch.sampler]
-        outputs[(ch.target.node, ch.target.path)] = (_accessor(gl, s.input, blob), _accessor(gl, s.output, blob))
-    m, d = f.model, f.data  # the state of the last frame
+    m, d = f.model, f.data  # the state of the last sample
     geom_xpos = {}
-    for b in range(len(poses.body_ids)):
-        idx = root.children[[gl.nodes[c].name for c in root.children].index(poses.body_names[b])]
-        times, trans = outputs[(idx, "translation")]
-        _, rot = outputs[(idx, "rotation")]
-        np.testing.assert_allclose(times, poses.t_s - poses.t_s[0], atol=1e-6)
-        # every frame: the body where the simulation had it (1e-4 m, 1e-3 rad)
-        np.testing.assert_allclose(trans, poses.position_m[:, b], atol=1e-4)
-        rot = rot / np.linalg.norm(rot, axis=1, keepdims=True)  # as a reader does with 16-bit keys
-        dots = np.abs(np.sum(rot[:, [3, 0, 1, 2]] * poses.quat_wxyz[:, b], axis=1))
-        assert np.all(2 * np.arccos(np.minimum(1.0, dots)) < 1e-3)
-        # the last frame, through the node tree: each geom's world position, back in MuJoCo's Z-up frame
-        for c in gl.nodes[idx].children:
+    nodes = body_nodes(gl, poses)
+    for b, name in enumerate(poses.body_names):
+        got = played(gl, blob, nodes[name], poses, b)
+        # every sample: the body where the simulation had it, within the keys' tolerance
+        assert np.max(np.linalg.norm(got["translation"] - poses.position_m[:, b], axis=1)) <= 1e-4
+        assert np.max(_turn(got["rotation"], poses.quat_wxyz[:, b])) <= np.radians(0.05)
+        assert len(got["keys"]["rotation"][0]) < poses.n_samples  # and fewer keys than samples
+        # the last sample, through the node tree: each geom's world position, back in MuJoCo's Z-up frame
+        for c in gl.nodes[nodes[name]].children:
             node = gl.nodes[c]
             geom = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, node.name)
-            world_y_up = R_root @ (trans[-1] + _rot(rot[-1]) @ np.array(node.translation))
+            q = got["rotation"][-1]
+            world_y_up = R_root @ (got["translation"][-1] + _rot(q[[1, 2, 3, 0]]) @ np.array(node.translation))
             geom_xpos[geom] = R_root.T @ world_y_up
     drawn = drawn_geoms(m)
     assert sorted(geom_xpos) == sorted(int(g) for g in drawn[m.geom_bodyid[drawn] > 0])  # every drawn geom
@@ -134,13 +177,27 @@ def test_every_creature_exports_with_one_mesh_per_shape_and_the_validators_bless
     if creature in ("fish", "boids"):
         assert len(gl.meshes) < 10 < n_geoms  # every fish, every bird shares its shape's one mesh
     assert [c.name for c in gl.cameras] == (["overview"] if creature in ("fish", "boids") else ["overview", "follow"])
-    anim = gl.animations[0]
-    last = {ch.target.node: _accessor(gl, anim.samplers[ch.sampler].output, blob)[-1]
-            for ch in anim.channels if ch.target.path == "translation"}
-    names = {n.name: n.translation for n in gl.nodes}  # a body that stays put has no channel: its node's pose
-    names.update({gl.nodes[i].name: p for i, p in last.items()})
+    # every sample of the simulation (every step: 1,200/s for the butterflies, 60/s for the fish, each step of
+    # the flock): each body within the default tolerance, 0.5 mm and 0.5 deg, and no two neighbouring rotation
+    # keys more than 20 deg apart (the wings' included) where the samples are closer than that (a flock's
+    # drawn heading may turn further in one step)
+    nodes = body_nodes(gl, poses)
+    keys, turned = [], set()
     for b, name in enumerate(poses.body_names):
-        np.testing.assert_allclose(names[name], poses.position_m[-1, b], atol=1e-4)
+        got = played(gl, blob, nodes[name], poses, b)
+        assert np.max(np.linalg.norm(got["translation"] - poses.position_m[:, b], axis=1)) <= 0.0005, name
+        assert np.max(_turn(got["rotation"], poses.quat_wxyz[:, b])) <= np.radians(0.5), name
+        if "rotation" in got["keys"]:
+            q = got["keys"]["rotation"][1][:, [3, 0, 1, 2]]
+            if np.max(_turn(poses.quat_wxyz[1:, b], poses.quat_wxyz[:-1, b])) <= np.radians(20.0):
+                assert np.max(_turn(q[1:], q[:-1])) <= np.radians(20.0) + 1e-4, name
+                turned.add(name)
+            keys.append(len(q))
+    prov = gl.asset.extras["keys"]
+    assert prov["samples"] == poses.n_samples and prov["tolerance_m"] == 0.0005 and prov["tolerance_deg"] == 0.5
+    assert sorted(c["rotation"] for c in prov["per_body"].values() if c["rotation"] > 1) == sorted(keys)
+    if creature == "butterfly3d":
+        assert {"wing_left", "wing_right"} <= turned
     reports = _khronos(paths)
     if reports is None:
         pytest.skip("the Khronos glTF-Validator is not installed (.ci/run installs it with npm into .ci/node)")
