@@ -10,8 +10,9 @@ Layout of the file:
 * under each body node, one still node per drawn geom, at the geom's place in the body, holding its mesh;
 * under it too, the cameras of :mod:`lifelike_mj.export.cameras`: ``camera overview`` (still, seeing the
   whole run) and, for a single creature, ``camera follow`` (moving with it);
-* one mesh per distinct shape (type, size, mesh) and one material per distinct colour, shared by every
-  geom that has them, so a flock of hundreds stores one bird's mesh.
+* one mesh per distinct shape (type, size, mesh) and one material per distinct look, shared by every geom
+  that has them, so a flock of hundreds stores one bird's mesh; a material is named as the MJCF's (``wing``,
+  ``body``), or after the first geom that wears it where the geom has none.
 
 Shapes are triangulated from the MJCF geoms (:mod:`lifelike_mj.export.shapes`). The colour is the
 geom's (or its material's) RGBA as the base colour, not metallic; translucent ones blend.
@@ -33,7 +34,7 @@ from lifelike_mj import __version__
 from lifelike_mj.errors import UserError
 from lifelike_mj.export.cameras import FOV_DEG, framing
 from lifelike_mj.export.keys import DEFAULT_TOLERANCE, Track, key_counts, tolerance_of
-from lifelike_mj.export.poses import Poses, drawn_geoms, geom_rgba
+from lifelike_mj.export.poses import Poses, drawn_geoms, geom_looks, geom_rgba
 from lifelike_mj.export.shapes import geom_shape, shape_key
 from lifelike_mj.io import atomic_path, strict
 from lifelike_mj.provenance import provenance
@@ -112,30 +113,31 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
     gl.nodes.append(root)
     buf = _Buffer(gl)
     meshes: dict[tuple, int] = {}
-    materials: dict[tuple, int] = {}
+    materials: dict[int, int] = {}
     rgba = geom_rgba(m)
+    look, look_names = geom_looks(m)
 
     def mesh_of(geom: int) -> int:
         key = shape_key(m, geom)
         colour = tuple(np.round(rgba[geom], 6).tolist())
-        full = (key, colour)
+        full = (key, int(look[geom]))
         if full not in meshes:
-            if colour not in materials:
-                mat = g.Material(name=f"rgba {colour}", doubleSided=True,
+            if look[geom] not in materials:
+                mat = g.Material(name=look_names[look[geom]], doubleSided=True,
                                  pbrMetallicRoughness=g.PbrMetallicRoughness(
                                      baseColorFactor=[float(c) for c in colour], metallicFactor=0.0,
                                      roughnessFactor=0.8))
                 if colour[3] < 1.0:
                     mat.alphaMode = g.BLEND
                 gl.materials.append(mat)
-                materials[colour] = len(gl.materials) - 1
+                materials[int(look[geom])] = len(gl.materials) - 1
             pos, nrm, tri = geom_shape(m, geom)
             a_pos = buf.add(pos.astype(np.float32), g.VEC3, g.ARRAY_BUFFER, minmax=True)
             a_nrm = buf.add(nrm.astype(np.float32), g.VEC3, g.ARRAY_BUFFER)
             idx = tri.reshape(-1).astype(np.uint16 if len(pos) < 65536 else np.uint32)
             a_idx = buf.add(idx, g.SCALAR, g.ELEMENT_ARRAY_BUFFER)
             gl.meshes.append(g.Mesh(primitives=[g.Primitive(attributes=g.Attributes(POSITION=a_pos, NORMAL=a_nrm),
-                                                            indices=a_idx, material=materials[colour])]))
+                                                            indices=a_idx, material=materials[int(look[geom])])]))
             meshes[full] = len(gl.meshes) - 1
         return meshes[full]
 

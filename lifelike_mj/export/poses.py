@@ -36,6 +36,27 @@ def geom_rgba(model: mujoco.MjModel) -> np.ndarray:
     return rgba
 
 
+def geom_looks(model: mujoco.MjModel) -> tuple[np.ndarray, list[str]]:
+    """Each geom's look: an index shared by the geoms that look alike (the same MJCF material and colour, or,
+    without a material, the same colour) and each look's name: its MJCF material's (``wing``, ``body``,
+    ``fish_blue``; the prefix of an attached copy, ``s0/f3/``, left off, so that every fish wears one
+    ``fish_blue``), else the name of the first geom that wears it (``geom7`` where that has none)."""
+    rgba = np.round(geom_rgba(model), 6)
+    index = np.empty(model.ngeom, dtype=np.int64)
+    seen: dict[tuple, int] = {}
+    names: list[str] = []
+    for g in range(model.ngeom):
+        mat = int(model.geom_matid[g])
+        material = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_MATERIAL, mat) if mat >= 0 else None
+        material = material.rsplit("/", 1)[-1] if material else None
+        key = (material, tuple(rgba[g].tolist()))
+        if key not in seen:
+            seen[key] = len(names)
+            names.append(material or mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g) or f"geom{g}")
+        index[g] = seen[key]
+    return index, names
+
+
 @dataclass
 class Poses:
     """Body poses over time, in MuJoCo's world frame (m, Z up): ``t_s`` (the samples' playback times, s),

@@ -11,7 +11,8 @@ Layout of the stage (Z up, metres, as MuJoCo's world; ``timeCodesPerSecond`` is 
   still meshes;
 * under each body, one ``Mesh`` per drawn geom at its place in the body;
 * ``/Shapes`` (a class, not drawn): one mesh per distinct shape, which the geoms reference, so a flock of
-  hundreds stores one bird; ``/Looks``: one ``UsdPreviewSurface`` material per colour.
+  hundreds stores one bird; ``/Looks``: one ``UsdPreviewSurface`` material per look,
+  named as the MJCF's material (or after the first geom that wears it).
 
 The provenance (versions, command, time, parameters, the frames' count, rate and span) is the root layer's
 ``customLayerData["lifelike_mj"]``, as strict JSON text.
@@ -32,7 +33,7 @@ import numpy as np
 
 from lifelike_mj.errors import UserError
 from lifelike_mj.export.keys import DEFAULT_TOLERANCE, key_counts, tolerance_of
-from lifelike_mj.export.poses import Poses, drawn_geoms, geom_rgba
+from lifelike_mj.export.poses import Poses, drawn_geoms, geom_looks, geom_rgba
 from lifelike_mj.export.shapes import geom_shape, shape_key
 from lifelike_mj.io import atomic_path, strict
 from lifelike_mj.provenance import provenance
@@ -94,7 +95,7 @@ def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | 
     UsdGeom.Scope.Define(stage, "/Looks")
     rgba = geom_rgba(m)
     meshes: dict[tuple, str] = {}
-    looks: dict[tuple, UsdShade.Material] = {}
+    looks: dict[int, UsdShade.Material] = {}
 
     def shape_of(geom: int) -> str:
         key = shape_key(m, geom)
@@ -112,18 +113,21 @@ def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | 
             meshes[key] = str(path)
         return meshes[key]
 
+    look, look_names = geom_looks(m)
+    look_used: set[str] = set()
+
     def look_of(geom: int):
         colour = tuple(np.round(rgba[geom], 6).tolist())
-        if colour not in looks:
-            mat = UsdShade.Material.Define(stage, f"/Looks/look{len(looks)}")
+        if look[geom] not in looks:
+            mat = UsdShade.Material.Define(stage, f"/Looks/{_ident(look_names[look[geom]], look_used)}")
             shader = UsdShade.Shader.Define(stage, mat.GetPath().AppendChild("surface"))
             shader.CreateIdAttr("UsdPreviewSurface")
             shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(Gf.Vec3f(*colour[:3]))
             shader.CreateInput("opacity", Sdf.ValueTypeNames.Float).Set(float(colour[3]))
             shader.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(0.8)
             mat.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")
-            looks[colour] = mat
-        return looks[colour]
+            looks[int(look[geom])] = mat
+        return looks[int(look[geom])]
 
     def still(parent: Sdf.Path, geom: int, used: set[str]) -> None:
         gname = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, geom) or f"geom{geom}"

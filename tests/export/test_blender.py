@@ -68,18 +68,57 @@ def test_blender_puts_every_body_where_the_simulation_had_it(runs, creature, suf
             assert angle < 1e-3, (k, name, angle)
 
 
+SCRIPT = Path(__file__).resolve().parents[2] / "examples" / "blender" / "import_motion.py"
+
+
+def _script(cwd: Path, *args: str) -> subprocess.CompletedProcess:
+    """The README's Blender command, run from ``cwd`` with relative paths."""
+    return subprocess.run([BLENDER, "-b", "--factory-startup", "--python", str(SCRIPT), "--", *args], cwd=cwd,
+                          capture_output=True, text=True, timeout=300)
+
+
 @needs_blender
-def test_the_readmes_blender_script_imports_a_flight_and_saves_it(runs, tmp_path):
+def test_the_readmes_blender_script_imports_saves_and_renders_from_relative_paths(runs, tmp_path):
     _, poses = runs("butterfly3d")
-    glb = write_poses(poses, tmp_path / "flight.glb")
-    script = Path(__file__).resolve().parents[2] / "examples" / "blender" / "import_flight.py"
+    (tmp_path / "runs").mkdir()
+    write_poses(poses.frames(), tmp_path / "runs" / "flight.glb")  # a run at 30 frames/s
+    slow = write_poses(poses, tmp_path / "runs" / "slow.glb")
+    with slow.open("r+b") as fh:  # the same run, saying 24 frames/s: the scene takes its rate from the file
+        data = fh.read()
+        fh.seek(0)
+        fh.write(data.replace(b'"per_s": 30.0', b'"per_s": 24.0').replace(b'"per_s":30.0', b'"per_s":24.0'))
+    done = _script(tmp_path, "runs/flight.glb", "flight.blend", "--render", "flight.png", "--samples", "2",
+                   "--size", "64x48")
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "Warning" not in done.stdout + done.stderr and "Traceback" not in done.stderr
+    assert (tmp_path / "flight.png").stat().st_size > 0
     probe = tmp_path / "probe.py"
     probe.write_text("import bpy, json, sys\ns = bpy.context.scene\n"
-                     "json.dump({'end': s.frame_end, 'fps': s.render.fps, 'camera': s.camera.name}, "
+                     "json.dump({'end': s.frame_end, 'fps': s.render.fps / s.render.fps_base, 'camera': s.camera.name}, "
                      "open(sys.argv[-1], 'w'))\n")
-    subprocess.run([BLENDER, "-b", "--factory-startup", "--python-exit-code", "1", "--python", str(script), "--",
-                    str(glb), str(tmp_path / "flight.blend")], check=True, capture_output=True, timeout=300)
-    subprocess.run([BLENDER, "-b", str(tmp_path / "flight.blend"), "--python-exit-code", "1", "--python", str(probe),
-                    "--", str(tmp_path / "scene.json")], check=True, capture_output=True, timeout=300)
-    scene = json.loads((tmp_path / "scene.json").read_text())
-    assert scene == {"end": poses.n_frames - 1, "fps": 30, "camera": "camera follow"}
+    for blend, fps in (("flight.blend", 30), ("slow.blend", 24)):
+        if blend == "slow.blend":
+            assert _script(tmp_path, "runs/slow.glb", blend).returncode == 0
+        subprocess.run([BLENDER, "-b", str(tmp_path / blend), "--python-exit-code", "1", "--python", str(probe),
+                        "--", str(tmp_path / "scene.json")], check=True, capture_output=True, timeout=300)
+        scene = json.loads((tmp_path / "scene.json").read_text())
+        span = poses.t_s[-1] - poses.t_s[0]
+        assert scene == {"end": round(span * fps), "fps": pytest.approx(fps), "camera": "camera follow"}
+    # what goes wrong: one sentence, status 2, nothing written
+    (tmp_path / "bad.glb").write_bytes(b"glTF" + b"\0" * 40)
+    broken = json.dumps({"asset": {"version": "2.0", "extras": {"frames": {"per_s": 30.0}}}, "scene": 0,
+                         "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 3}]}).encode()
+    broken += b" " * (-len(broken) % 4)
+    (tmp_path / "broken.glb").write_bytes(b"glTF" + (2).to_bytes(4, "little") + (20 + len(broken)).to_bytes(4, "little")
+                                          + len(broken).to_bytes(4, "little") + b"JSON" + broken)
+    for args, says in ((["missing.glb", "x.blend"], "does not exist"), (["bad.glb", "x.blend"], "not a binary glTF"),
+                       (["broken.glb", "x.blend"], "could not import"),
+                       (["runs/flight.glb", "flight.blend"], "exists; give --overwrite"),
+                       (["runs/flight.glb", "x.blend", "--camera", "nope"], "no camera 'nope'"),
+                       (["runs/flight.glb", "nofolder/x.blend"], "does not exist"),
+                       (["runs/flight.glb", "x.blend", "--size", "big"], "WIDTHxHEIGHT")):
+        done = _script(tmp_path, *args)
+        lines = [x for x in done.stderr.splitlines() if x.startswith("import_motion.py:")]
+        assert done.returncode == 2 and len(lines) == 1 and says in lines[0], (args, done.stderr[-1500:])
+        assert "Traceback" not in done.stderr
+    assert not (tmp_path / "x.blend").exists()

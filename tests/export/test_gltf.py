@@ -177,6 +177,11 @@ def test_every_creature_exports_with_one_mesh_per_shape_and_the_validators_bless
     if creature in ("fish", "boids"):
         assert len(gl.meshes) < 10 < n_geoms  # every fish, every bird shares its shape's one mesh
     assert [c.name for c in gl.cameras] == (["overview"] if creature in ("fish", "boids") else ["overview", "follow"])
+    # materials named as the MJCF names them, one per look (every fish wears one fish_blue)
+    looks = {"butterfly3d": {"wing", "body", "grid"}, "butterfly2d": {"wing", "body", "grid"},
+             "fish": {"fish_blue", "fish_fin", "fish_eye", "sand", "glass", "back"}, "boids": {"type0", "floor", "edge"}}
+    names = [mat.name for mat in gl.materials]
+    assert looks[creature] <= set(names) and len(names) == len(set(names)), names
     # every sample of the simulation (every step: 1,200/s for the butterflies, 60/s for the fish, each step of
     # the flock): each body within the default tolerance, 0.5 mm and 0.5 deg, and no two neighbouring rotation
     # keys more than 20 deg apart (the wings' included) where the samples are closer than that (a flock's
