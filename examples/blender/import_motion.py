@@ -10,7 +10,8 @@ Arguments after ``--``: the ``.glb``/``.gltf`` file, then optionally the ``.blen
   CPU, the default, or ``eevee``, which needs a display: run Blender under ``xvfb-run`` where there is none;
   ``--samples``, ``--size WxH``);
 * ``--camera NAME``: the camera to look through (default the run's ``camera follow``, else ``camera
-  overview``);
+  overview``); ``--zoom Z`` narrows its field of view Z times (a longer lens); ``--follow BONE`` looks through
+  a new camera that follows a bone (a creature: ``butterfly``, ``s0/f3/fish``) from ``--distance`` metres;
 * ``--overwrite``: replace an existing ``.blend`` or image (without it the script refuses, and writes nothing).
 
 Paths are taken from the folder Blender was started in. The scene's frame rate is the file's (its
@@ -101,6 +102,9 @@ def parse(argv: list[str]) -> argparse.Namespace:
     p.add_argument("--samples", type=int, default=32)
     p.add_argument("--size", default="960x540")
     p.add_argument("--camera")
+    p.add_argument("--zoom", type=float, default=1.0)
+    p.add_argument("--follow")
+    p.add_argument("--distance", type=float, default=0.3)
     p.add_argument("--overwrite", action="store_true")
     try:
         args = p.parse_args(argv)
@@ -129,9 +133,33 @@ def parse(argv: list[str]) -> argparse.Namespace:
     except (ValueError, AssertionError):
         fail(f"--size is WIDTHxHEIGHT in pixels (16 to 8192), got {args.size!r}.")
     args.width, args.height = w, h
+    if not 0.1 <= args.zoom <= 100:
+        fail(f"--zoom is 0.1 to 100, got {args.zoom:g}.")
     if not 1 <= args.samples <= 4096:
         fail(f"--samples is 1 to 4096, got {args.samples}.")
     return args
+
+
+def follow(scene, bone: str, distance: float):
+    """A camera that keeps ``distance`` m from the bone ``bone`` of an imported armature (behind, to the left and
+    above it, in the world's axes) and looks at it."""
+    arm = next((o for o in bpy.data.objects if o.type == "ARMATURE" and bone in o.data.bones), None)
+    if arm is None:
+        names = sorted(b.name for o in bpy.data.objects if o.type == "ARMATURE" for b in o.data.bones)
+        fail(f"no armature has a bone {bone!r}" + (f"; the bones include {', '.join(names[:6])}." if names else "."))
+    if not 0.001 <= distance <= 1000:
+        fail(f"--distance is 0.001 to 1000 m, got {distance:g}.")
+    cam = bpy.data.objects.new(f"camera {bone}", bpy.data.cameras.new(f"camera {bone}"))
+    cam.data.clip_start = distance / 100.0
+    scene.collection.objects.link(cam)
+    place = cam.constraints.new("COPY_LOCATION")
+    place.target, place.subtarget = arm, bone
+    cam.location = (-0.6 * distance, 0.55 * distance, 0.58 * distance)
+    place.use_offset = True
+    aim = cam.constraints.new("TRACK_TO")
+    aim.target, aim.subtarget = arm, bone
+    aim.track_axis, aim.up_axis = "TRACK_NEGATIVE_Z", "UP_Y"
+    return cam
 
 
 def main() -> None:
@@ -155,6 +183,10 @@ def main() -> None:
     if args.camera is not None and args.camera not in cameras:
         fail(f"the run has no camera {args.camera!r}; it has {', '.join(sorted(cameras)) or 'none'}.")
     scene.camera = cameras.get(args.camera) or cameras.get("camera follow") or cameras.get("camera overview")
+    if args.follow is not None:
+        scene.camera = follow(scene, args.follow, args.distance)
+    if scene.camera is not None and args.zoom != 1.0:
+        scene.camera.data.lens *= args.zoom
     if not any(o.type == "LIGHT" for o in bpy.data.objects):
         sun = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
         sun.data.energy = 3.0

@@ -31,19 +31,21 @@ def format_of(path: str | Path, fmt: str | None = None) -> str:
 
 
 def write_poses(poses, path: str | Path, fmt: str | None = None, name: str = "lifelike-mj run",
-                parameters: dict | None = None, rotations: str = "short", tolerance=(0.0005, 0.5)) -> Path:
+                parameters: dict | None = None, rotations: str = "short", tolerance=(0.0005, 0.5),
+                rigs: list | None = None) -> Path:
     """Write recorded poses (:class:`~lifelike_mj.export.poses.Poses`) in ``fmt`` (default: from the ending of
     ``path``; :data:`FORMATS`), atomically, with the provenance and ``parameters``; each body keyed within
-    ``tolerance`` (m, deg) of every sample (:mod:`lifelike_mj.export.keys`). Returns the path."""
+    ``tolerance`` (m, deg) of every sample (:mod:`lifelike_mj.export.keys`); ``rigs``: the creatures as skinned
+    meshes on skeletons (:mod:`lifelike_mj.export.rig`; glTF and HTML), else the MJCF's geoms. Returns the path."""
     fmt = format_of(path, fmt)
     if fmt in ("glb", "gltf"):
         from lifelike_mj.export.gltf import write_gltf
 
-        return write_gltf(poses, path, name, parameters, rotations, tolerance)
+        return write_gltf(poses, path, name, parameters, rotations, tolerance, rigs)
     if fmt == "usd":
         from lifelike_mj.export.usd import write_usd
 
         return write_usd(poses, path, name, parameters, tolerance)
     from lifelike_mj.export.html import write_html
 
-    return write_html(poses, path, name, parameters, rotations, tolerance)
+    return write_html(poses, path, name, parameters, rotations, tolerance, rigs)

@@ -35,6 +35,7 @@ from lifelike_mj.errors import UserError
 from lifelike_mj.export.cameras import FOV_DEG, framing
 from lifelike_mj.export.keys import DEFAULT_TOLERANCE, Track, key_counts, tolerance_of
 from lifelike_mj.export.poses import Poses, drawn_geoms, geom_looks, geom_rgba
+from lifelike_mj.export.rig import Look, Mesh, Rig, bone_keys
 from lifelike_mj.export.shapes import geom_shape, shape_key
 from lifelike_mj.io import atomic_path, strict
 from lifelike_mj.provenance import provenance
@@ -83,7 +84,7 @@ def quantize_rotations(q_xyzw: np.ndarray) -> np.ndarray:
 
 
 def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | None = None,
-               rotations: str = "short", tolerance=DEFAULT_TOLERANCE) -> g.GLTF2:
+               rotations: str = "short", tolerance=DEFAULT_TOLERANCE, rigs: list[Rig] | None = None) -> g.GLTF2:
     """The glTF document (module docstring) of ``poses``; :func:`write_gltf` writes it. The asset's
     ``extras`` hold the provenance: the versions, the command, the time and ``parameters`` (what made the
     run), with the frames' count, rate and times, the samples' and the keys kept per body.
@@ -93,7 +94,11 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
     ``rotations``: ``"short"`` stores the quaternions as normalized 16-bit integers (:func:`quantize_rotations`,
     half the bytes; core glTF 2.0), ``"float"`` as 32-bit floats. Positions are always 32-bit floats (glTF
     allows nothing else for translation keys). A body that does not move or turn over the whole run gets no
-    channel for it: its node holds the still pose."""
+    channel for it: its node holds the still pose.
+
+    ``rigs``: the creatures as skinned meshes on skeletons (:mod:`lifelike_mj.export.rig`), in place of their
+    bodies' MJCF geoms: each an armature node (the creature's name) holding its bones (MuJoCo bodies named as in
+    the MJCF, and the extra bones), a skin, and a skinned mesh node at the scene's root."""
     if rotations not in ("short", "float"):
         raise UserError(f"rotations are stored as 'short' or 'float', got {rotations!r}.")
     tolerance = tolerance_of(tolerance)
@@ -165,7 +170,10 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
         anim.channels.append(g.AnimationChannel(sampler=len(anim.samplers) - 1,
                                                 target=g.AnimationChannelTarget(node=node, path=path)))
 
+    rigged = {bone.body for r in rigs or [] for bone in r.bones if bone.body is not None}
     for b, (body, bname) in enumerate(zip(poses.body_ids, poses.body_names)):
+        if bname in rigged:
+            continue
         node = g.Node(name=bname, translation=[float(v) for v in poses.position_m[0, b]],
                       rotation=_xyzw(poses.quat_wxyz[0, b]), children=[], extras={"mujoco_body": bname})
         gl.nodes.append(node)
@@ -181,11 +189,109 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
             rot = poses.quat_wxyz[track.rotation, b][:, [1, 2, 3, 0]]
             channel(idx, "rotation", track.rotation,
                     quantize_rotations(rot) if rotations == "short" else rot.astype(np.float32), g.VEC4)
+    if rigs:
+        prov["rigs"] = _add_rigs(gl, root, buf, channel, poses, rigs, tolerance, rotations)
+        gl.asset.extras = strict(prov)
     _add_cameras(gl, root, poses, tracks, channel)
     gl.animations = [anim] if anim.channels else []
     gl.buffers = [g.Buffer(byteLength=len(buf.data))]
     gl.set_binary_blob(bytes(buf.data))
     return gl
+
+
+def _png(image: np.ndarray) -> bytes:
+    import io
+
+    from PIL import Image
+
+    out = io.BytesIO()
+    Image.fromarray(np.ascontiguousarray(image, dtype=np.uint8), "RGBA").save(out, "PNG", optimize=True)
+    return out.getvalue()
+
+
+def _add_rigs(gl: g.GLTF2, root: g.Node, buf: _Buffer, channel, poses: Poses, rigs: list[Rig], tolerance,
+              rotations: str) -> dict:
+    """Each rig as an armature node under ``root`` with its bones, a skin and a skinned mesh node at the scene's
+    root (glTF ignores a skinned mesh node's own place: its joints place it); meshes, textures and inverse bind
+    matrices shared between the rigs that share them. Returns each rig's bones and keys, for the provenance."""
+    R = np.eye(4)
+    R[:3, :3] = Z_UP_TO_Y_UP_MATRIX  # the root's turn, which the joints' world transforms include
+    looks: dict[int, int] = {}
+    meshes: dict[int, int] = {}
+    binds: dict[bytes, int] = {}
+    report = {}
+
+    def material(look: Look) -> int:
+        if id(look) not in looks:
+            pbr = g.PbrMetallicRoughness(baseColorFactor=[float(c) for c in look.rgba], metallicFactor=0.0,
+                                         roughnessFactor=float(look.roughness))
+            if look.image is not None:
+                png = _png(look.image)
+                while len(buf.data) % 4:
+                    buf.data.append(0)
+                gl.bufferViews.append(g.BufferView(buffer=0, byteOffset=len(buf.data), byteLength=len(png)))
+                buf.data += png
+                gl.images.append(g.Image(name=look.name, mimeType="image/png", bufferView=len(gl.bufferViews) - 1))
+                if not gl.samplers:
+                    gl.samplers.append(g.Sampler(magFilter=g.LINEAR, minFilter=g.LINEAR_MIPMAP_LINEAR,
+                                                 wrapS=g.CLAMP_TO_EDGE, wrapT=g.CLAMP_TO_EDGE))
+                gl.textures.append(g.Texture(sampler=0, source=len(gl.images) - 1, name=look.name))
+                pbr.baseColorTexture = g.TextureInfo(index=len(gl.textures) - 1)
+            mat = g.Material(name=look.name, doubleSided=look.double_sided, pbrMetallicRoughness=pbr)
+            if look.rgba[3] < 1.0 or (look.image is not None and look.image[..., 3].min() < 255):
+                mat.alphaMode = g.BLEND
+            gl.materials.append(mat)
+            looks[id(look)] = len(gl.materials) - 1
+        return looks[id(look)]
+
+    def mesh_of(mesh: Mesh) -> int:
+        if id(mesh) not in meshes:
+            pos = mesh.positions @ Z_UP_TO_Y_UP_MATRIX.T
+            nrm = mesh.normals @ Z_UP_TO_Y_UP_MATRIX.T
+            attrs = g.Attributes(
+                POSITION=buf.add(pos.astype(np.float32), g.VEC3, g.ARRAY_BUFFER, minmax=True),
+                NORMAL=buf.add(nrm.astype(np.float32), g.VEC3, g.ARRAY_BUFFER),
+                TEXCOORD_0=buf.add(mesh.uv.astype(np.float32), g.VEC2, g.ARRAY_BUFFER),
+                JOINTS_0=buf.add(mesh.joints.astype(np.uint16), g.VEC4, g.ARRAY_BUFFER),
+                WEIGHTS_0=buf.add(mesh.weights.astype(np.float32), g.VEC4, g.ARRAY_BUFFER))
+            prims = []
+            for look, tris in mesh.parts:
+                idx = tris.reshape(-1).astype(np.uint16 if len(pos) < 65536 else np.uint32)
+                prims.append(g.Primitive(attributes=attrs, indices=buf.add(idx, g.SCALAR, g.ELEMENT_ARRAY_BUFFER),
+                                         material=material(look)))
+            gl.meshes.append(g.Mesh(name=mesh.name, primitives=prims))
+            meshes[id(mesh)] = len(gl.meshes) - 1
+        return meshes[id(mesh)]
+
+    for rig in rigs:
+        rig.check()
+        keys = bone_keys(poses.t_s, rig, tolerance, rotations)
+        arm = g.Node(name=rig.name, children=[], extras={"lifelike_mj_rig": rig.name, **rig.extras})
+        gl.nodes.append(arm)
+        root.children.append(len(gl.nodes) - 1)
+        first = len(gl.nodes)
+        for i, (bone, k) in enumerate(zip(rig.bones, keys)):
+            extras = {"mujoco_body": bone.body} if bone.body is not None else {"secondary_motion": True}
+            gl.nodes.append(g.Node(name=bone.name, translation=[float(v) for v in k.still_translation],
+                                   rotation=_xyzw(k.still_rotation), children=[], extras=extras))
+            (arm if bone.parent < 0 else gl.nodes[first + bone.parent]).children.append(first + i)
+            if k.translation is not None:
+                channel(first + i, "translation", k.translation, k.translation_values.astype(np.float32), g.VEC3)
+            if k.rotation is not None:
+                rot = k.rotation_values[:, [1, 2, 3, 0]]
+                channel(first + i, "rotation", k.rotation,
+                        quantize_rotations(rot) if rotations == "short" else rot.astype(np.float32), g.VEC4)
+        ibm = np.stack([np.linalg.inv(R @ b.bind).T for b in rig.bones]).astype(np.float32)  # column-major
+        if ibm.tobytes() not in binds:
+            binds[ibm.tobytes()] = buf.add(ibm, g.MAT4)
+        gl.skins.append(g.Skin(name=rig.name, joints=list(range(first, first + len(rig.bones))),
+                               inverseBindMatrices=binds[ibm.tobytes()]))
+        gl.nodes.append(g.Node(name=f"{rig.name} mesh", mesh=mesh_of(rig.mesh), skin=len(gl.skins) - 1))
+        gl.scenes[0].nodes.append(len(gl.nodes) - 1)
+        report[rig.name] = {b.name: {"translation": 1 if k.translation is None else len(k.translation),
+                                     "rotation": 1 if k.rotation is None else len(k.rotation)}
+                            for b, k in zip(rig.bones, keys)}
+    return report
 
 
 def _add_cameras(gl: g.GLTF2, root: g.Node, poses: Poses, tracks: list[Track], channel) -> None:
@@ -213,14 +319,14 @@ def _add_cameras(gl: g.GLTF2, root: g.Node, poses: Poses, tracks: list[Track], c
 
 
 def write_gltf(poses: Poses, path: str | Path, name: str = "lifelike-mj run", parameters: dict | None = None,
-               rotations: str = "short", tolerance=DEFAULT_TOLERANCE) -> Path:
+               rotations: str = "short", tolerance=DEFAULT_TOLERANCE, rigs: list[Rig] | None = None) -> Path:
     """Write ``poses`` as animated glTF 2.0: binary (``.glb``) or JSON with the buffer inside (``.gltf``),
     atomically, with the provenance (:func:`build_gltf`; ``parameters``: what made the run; ``rotations``:
     ``"short"`` or ``"float"`` keys; ``tolerance``: the keys' (m, deg)). Returns the path."""
     path = Path(path)
     if path.suffix.lower() not in (".glb", ".gltf"):
         raise UserError(f"a glTF file ends in .glb or .gltf, got {path.name!r}.")
-    gl = build_gltf(poses, name, parameters, rotations, tolerance)
+    gl = build_gltf(poses, name, parameters, rotations, tolerance, rigs)
     with atomic_path(path) as tmp:
         if path.suffix.lower() == ".glb":
             gl.save_binary(str(tmp))

@@ -122,9 +122,9 @@ def _inline(text: str) -> str:
 
 
 def build_html(poses: Poses, name: str = "lifelike-mj run", parameters: dict | None = None,
-               rotations: str = "short", tolerance=DEFAULT_TOLERANCE) -> str:
+               rotations: str = "short", tolerance=DEFAULT_TOLERANCE, rigs: list | None = None) -> str:
     """The page (module docstring) of ``poses`` as text; :func:`write_html` writes it."""
-    gl = build_gltf(poses, name, parameters, rotations, tolerance)
+    gl = build_gltf(poses, name, parameters, rotations, tolerance, rigs)
     f = framing(poses)
     y_up = Z_UP_TO_Y_UP_MATRIX
     d = y_up @ f.direction  # model-viewer's orbit: theta about +Y from +Z, phi from +Y
@@ -147,12 +147,12 @@ def build_html(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
 
 
 def write_html(poses: Poses, path: str | Path, name: str = "lifelike-mj run", parameters: dict | None = None,
-               rotations: str = "short", tolerance=DEFAULT_TOLERANCE) -> Path:
+               rotations: str = "short", tolerance=DEFAULT_TOLERANCE, rigs: list | None = None) -> Path:
     """Write the page of ``poses`` (module docstring) to ``path`` (``.html``), atomically. Returns the path."""
     path = Path(path)
     if path.suffix.lower() != ".html":
         raise UserError(f"a web page ends in .html, got {path.name!r}.")
-    text = build_html(poses, name, parameters, rotations, tolerance)
+    text = build_html(poses, name, parameters, rotations, tolerance, rigs)
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
     return path

@@ -221,7 +221,7 @@ def _lifelike(*args: str, cwd: Path) -> subprocess.Popen:
                             stderr=subprocess.PIPE, text=True)
 
 
-@pytest.mark.parametrize("creature, extra", [("fish", ["--duration", "4"])])
+@pytest.mark.parametrize("creature, extra", [("fish", ["--duration", "120", "--n", "30"])])
 def test_two_exports_to_one_file_started_together_leave_the_first_ones_file(creature, extra, tmp_path):
     """Two real processes: the first claims the file; the second, started while the first works, exits 2 naming it;
     the file is the first one's (its seed in the file's provenance)."""

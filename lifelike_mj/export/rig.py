@@ -1,0 +1,314 @@
+"""Rigged creatures for the exporters: a skeleton whose bones are the MuJoCo bodies (named as in the MJCF) and
+the extra bones of secondary motion, with a skinned, textured mesh bound to it.
+
+A creature's slice builds its :class:`Rig` from a run's :class:`~lifelike_mj.export.poses.Poses` (its mesh,
+texture and secondary motion are its own business); this module holds what every rig shares and turns the
+bones' world poses into keys:
+
+* the **bind pose** is the creature at rest, its root bone at the origin (x forward, z up, metres), so that a
+  flock of hundreds binds one mesh with one set of inverse bind matrices;
+* each bone's **world pose** is given at every sample of the run; its keys are local to its parent bone
+  (what a glTF node or a UsdSkel joint holds), chosen parent first: a child's local target is taken against its
+  parent's pose *as the keys will play it*, so the child's keys also absorb the parent's interpolation and
+  storage error. Every bone then stays within the key tolerance of its world pose at every sample, however
+  deep the chain (:func:`bone_keys`).
+
+Quaternions here are (w, x, y, z), as MuJoCo's.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from lifelike_mj.errors import UserError
+from lifelike_mj.export.keys import SHORT_ROTATION_RAD, lerp_keys, slerp_keys, tolerance_of
+
+# ---- quaternions (w, x, y, z), row by row ------------------------------------------------------------
+
+
+def qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product ``a b`` (either may be one quaternion or rows of them)."""
+    aw, ax, ay, az = np.moveaxis(np.asarray(a, dtype=float), -1, 0)
+    bw, bx, by, bz = np.moveaxis(np.asarray(b, dtype=float), -1, 0)
+    return np.stack([aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
+                     aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw], axis=-1)
+
+
+def qconj(q: np.ndarray) -> np.ndarray:
+    return np.asarray(q, dtype=float) * np.array([1.0, -1.0, -1.0, -1.0])
+
+
+def qrot(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The vectors ``v`` turned by the unit quaternions ``q``."""
+    q = np.asarray(q, dtype=float)
+    v = np.asarray(v, dtype=float)
+    u = q[..., 1:]
+    t = 2.0 * np.cross(u, v)
+    return v + q[..., :1] * t + np.cross(u, t)
+
+
+def qaxis(axis, angle_rad) -> np.ndarray:
+    """Rotations by ``angle_rad`` (scalar or array) about the unit ``axis``."""
+    a = np.asarray(angle_rad, dtype=float)[..., None] / 2.0
+    return np.concatenate([np.cos(a), np.sin(a) * np.asarray(axis, dtype=float)], axis=-1)
+
+
+def continuous(q: np.ndarray) -> np.ndarray:
+    """Rows of quaternions with their signs chosen so that neighbours lie on one side (for slerp)."""
+    q = np.array(q, dtype=float)
+    flip = np.cumsum(np.sum(q[1:] * q[:-1], axis=-1) < 0.0, axis=0) % 2 == 1
+    q[1:][flip] *= -1.0
+    return q
+
+
+def lerp_at(t: np.ndarray, keys: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Linear interpolation of the key rows ``x`` (at the sample indices ``keys``) at every time of ``t``."""
+    tk = t[keys]
+    return np.stack([np.interp(t, tk, x[:, j]) for j in range(x.shape[1])], axis=1)
+
+
+def slerp_at(t: np.ndarray, keys: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Spherical interpolation of the unit key quaternions ``q`` (at the sample indices ``keys``) at every
+    time of ``t``."""
+    tk = t[keys]
+    k = np.clip(np.searchsorted(tk, t, side="right") - 1, 0, len(tk) - 2)
+    u = np.clip((t - tk[k]) / (tk[k + 1] - tk[k]), 0.0, 1.0)[:, None]
+    a, b = q[k], q[k + 1].copy()
+    dot = np.sum(a * b, axis=1)
+    b[dot < 0] *= -1.0
+    theta = np.arccos(np.clip(np.abs(dot), 0.0, 1.0))[:, None]
+    small = theta < 1e-9
+    s = np.where(small, 1.0, np.sin(theta))
+    out = np.where(small, 1.0 - u, np.sin((1.0 - u) * theta) / s) * a + np.where(small, u, np.sin(u * theta) / s) * b
+    return out / np.linalg.norm(out, axis=1, keepdims=True)
+
+
+def matrix(pos: np.ndarray, quat_wxyz: np.ndarray) -> np.ndarray:
+    """The 4x4 transform of a position and a unit quaternion."""
+    w, x, y, z = quat_wxyz
+    R = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                  [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                  [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+    M = np.eye(4)
+    M[:3, :3], M[:3, 3] = R, pos
+    return M
+
+
+# ---- what a rig is -----------------------------------------------------------------------------------
+
+
+@dataclass
+class Look:
+    """A material: its name (the MJCF's where it has one), base colour (RGBA, 0-1), optional texture image
+    (``(H, W, 4)`` uint8 RGBA, embedded as PNG), and how it is drawn."""
+
+    name: str
+    rgba: tuple[float, float, float, float] = (1.0, 1.0, 1.0, 1.0)
+    image: np.ndarray | None = None
+    double_sided: bool = True
+    roughness: float = 0.7
+
+
+@dataclass
+class Mesh:
+    """A skinned mesh in its rig's bind pose (m; x forward, z up): ``positions``, ``normals`` ``(V, 3)``, ``uv``
+    ``(V, 2)`` (texture coordinates, v down as glTF's), ``joints`` ``(V, 4)`` bone indices, ``weights``
+    ``(V, 4)`` (summing to 1); ``parts``: ``(look, triangles (T, 3))`` per material."""
+
+    name: str
+    positions: np.ndarray
+    normals: np.ndarray
+    uv: np.ndarray
+    joints: np.ndarray
+    weights: np.ndarray
+    parts: list[tuple[Look, np.ndarray]]
+
+
+@dataclass
+class Bone:
+    """One bone: ``name`` (a MuJoCo body's, or ``body/extra`` for a bone of secondary motion), ``parent``
+    (index in the rig's bones, -1 for the root), ``bind`` (4x4 pose at rest in the rig's frame), and its world
+    pose at every sample: ``position_m`` ``(n, 3)``, ``quat_wxyz`` ``(n, 4)``; ``body``: the MuJoCo body it is
+    (``None`` for an extra bone)."""
+
+    name: str
+    parent: int
+    bind: np.ndarray
+    position_m: np.ndarray
+    quat_wxyz: np.ndarray
+    body: str | None = None
+
+
+@dataclass
+class Rig:
+    """One creature: ``name`` (its root body's), its ``bones`` (parents before children) and its ``mesh``
+    (shared, by identity, between the rigs that look alike); ``extras``: written with it (strict JSON);
+    ``secondary``: the series its secondary motion was computed from (for reports and tests, not written)."""
+
+    name: str
+    bones: list[Bone]
+    mesh: Mesh
+    extras: dict = field(default_factory=dict)
+    secondary: dict = field(default_factory=dict)
+
+    def check(self) -> None:
+        for i, b in enumerate(self.bones):
+            if not -1 <= b.parent < i:
+                raise UserError(f"bone {b.name!r} of {self.name} must come after its parent.")
+        if self.mesh.joints.max(initial=0) >= len(self.bones):
+            raise UserError(f"the mesh of {self.name} is bound to a bone it does not have.")
+
+
+# ---- keys, parent first --------------------------------------------------------------------------------
+
+
+@dataclass
+class BoneKeys:
+    """A bone's local keys: ``translation``/``rotation`` sample indices (``None``: still, ``still_*`` holds
+    the value) and the stored values at them (rotations as quaternions w, x, y, z)."""
+
+    translation: np.ndarray | None
+    rotation: np.ndarray | None
+    translation_values: np.ndarray
+    rotation_values: np.ndarray
+    still_translation: np.ndarray
+    still_rotation: np.ndarray
+
+
+def _stored(q: np.ndarray, rotations: str) -> np.ndarray:
+    """Quaternions as a reader gets them back from the file."""
+    if rotations == "short":
+        q = np.round(np.clip(q, -1.0, 1.0) * 32767.0) / 32767.0
+    else:
+        q = q.astype(np.float32).astype(float)
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+
+def bone_keys(t: np.ndarray, rig: Rig, tolerance=(0.0005, 0.5), rotations: str = "short") -> list[BoneKeys]:
+    """Each bone's local keys (module docstring): within ``tolerance`` (m, deg) of its world pose at every
+    sample of ``t``, less what storing costs (``rotations``: ``"short"`` 16-bit or ``"float"``)."""
+    tol_m, tol_deg = tolerance_of(tolerance)
+    span = max(float(np.max(np.abs(b.position_m))) for b in rig.bones)
+    tol_m -= 6e-8 * span + 1e-9
+    tol_rad = math.radians(tol_deg) - (SHORT_ROTATION_RAD if rotations == "short" else 1e-6)
+    if tol_m <= 0:
+        raise UserError(f"a key tolerance of {tolerance_of(tolerance)[0]:g} m is below what 32-bit positions "
+                        f"{span:g} m from the origin can hold; give a larger one.")
+    played: list[tuple[np.ndarray, np.ndarray]] = []  # each bone's world pose as its keys play it
+    out = []
+    for b in rig.bones:
+        if b.parent < 0:
+            p_local, q_local = b.position_m, continuous(b.quat_wxyz)
+        else:
+            pp, pq = played[b.parent]
+            p_local = qrot(qconj(pq), b.position_m - pp)
+            q_local = continuous(qmul(qconj(pq), b.quat_wxyz))
+        # translation: still where every sample is within a quarter of the tolerance of the first
+        if np.max(np.linalg.norm(p_local - p_local[0], axis=1)) <= tol_m / 4:
+            tk, tv = None, p_local[:1].astype(np.float32).astype(float)
+            p_play = np.repeat(tv, len(t), axis=0)
+        else:
+            tk = lerp_keys(t, p_local, tol_m * 0.75)
+            tv = p_local[tk].astype(np.float32).astype(float)
+            p_play = lerp_at(t, tk, tv)
+        if np.max(2.0 * np.arccos(np.clip(np.abs(q_local @ q_local[0]), 0.0, 1.0))) <= tol_rad / 4:
+            rk, rv = None, _stored(q_local[:1], "float")
+            q_play = np.repeat(rv, len(t), axis=0)
+        else:
+            rk = slerp_keys(t, q_local, tol_rad * 0.75)
+            rv = _stored(q_local[rk], rotations)
+            q_play = slerp_at(t, rk, rv)
+        if b.parent < 0:
+            played.append((p_play, q_play))
+        else:
+            pp, pq = played[b.parent]
+            played.append((pp + qrot(pq, p_play), qmul(pq, q_play)))
+        out.append(BoneKeys(tk, rk, tv, rv, tv[0], rv[0]))
+    return out
+
+
+def check_bone_keys(t: np.ndarray, rig: Rig, keys: list[BoneKeys]) -> tuple[float, float]:
+    """The largest miss (m, rad) of the keys' world poses, as a player composes them, against the rig's
+    world poses over every sample: what the tolerance bounds."""
+    worst_m, worst_rad = 0.0, 0.0
+    played: list[tuple[np.ndarray, np.ndarray]] = []
+    for b, k in zip(rig.bones, keys):
+        p = np.repeat(k.still_translation[None], len(t), axis=0) if k.translation is None else \
+            lerp_at(t, k.translation, k.translation_values)
+        q = np.repeat(k.still_rotation[None], len(t), axis=0) if k.rotation is None else \
+            slerp_at(t, k.rotation, k.rotation_values)
+        if b.parent >= 0:
+            pp, pq = played[b.parent]
+            p, q = pp + qrot(pq, p), qmul(pq, q)
+        played.append((p, q))
+        worst_m = max(worst_m, float(np.max(np.linalg.norm(p - b.position_m, axis=1))))
+        d = np.clip(np.abs(np.sum(q * b.quat_wxyz, axis=1)), 0.0, 1.0)
+        worst_rad = max(worst_rad, float(np.max(2.0 * np.arccos(d))))
+    return worst_m, worst_rad
+
+
+# ---- building rigs from a run ---------------------------------------------------------------------------
+
+
+def rest_pose(model, body: int) -> np.ndarray:
+    """The 4x4 pose of ``body`` at rest (its joints at zero) in the frame of its root body (the body below the
+    world that carries it): the bind pose of its bone."""
+    M = np.eye(4)
+    b = int(body)
+    root = int(model.body_rootid[b])
+    while b != root:
+        M = matrix(model.body_pos[b], model.body_quat[b]) @ M
+        b = int(model.body_parentid[b])
+    return M
+
+
+def creatures(poses) -> dict[int, list[int]]:
+    """The run's bodies grouped by creature: each root body's id -> the indices (in ``poses``) of its bodies,
+    the root first, parents before children."""
+    m = poses.model
+    out: dict[int, list[int]] = {}
+    for i, b in enumerate(poses.body_ids):
+        out.setdefault(int(m.body_rootid[b]), []).append(i)
+    for root, idx in out.items():
+        idx.sort(key=lambda i: (int(poses.body_ids[i]) != root, int(poses.body_ids[i])))  # MJCF order: parents first
+    return out
+
+
+def body_bone(poses, i: int, parent: int, name: str | None = None) -> Bone:
+    """The bone of the run's ``i``-th body (its world pose at every sample, its rest pose as bind)."""
+    body = poses.body_names[i]
+    return Bone(name or body, parent, rest_pose(poses.model, poses.body_ids[i]), poses.position_m[:, i],
+                poses.quat_wxyz[:, i], body)
+
+
+def extra_bone(name: str, parent: int, bones: list[Bone], offset_m, turn_wxyz: np.ndarray | None = None,
+               rest_wxyz=(1.0, 0.0, 0.0, 0.0)) -> Bone:
+    """A bone of secondary motion: at ``offset_m`` in its parent bone's frame, turned there by ``rest_wxyz``
+    and then by ``turn_wxyz`` (rows, one per sample; ``None``: still)."""
+    p = bones[parent]
+    rest = np.asarray(rest_wxyz, dtype=float)
+    local = np.broadcast_to(rest, p.quat_wxyz.shape) if turn_wxyz is None else qmul(rest, turn_wxyz)
+    pos = p.position_m + qrot(p.quat_wxyz, np.broadcast_to(np.asarray(offset_m, dtype=float), p.position_m.shape))
+    quat = qmul(p.quat_wxyz, local)
+    return Bone(name, parent, p.bind @ matrix(np.asarray(offset_m, dtype=float), rest), pos, continuous(quat))
+
+
+def damped(signal: np.ndarray, dt: float, hz: float, zeta: float) -> np.ndarray:
+    """The response of a damped oscillator (natural frequency ``hz``, damping ratio ``zeta``, unit static gain)
+    to ``signal`` ``(n, k)`` sampled every ``dt`` s, from rest at the first sample's value: a lagging follower
+    (semi-implicit Euler, sub-stepped to stay stable)."""
+    w = 2.0 * math.pi * hz
+    sub = max(1, int(math.ceil(dt * w / 0.2)))
+    h = dt / sub
+    y = np.array(signal[0], dtype=float)
+    v = np.zeros_like(y)
+    out = np.empty_like(signal, dtype=float)
+    for k in range(len(signal)):
+        for _ in range(sub):
+            v += h * (w * w * (signal[k] - y) - 2.0 * zeta * w * v)
+            y = y + h * v
+        out[k] = y
+    return out
