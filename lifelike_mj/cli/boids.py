@@ -270,3 +270,10 @@ def export_poses(args):
     flock = Flock(_params(args), args.n, args.seed)
     return (run_window(flock, args.start, args.steps, 1.0 / args.steps_per_frame,
                        1.0 / (args.steps_per_frame * args.fps), unit="steps"), parameters_of(args))
+
+
+def export_rigs(poses) -> list:
+    """The run's creatures as rigs (skinned, textured meshes on skeletons), for ``export --looks rig``."""
+    from lifelike_mj.boids.look import rigs
+
+    return rigs(poses)

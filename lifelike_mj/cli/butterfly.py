@@ -430,3 +430,10 @@ def export_poses(args):
     flight = Flight(_controller(args), params(args), _condition(args), backend="mujoco", config=args.config,
                     force_mode=args.force_mode)
     return run_window(flight, args.start, args.duration, args.fps), parameters_of(args)
+
+
+def export_rigs(poses) -> list:
+    """The run's creatures as rigs (skinned, textured meshes on skeletons), for ``export --looks rig``."""
+    from lifelike_mj.butterfly.look import rigs
+
+    return rigs(poses, ("swallowtail",))

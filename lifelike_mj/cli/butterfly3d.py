@@ -312,6 +312,13 @@ def export_poses(args):
     return run_window(sim, args.start, args.duration, args.fps), parameters_of(args)
 
 
+def export_rigs(poses) -> list:
+    """The run's creatures as rigs (skinned, textured meshes on skeletons), for ``export --looks rig``."""
+    from lifelike_mj.butterfly.look import rigs
+
+    return rigs(poses)
+
+
 def add_view_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--controller", default="wind", help="a shipped 3D controller's name (wind, steer, cruise) or a file")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")

@@ -41,6 +41,10 @@ def add_export_verb(sub) -> None:
                        help="glb, gltf, usd or html (default: from the file's ending)")
         q.add_argument("--rotations", default="short", choices=("short", "float"),
                        help="glTF and web keyframes' rotations: 16-bit (within 6e-5 rad, half the bytes) or 32-bit")
+        q.add_argument("--looks", default="rig", choices=("rig", "mjcf"),
+                       help="rig: each creature a textured mesh on a skeleton of its MuJoCo bodies and the bones of "
+                            "its secondary motion (glTF and web page; USD is written with mjcf); mjcf: the model's "
+                            "own geoms on each body")
         q.add_argument("--key-tolerance", default="0.5mm,0.5deg", metavar="DIST,ANGLE",
                        help="how far the interpolated keys may stray from the simulation, sampled at every step: a "
                             "distance (um, mm, cm, m) and an angle (deg, rad)")
@@ -78,36 +82,44 @@ def cmd_export(args) -> None:
     t0 = time.perf_counter()
     poses, parameters = mod.export_poses(args)
     t_sim = time.perf_counter() - t0
-    parameters = {"creature": args.what, **parameters, "format": fmt, "rotations": args.rotations,
+    looks = "mjcf" if fmt == "usd" else args.looks
+    rigs = mod.export_rigs(poses) if looks == "rig" else None
+    parameters = {"creature": args.what, **parameters, "format": fmt, "rotations": args.rotations, "looks": looks,
                   "key_tolerance": {"m": tolerance[0], "deg": tolerance[1]}}
     path = write_poses(poses, args.out, fmt, name=f"lifelike-mj {args.what}", parameters=parameters,
-                       rotations=args.rotations, tolerance=tolerance)
+                       rotations=args.rotations, tolerance=tolerance, rigs=rigs)
     t_write = time.perf_counter() - t0 - t_sim
     size = path.stat().st_size
-    counts = key_counts(poses.tracks(tolerance, "float" if fmt == "usd" else args.rotations), poses.body_names)
-    info = {"out": str(path), "format": fmt, "bytes": size, "frames": poses.n_frames, "fps": poses.fps,
+    storage = "float" if fmt == "usd" else args.rotations
+    if rigs:
+        counts = {f"{r.name}:{b}": c for r in rigs for b, c in r.key_counts(poses.t_s, tolerance, storage).items()}
+        what = f"{len(rigs)} {'rigs' if len(rigs) > 1 else 'rig'} ({sum(len(r.bones) for r in rigs)} bones)"
+    else:
+        counts = key_counts(poses.tracks(tolerance, storage), poses.body_names)
+        what = f"{len(poses.body_ids)} bodies"
+    info = {"out": str(path), "format": fmt, "looks": looks, "bytes": size, "frames": poses.n_frames, "fps": poses.fps,
             "samples": poses.n_samples, "bodies": len(poses.body_ids), "span_s": float(poses.t_s[-1] - poses.t_s[0]),
             "key_tolerance": {"m": tolerance[0], "deg": tolerance[1]}, "keys": counts, "simulate_s": t_sim,
             "write_s": t_write}
-    emit(args, info, f"wrote {len(poses.body_ids)} bodies, {poses.n_frames} frames at {poses.fps:g}/s "
-         f"({size / 1e6:.2f} MB) to {path} in {t_sim + t_write:.1f} s\n" + keys_text(counts, poses.n_samples))
+    emit(args, info, f"wrote {what}, {poses.n_frames} frames at {poses.fps:g}/s ({size / 1e6:.2f} MB) to {path} "
+         f"in {t_sim + t_write:.1f} s\n" + keys_text(counts, poses.n_samples))
 
 
 def keys_text(counts: dict[str, dict[str, int]], samples: int) -> str:
     """The keys kept per body, in a few lines: each body for a few, a summary for a crowd."""
     rows = [(name, c["translation"], c["rotation"]) for name, c in counts.items()]
     head = f"keys kept of {samples:,} samples (translation, rotation):"
-    if len(rows) <= 8:
+    if len(rows) <= 12:
         return head + "".join(f"\n  {n}: {t:,}, {r:,}" for n, t, r in rows)
     t = np.array([r[1] for r in rows])
     r = np.array([r[2] for r in rows])
-    return (head + f"\n  {len(rows):,} bodies: translation {t.min():,}-{t.max():,} (median {int(np.median(t)):,}), "
+    return (head + f"\n  {len(rows):,} bodies or bones: translation {t.min():,}-{t.max():,} (median {int(np.median(t)):,}), "
             f"rotation {r.min():,}-{r.max():,} (median {int(np.median(r)):,}); --json lists each")
 
 
 def parameters_of(args: argparse.Namespace) -> dict:
     """The creature's options as given (what made the run), for the file's provenance."""
-    skip = {"func", "out", "format", "overwrite", "json", "command", "what", "rotations", "key_tolerance"}
+    skip = {"func", "out", "format", "overwrite", "json", "command", "what", "rotations", "key_tolerance", "looks"}
     return {k: (list(v) if isinstance(v, tuple) else v) for k, v in vars(args).items() if k not in skip}
 
 

@@ -181,3 +181,10 @@ def export_poses(args):
                  body_unit="fish-steps (substeps included)")
     tank = Tank(params, args.fish, args.seed, _tank(args))
     return run_window(tank, args.start, args.duration, args.fps), parameters_of(args)
+
+
+def export_rigs(poses) -> list:
+    """The run's creatures as rigs (skinned, textured meshes on skeletons), for ``export --looks rig``."""
+    from lifelike_mj.fish.look import rigs
+
+    return rigs(poses)

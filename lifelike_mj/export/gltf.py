@@ -35,7 +35,7 @@ from lifelike_mj.errors import UserError
 from lifelike_mj.export.cameras import FOV_DEG, framing
 from lifelike_mj.export.keys import DEFAULT_TOLERANCE, Track, key_counts, tolerance_of
 from lifelike_mj.export.poses import Poses, drawn_geoms, geom_looks, geom_rgba
-from lifelike_mj.export.rig import Look, Mesh, Rig, bone_keys
+from lifelike_mj.export.rig import Look, Mesh, Rig
 from lifelike_mj.export.shapes import geom_shape, shape_key
 from lifelike_mj.io import atomic_path, strict
 from lifelike_mj.provenance import provenance
@@ -265,7 +265,7 @@ def _add_rigs(gl: g.GLTF2, root: g.Node, buf: _Buffer, channel, poses: Poses, ri
 
     for rig in rigs:
         rig.check()
-        keys = bone_keys(poses.t_s, rig, tolerance, rotations)
+        keys = rig.keys(poses.t_s, tolerance, rotations)
         arm = g.Node(name=rig.name, children=[], extras={"lifelike_mj_rig": rig.name, **rig.extras})
         gl.nodes.append(arm)
         root.children.append(len(gl.nodes) - 1)
@@ -288,9 +288,7 @@ def _add_rigs(gl: g.GLTF2, root: g.Node, buf: _Buffer, channel, poses: Poses, ri
                                inverseBindMatrices=binds[ibm.tobytes()]))
         gl.nodes.append(g.Node(name=f"{rig.name} mesh", mesh=mesh_of(rig.mesh), skin=len(gl.skins) - 1))
         gl.scenes[0].nodes.append(len(gl.nodes) - 1)
-        report[rig.name] = {b.name: {"translation": 1 if k.translation is None else len(k.translation),
-                                     "rotation": 1 if k.rotation is None else len(k.rotation)}
-                            for b, k in zip(rig.bones, keys)}
+        report[rig.name] = rig.key_counts(poses.t_s, tolerance, rotations)
     return report
 
 

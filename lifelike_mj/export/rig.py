@@ -154,6 +154,20 @@ class Rig:
     extras: dict = field(default_factory=dict)
     secondary: dict = field(default_factory=dict)
 
+    def keys(self, t: np.ndarray, tolerance=(0.0005, 0.5), rotations: str = "short") -> list[BoneKeys]:
+        """The bones' keys (:func:`bone_keys`), computed once per tolerance and storage."""
+        key = (tolerance_of(tolerance), rotations, len(t))
+        cache = self.__dict__.setdefault("_keys", {})
+        if key not in cache:
+            cache[key] = bone_keys(t, self, key[0], rotations)
+        return cache[key]
+
+    def key_counts(self, t: np.ndarray, tolerance=(0.0005, 0.5), rotations: str = "short") -> dict:
+        """Keys kept per bone and channel (a still channel has 1: its node's value)."""
+        return {b.name: {"translation": 1 if k.translation is None else len(k.translation),
+                         "rotation": 1 if k.rotation is None else len(k.rotation)}
+                for b, k in zip(self.bones, self.keys(t, tolerance, rotations))}
+
     def check(self) -> None:
         for i, b in enumerate(self.bones):
             if not -1 <= b.parent < i:
