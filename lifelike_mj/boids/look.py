@@ -64,7 +64,9 @@ def flight_frame(t: np.ndarray, pos: np.ndarray, sigma: float = SMOOTH_STEPS):
     yaw_rate = np.gradient(yaw, t) if n > 2 else np.zeros(n)
     bank = np.arctan(horiz * yaw_rate / G)  # coordinated turn: tan(bank) = v * yaw rate / g
     accel = np.gradient(speed, t) if n > 2 else np.zeros(n)
-    q = qmul(qmul(qaxis((0.0, 0.0, 1.0), yaw), qaxis((0.0, 1.0, 0.0), -pitch)), qaxis((1.0, 0.0, 0.0), bank))
+    # heading, then climb (nose up: a negative turn about y), then bank (into a left turn, a positive yaw rate,
+    # the left wing goes down: a negative turn about the forward axis)
+    q = qmul(qmul(qaxis((0.0, 0.0, 1.0), yaw), qaxis((0.0, 1.0, 0.0), -pitch)), qaxis((1.0, 0.0, 0.0), -bank))
     series = {"speed_m_s": speed, "yaw_rate_rad_s": yaw_rate, "bank_rad": bank, "climb_m_s": v[:, 2],
               "accel_m_s2": accel, "horizontal_m_s": horiz}
     return p, continuous(q), series

@@ -266,7 +266,7 @@ def _add_rigs(gl: g.GLTF2, root: g.Node, buf: _Buffer, channel, poses: Poses, ri
     for rig in rigs:
         rig.check()
         keys = rig.keys(poses.t_s, tolerance, rotations)
-        arm = g.Node(name=rig.name, children=[], extras={"lifelike_mj_rig": rig.name, **rig.extras})
+        arm = g.Node(name=f"{rig.name} rig", children=[], extras={"lifelike_mj_rig": rig.name, **rig.extras})
         gl.nodes.append(arm)
         root.children.append(len(gl.nodes) - 1)
         first = len(gl.nodes)

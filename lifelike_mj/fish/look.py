@@ -12,8 +12,8 @@ strokes at routine speeds, body and caudal fin in bursts; Gerstner 1999: body an
   with ``U`` the fish's forward speed and ``L`` its length; tail amplitude :data:`TAIL_AMPLITUDE_L` L (his
   amplitude of about L/5, taken as peak to peak), growing from the head as ``(0.1 + 0.9 (s/L)^2)``; wave length
   :data:`WAVELENGTH_L` L (0.76 L in trout, Webb 1971; about 1 L in carangiform swimmers). The wave is on while
-  the fish speeds up faster than :data:`BURST_ACCEL_BL_S2` body lengths/s^2 or turns faster than
-  :data:`TURN_DEG_S`, and fades over :data:`COAST_FADE_S` once it coasts.
+  the fish speeds up faster than :data:`BURST_ACCEL_BL_S2` body lengths/s^2 or, swimming, turns faster than
+  :data:`TURN_DEG_S` (:func:`activity`), and fades over :data:`COAST_FADE_S` once it coasts.
 * **Turning bend**: the spine follows the path's curvature (yaw rate / speed), so the body bends toward the
   side of a turn, a C-bend in an escape (at most :data:`MAX_BEND_DEG` over the spine).
 * **Pectoral fins** beat while the body wave is off, at a frequency rising with speed
@@ -35,8 +35,11 @@ TAIL_AMPLITUDE_L, WAVELENGTH_L = 0.1, 0.9
 #: When the body wave runs: forward acceleration (BL/s^2) or yaw rate (deg/s) above these; it fades over
 #: COAST_FADE_S (s) once both fall below.
 BURST_ACCEL_BL_S2, TURN_DEG_S, COAST_FADE_S = 4.0, 150.0, 0.25
-#: The largest bend of the spine in a turn (deg, head to tail).
-MAX_BEND_DEG = 70.0
+#: The wave rises over this time (s) and a turn starts it only above this speed (BL/s).
+WAVE_RISE_S, TURN_WAVE_BL_S = 0.04, 1.5
+#: The largest bend of the spine in a turn (deg, head to tail), and the time (s, a Gaussian's sigma) over which
+#: the yaw rate and speed that set it are smoothed (their differences from one step to the next are jittery).
+MAX_BEND_DEG, BEND_SMOOTH_S = 70.0, 0.06
 #: Pectoral fin beat: Hz at rest, plus Hz per body length/s; stroke amplitude (deg).
 PECTORAL_HZ, PECTORAL_HZ_PER_BL_S, PECTORAL_DEG = 2.5, 1.2, 35.0
 #: The spine's joints, as fractions of the length from the snout (the last carries the caudal fin).
@@ -64,14 +67,26 @@ def kinematics(t: np.ndarray, pos: np.ndarray, quat: np.ndarray):
     return speed, accel, omega_body[:, 2]
 
 
-def activity(t: np.ndarray, accel_bl: np.ndarray, yaw_deg_s: np.ndarray) -> np.ndarray:
-    """The body wave's weight (0 to 1): 1 while bursting or turning sharply, fading over the coast."""
-    on = (accel_bl > BURST_ACCEL_BL_S2) | (np.abs(yaw_deg_s) > TURN_DEG_S)
+def _smooth(x: np.ndarray, sigma: float) -> np.ndarray:
+    """``x`` smoothed by a Gaussian of ``sigma`` samples, its ends held."""
+    if sigma < 0.5 or len(x) < 3:
+        return np.asarray(x, dtype=float)
+    r = int(math.ceil(3 * sigma))
+    k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
+    return np.convolve(np.concatenate([np.full(r, x[0]), x, np.full(r, x[-1])]), k / k.sum(), mode="valid")
+
+
+def activity(t: np.ndarray, accel_bl: np.ndarray, yaw_deg_s: np.ndarray, speed_bl: np.ndarray) -> np.ndarray:
+    """The body wave's weight (0 to 1): rising within :data:`WAVE_RISE_S` while the fish bursts (speeds up
+    faster than :data:`BURST_ACCEL_BL_S2`) or turns sharply (faster than :data:`TURN_DEG_S` while swimming
+    faster than :data:`TURN_WAVE_BL_S`: a slow turn on the spot is a bend, not a wave), fading over
+    :data:`COAST_FADE_S` once it coasts."""
+    on = (accel_bl > BURST_ACCEL_BL_S2) | ((np.abs(yaw_deg_s) > TURN_DEG_S) & (speed_bl > TURN_WAVE_BL_S))
     out = np.zeros(len(t))
     level = 0.0
-    for k in range(len(t)):
-        dt = t[k] - t[k - 1] if k else 0.0
-        level = 1.0 if on[k] else level * math.exp(-dt / COAST_FADE_S) if dt > 0 else level
+    for k in range(1, len(t)):
+        dt = t[k] - t[k - 1]
+        level = 1.0 - (1.0 - level) * math.exp(-dt / WAVE_RISE_S) if on[k] else level * math.exp(-dt / COAST_FADE_S)
         out[k] = level
     return out
 
@@ -88,7 +103,8 @@ def spine_angles(t, speed, yaw_rate, weight, length_m: float):
     heading = np.arctan2(np.diff(y, axis=1), np.diff(s) * length_m)
     # the bend that follows the path's curvature (yaw rate over speed): on a curved path each segment points
     # back along the curve, turned by the curvature times its distance behind the root (the centre of mass)
-    kappa = yaw_rate / np.maximum(np.abs(speed), 0.5 * length_m)
+    dt = float(np.median(np.diff(t))) if len(t) > 1 else 1.0
+    kappa = _smooth(yaw_rate, BEND_SMOOTH_S / dt) / np.maximum(np.abs(_smooth(speed, BEND_SMOOTH_S / dt)), 0.5 * length_m)
     mid = 0.5 * (s[1:] + s[:-1])
     bend = -kappa[:, None] * length_m * (mid[None, :] - mid[0])
     cap = math.radians(MAX_BEND_DEG)
@@ -186,7 +202,7 @@ def fish_rig(poses, indices: list[int], length_m: float, looks: _Looks, meshes: 
     root = body_bone(poses, indices[0], -1)
     bones: list[Bone] = [root]
     speed, accel, yaw = kinematics(t, root.position_m, root.quat_wxyz)
-    weight = activity(t, accel / length_m, np.degrees(yaw))
+    weight = activity(t, accel / length_m, np.degrees(yaw), speed / length_m)
     joints, phase, f = spine_angles(t, speed, yaw, weight, length_m)
     snout_x = 0.032  # the model's snout, 0.032 m ahead of the centre of mass (fish.xml)
     z = (0.0, 0.0, 1.0)

@@ -19,7 +19,7 @@ def _accessor(gl, i, blob):
     view = gl.bufferViews[acc.bufferView]
     dtype = {pygltflib.FLOAT: np.float32, pygltflib.UNSIGNED_SHORT: np.uint16, pygltflib.UNSIGNED_INT: np.uint32,
              pygltflib.SHORT: np.int16}
-    width = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}[acc.type]
+    width = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}[acc.type]
     raw = np.frombuffer(blob, dtype=dtype[acc.componentType], count=acc.count * width,
                         offset=view.byteOffset + (acc.byteOffset or 0))
     if acc.normalized:  # glTF 2.0 3.11: a normalized signed short c stands for max(c / 32767, -1)
