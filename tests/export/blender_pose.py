@@ -3,8 +3,9 @@ has Blender as a module (PyPI's ``bpy``): ``python blender_pose.py -- FILE OUT.j
 
 Imports FILE (.glb/.gltf with Blender's glTF importer, .usd* with its USD importer) into an empty scene at FPS
 frames per second and writes, for each time T (s from the start), every imported body's world matrix as
-Blender evaluates it at frame ``T x FPS`` (a subframe where it falls between frames):
-``{"frames": {T: {body: 4x4}}, "blender": version}`` (or ``{"error": ...}`` where it cannot import the format).
+Blender evaluates it at frame ``T x FPS`` (a subframe where it falls between frames), and every armature's
+bones' world matrices: ``{"frames": {T: {body: 4x4}}, "bones": {T: {bone: 4x4}}, "armatures": {armature:
+[bones]}, "blender": version}`` (or ``{"error": ...}`` where it cannot import the format).
 Bodies are found by their ``mujoco_body`` custom property (glTF: the node's extras; USD: the Xform's
 ``userProperties:mujoco_body``).
 """
@@ -37,12 +38,16 @@ else:
     # mesh, at the geom's place in the body)
     bpy.ops.wm.usd_import(filepath=path, merge_parent_xform=False)
     bodies = {o.name: o["mujoco_body"] for o in bpy.data.objects if "mujoco_body" in o.keys()}  # code k: frame k
-result = {"blender": bpy.app.version_string, "frames": {}}
+arms = [o for o in bpy.data.objects if o.type == "ARMATURE"]
+result = {"blender": bpy.app.version_string, "frames": {}, "bones": {},
+          "armatures": {o.name: [b.name for b in o.data.bones] for o in arms}}
 for k, frame in frames.items():
     whole = int(frame // 1)
     scene.frame_set(whole, subframe=frame - whole)
     depsgraph = bpy.context.evaluated_depsgraph_get()
     result["frames"][str(k)] = {body: [list(r) for r in bpy.data.objects[name].evaluated_get(depsgraph).matrix_world]
                                 for name, body in bodies.items()}
+    result["bones"][str(k)] = {b.name: [list(r) for r in (o.matrix_world @ b.matrix)] for o in arms
+                               for b in o.evaluated_get(depsgraph).pose.bones}
 with open(out, "w") as fh:
     json.dump(result, fh)

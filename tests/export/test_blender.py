@@ -68,6 +68,52 @@ def test_blender_puts_every_body_where_the_simulation_had_it(runs, creature, suf
             assert angle < 1e-3, (k, name, angle)
 
 
+@needs_blender
+def test_blender_imports_an_armature_per_creature_whose_bones_follow_the_simulation(runs, creature, tmp_path):
+    """Debian's Blender imports each rigged creature as an armature with one bone per body (named as in the MJCF)
+    and the bones of its secondary motion; each bone's head is where the bone is (1e-4 m) and its turn between
+    two of three times is the bone's (1e-3 rad; Blender keeps a bone's own axes, fixed by its importer)."""
+    import importlib
+
+    looks = {"butterfly3d": "butterfly", "butterfly2d": "butterfly", "fish": "fish", "boids": "boids"}[creature]
+    _, poses = runs(creature)
+    rigs = importlib.import_module(f"lifelike_mj.{looks}.look").rigs(poses)
+    if creature == "boids":
+        rigs = rigs[:12]  # a dozen birds are enough for Blender here
+    path = write_poses(poses, tmp_path / f"{creature}.glb", tolerance=TIGHT, rigs=rigs)
+    samples = poses.frame_samples[[0, poses.n_frames // 2 - 1, poses.n_frames - 1]]
+    samples[1] += 1
+    times = {k: repr(float(poses.t_s[k] - poses.t_s[0])) for k in samples}
+    got = _in_blender(path, poses.fps, list(times.values()))
+    assert sorted(got["armatures"]) == sorted(f"{r.name} rig" for r in rigs)
+    for r in rigs:
+        assert sorted(got["armatures"][f"{r.name} rig"]) == sorted(b.name for b in r.bones)
+    assert {b.body for r in rigs for b in r.bones} - {None} >= {n for n in poses.body_names
+                                                               if any(n == b.name for r in rigs for b in r.bones)}
+    first = None
+    for k in samples:
+        seen = got["bones"][times[k]]
+        for r in rigs:
+            for b in r.bones:
+                M = np.array(seen[b.name])
+                np.testing.assert_allclose(M[:3, 3], b.position_m[k], atol=1e-4)
+        if first is None:
+            first = (k, seen)
+            continue
+        k0, seen0 = first
+        for r in rigs:
+            for b in r.bones:  # the turn from the first time to this one, in the world
+                turn = np.array(seen[b.name])[:3, :3] @ np.array(seen0[b.name])[:3, :3].T
+                R1, R0 = np.empty(9), np.empty(9)
+                mujoco.mju_quat2Mat(R1, b.quat_wxyz[k])
+                mujoco.mju_quat2Mat(R0, b.quat_wxyz[k0])
+                want = R1.reshape(3, 3) @ R0.reshape(3, 3).T
+                # |A - B| (Frobenius) = 2 sqrt(2) sin(angle / 2): unlike the trace's arccos, not thrown by Blender's
+                # 32-bit matrices, whose columns are unit only to 1e-7
+                angle = 2.0 * np.arcsin(min(1.0, np.linalg.norm(turn - want) / (2.0 * np.sqrt(2.0))))
+                assert angle < 1e-3, (k, b.name, angle)
+
+
 SCRIPT = Path(__file__).resolve().parents[2] / "examples" / "blender" / "import_motion.py"
 
 
