@@ -24,14 +24,22 @@ def without_creature(page: Path, out: Path) -> Path:
     for body in bodies:
         for child in body.children:
             gl.nodes[child].mesh = None
+    for node in gl.nodes:  # a rigged creature: its skinned mesh
+        if node.skin is not None:
+            node.mesh, node.skin = None, None
     empty = base64.b64encode(b"".join(gl.save_to_bytes())).decode("ascii")
     out.write_text(text.replace(b64, empty))
     return out
 
 
-def test_the_page_plays_each_creature_offline(runs, creature, tmp_path, chromium):
+def test_the_page_plays_each_rigged_creature_offline(runs, creature, tmp_path, chromium):
+    """The page as ``lifelike-mj export`` writes it by default: the creatures rigged, skinned and textured."""
+    import importlib
+
     _, poses = runs(creature)
-    page = write_poses(poses, tmp_path / f"{creature}.html", parameters={"creature": creature})
+    looks = {"butterfly3d": "butterfly", "butterfly2d": "butterfly", "fish": "fish", "boids": "boids"}[creature]
+    rigs = importlib.import_module(f"lifelike_mj.{looks}.look").rigs(poses)
+    page = write_poses(poses, tmp_path / f"{creature}.html", parameters={"creature": creature}, rigs=rigs)
     text = page.read_text()
     assert "<script src" not in text and 'src="http' not in text  # one file: the viewer and the run inside
     span = float(poses.t_s[-1] - poses.t_s[0])
