@@ -312,6 +312,11 @@ def export_poses(args):
     return run_window(sim, args.start, args.duration, args.fps), parameters_of(args)
 
 
+def loop_cut_body(args) -> str | None:
+    """The body whose beat a looped export is cut at (``export --loop``), or None to blend the loop."""
+    return "wing_left" if not args.garden and args.task == "level" else None
+
+
 def export_rigs(poses) -> list:
     """The run's creatures as rigs (skinned, textured meshes on skeletons), for ``export --looks rig``."""
     from lifelike_mj.butterfly.look import rigs

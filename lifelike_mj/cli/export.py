@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from lifelike_mj.cli.common import Parser, add_json, add_overwrite, count, emit
+from lifelike_mj.cli.common import Parser, add_json, add_overwrite, count, emit, num
 
 #: The creatures that export, in the order of the help.
 EXPORTERS = ("butterfly", "butterfly3d", "fish", "boids")
@@ -45,6 +45,14 @@ def add_export_verb(sub) -> None:
                        help="rig: each creature a textured mesh on a skeleton of its MuJoCo bodies and the bones of "
                             "its secondary motion (glTF and web page; USD is written with mjcf); mjcf: the model's "
                             "own geoms on each body")
+        q.add_argument("--loop", action="store_true",
+                       help="a clip whose last frame joins its first: a butterfly in level flight is cut at whole "
+                            "wing beats (flying in place, its travel per loop recorded as root motion); anything "
+                            "else is recorded --loop-blend longer and its end blended into its start")
+        q.add_argument("--loop-blend", type=num(0.05, 60.0, unit="s"), default=1.0, metavar="S",
+                       help="seconds of playback over which a looped clip's end fades into its start, recorded "
+                            "before the clip (for a cut, the lead-in that the secondary motion starts from; "
+                            "default 1)")
         q.add_argument("--key-tolerance", default="0.5mm,0.5deg", metavar="DIST,ANGLE",
                        help="how far the interpolated keys may stray from the simulation, sampled at every step: a "
                             "distance (um, mm, cm, m) and an angle (deg, rad)")
@@ -79,13 +87,28 @@ def cmd_export(args) -> None:
 
         require_usd()
     mod = _module(args.what)
+    cut = args.loop and getattr(mod, "loop_cut_body", lambda a: None)(args)
+    if args.loop:  # a lead-in recorded before the clip: the blend's, or the secondary motion's history for a cut
+        _lengthen(args, args.loop_blend)
     t0 = time.perf_counter()
     poses, parameters = mod.export_poses(args)
     t_sim = time.perf_counter() - t0
+    loop = None
     looks = "mjcf" if fmt == "usd" else args.looks
-    rigs = mod.export_rigs(poses) if looks == "rig" else None
+    if args.loop:
+        from lifelike_mj.export import loop as looping
+
+        rigs = mod.export_rigs(poses) if looks == "rig" else None
+        if cut:
+            i = poses.body_names.index(cut)
+            period = looping.beat_period(poses.t_s, poses.quat_wxyz[:, i], poses.quat_wxyz[:, 0])
+            poses, rigs, loop = looping.loop_cut(poses, rigs, period, args.loop_blend)
+        else:
+            poses, rigs, loop = looping.loop_blend(poses, rigs, args.loop_blend)
+    else:
+        rigs = mod.export_rigs(poses) if looks == "rig" else None
     parameters = {"creature": args.what, **parameters, "format": fmt, "rotations": args.rotations, "looks": looks,
-                  "key_tolerance": {"m": tolerance[0], "deg": tolerance[1]}}
+                  "key_tolerance": {"m": tolerance[0], "deg": tolerance[1]}, "loop": loop}
     path = write_poses(poses, args.out, fmt, name=f"lifelike-mj {args.what}", parameters=parameters,
                        rotations=args.rotations, tolerance=tolerance, rigs=rigs)
     t_write = time.perf_counter() - t0 - t_sim
@@ -99,10 +122,30 @@ def cmd_export(args) -> None:
         what = f"{len(poses.body_ids)} bodies"
     info = {"out": str(path), "format": fmt, "looks": looks, "bytes": size, "frames": poses.n_frames, "fps": poses.fps,
             "samples": poses.n_samples, "bodies": len(poses.body_ids), "span_s": float(poses.t_s[-1] - poses.t_s[0]),
-            "key_tolerance": {"m": tolerance[0], "deg": tolerance[1]}, "keys": counts, "simulate_s": t_sim,
-            "write_s": t_write}
+            "key_tolerance": {"m": tolerance[0], "deg": tolerance[1]}, "keys": counts, "loop": loop,
+            "simulate_s": t_sim, "write_s": t_write}
     emit(args, info, f"wrote {what}, {poses.n_frames} frames at {poses.fps:g}/s ({size / 1e6:.2f} MB) to {path} "
-         f"in {t_sim + t_write:.1f} s\n" + keys_text(counts, poses.n_samples))
+         f"in {t_sim + t_write:.1f} s\n" + keys_text(counts, poses.n_samples) + _loop_text(loop))
+
+
+def _loop_text(loop: dict | None) -> str:
+    if not loop:
+        return ""
+    how = (f"cut at {loop['beats']} wing beats of {loop['period_s'] * 1000:.1f} ms, flying in place (root motion "
+           f"{np.linalg.norm(loop['root_motion_m']):.3f} m per loop)" if loop["mode"] == "cut"
+           else f"its last {loop['blend_s']:.2f} s blended into its start")
+    hint = ("; the flight had not settled into a repeating beat: a later --start (after the take-off) closes it"
+            if loop["mode"] == "cut" and loop["seam_deg"] > 2.0 else "")
+    return (f"\nloop of {loop['span_s']:.2f} s, {how}; seam: {loop['seam_m'] * 1000:.2f} mm, "
+            f"{loop['seam_deg']:.2f} deg{hint}")
+
+
+def _lengthen(args, seconds: float) -> None:
+    """Record ``seconds`` of playback more (a looped blend's lead-in): ``--duration`` or a flock's ``--steps``."""
+    if hasattr(args, "steps_per_frame"):
+        args.steps += int(round(seconds * args.fps * args.steps_per_frame))
+    else:
+        args.duration += seconds
 
 
 def keys_text(counts: dict[str, dict[str, int]], samples: int) -> str:
@@ -119,7 +162,8 @@ def keys_text(counts: dict[str, dict[str, int]], samples: int) -> str:
 
 def parameters_of(args: argparse.Namespace) -> dict:
     """The creature's options as given (what made the run), for the file's provenance."""
-    skip = {"func", "out", "format", "overwrite", "json", "command", "what", "rotations", "key_tolerance", "looks"}
+    skip = {"func", "out", "format", "overwrite", "json", "command", "what", "rotations", "key_tolerance", "looks",
+            "loop", "loop_blend"}
     return {k: (list(v) if isinstance(v, tuple) else v) for k, v in vars(args).items() if k not in skip}
 
 
