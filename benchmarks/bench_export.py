@@ -1,17 +1,19 @@
-"""Export sizes and speed (issue 16): writes benchmarks/results/export.json and prints the table for
+"""Export sizes and speed (issues 16 and 25): writes benchmarks/results/export.json and prints the table for
 docs/performance.md.
 
-Run: ``python benchmarks/bench_export.py [--repeats 3]``. Two runs are recorded once each: a flock of 300
-boids for 10,000 steps (a keyframe every 5 steps: 2,001 frames, played at 30 frames/s) and a tank of 10 fish
-for 60 s at 30 frames/s (1,801 frames). Each is then written in every format, ``--repeats`` times (the
-median time is reported):
+Run: ``python benchmarks/bench_export.py [--repeats 3]``. Two runs are recorded once each, every step sampled: a
+flock of 300 boids for 10,000 steps (5 steps a frame: 2,001 frames, played at 30 frames/s) and a tank of 10 fish
+for 60 s (60 steps/s, 30 frames/s). Each is then written ``--repeats`` times (the median time is reported; the
+rigged flock once, as it takes long) as:
 
-* ``glb (32-bit keys)``: the uncompressed baseline, every keyframe value a 32-bit float;
-* ``glb``, ``gltf``, ``html``: the defaults (rotation keys as normalized 16-bit integers);
-* ``usdc``, ``usda``: USD, binary and text.
+* ``frames, every frame a key``: the layout before keys were chosen (issue 16's default file): the frames
+  only, each a key (keyed here within 0.01 mm and 0.01 deg, which keeps nearly every frame that moves);
+* ``mjcf, keyed``: the MJCF's geoms on each body, every step sampled and keyed within 0.5 mm and 0.5 deg;
+* ``rig``: the default, each creature a skinned, textured mesh on its skeleton with its secondary motion
+  (the rigs' building timed apart);
+* ``html (rig)`` and ``usdc (mjcf)``.
 
-Sizes are bytes on disk, with the gzip size of the defaults (what a web server sends). ``raw keys`` is the
-least any file holding every keyframe as 32-bit floats can weigh: frames x bodies x 7 x 4 bytes.
+Sizes are bytes on disk, with the gzip size (what a web server sends).
 """
 
 from __future__ import annotations
@@ -29,21 +31,19 @@ from lifelike_mj.io import write_json
 from lifelike_mj.machine import machine_info
 from lifelike_mj.provenance import provenance
 
-#: (label, file ending, rotations).
-VARIANTS = [("glb (32-bit keys)", ".glb", "float"), ("glb", ".glb", "short"), ("gltf", ".gltf", "short"),
-            ("html", ".html", "short"), ("usdc", ".usdc", "short"), ("usda", ".usda", "short")]
-
 
 def runs():
     from lifelike_mj.boids import Flock
+    from lifelike_mj.boids.look import rigs as bird_rigs
     from lifelike_mj.fish import Tank
+    from lifelike_mj.fish.look import rigs as fish_rigs
 
     t0 = time.perf_counter()
     flock = record_poses(Flock(n=300, seed=0), 10_000, fps=1.0 / 5.0, time_scale=1.0 / (5 * 30))
     t1 = time.perf_counter()
     tank = record_poses(Tank(n_fish=10, seed=0), 60.0, fps=30.0)
     t2 = time.perf_counter()
-    return [("300 boids, 10,000 steps", flock, t1 - t0), ("10 fish, 60 s", tank, t2 - t1)]
+    return [("300 boids, 10,000 steps", flock, t1 - t0, bird_rigs), ("10 fish, 60 s", tank, t2 - t1, fish_rigs)]
 
 
 def main() -> None:
@@ -53,30 +53,38 @@ def main() -> None:
     args = ap.parse_args()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        for label, poses, sim_s in runs():
-            raw = poses.n_frames * len(poses.body_ids) * 7 * 4
-            row = {"run": label, "frames": poses.n_frames, "bodies": len(poses.body_ids), "simulate_s": sim_s,
-                   "raw_keys_bytes": raw, "formats": {}}
-            for name, suffix, rotations in VARIANTS:
+        for label, poses, sim_s, make_rigs in runs():
+            t = time.perf_counter()
+            rigs = make_rigs(poses)
+            rig_s = time.perf_counter() - t
+            row = {"run": label, "frames": poses.n_frames, "samples": poses.n_samples, "bodies": len(poses.body_ids),
+                   "simulate_s": sim_s, "build_rigs_s": rig_s, "formats": {}}
+            variants = [("frames, every frame a key", ".glb", poses.frames(), (1e-5, 0.01), None),
+                        ("mjcf, keyed", ".glb", poses, (0.0005, 0.5), None),
+                        ("rig (default)", ".glb", poses, (0.0005, 0.5), rigs),
+                        ("html (rig)", ".html", poses, (0.0005, 0.5), rigs),
+                        ("usdc (mjcf)", ".usdc", poses, (0.0005, 0.5), None)]
+            for name, suffix, data, tol, rg in variants:
                 path = Path(tmp) / f"run{suffix}"
                 times = []
-                for _ in range(args.repeats):
+                for _ in range(1 if (rg is not None and len(rg) > 100) else args.repeats):
                     path.unlink(missing_ok=True)
                     t = time.perf_counter()
-                    write_poses(poses, path, rotations=rotations)
+                    write_poses(data, path, tolerance=tol, rigs=rg)
                     times.append(time.perf_counter() - t)
-                data = path.read_bytes()
-                row["formats"][name] = {"bytes": len(data), "write_s": statistics.median(times),
-                                        "gzip_bytes": len(gzip.compress(data, 6))}
+                raw = path.read_bytes()
+                row["formats"][name] = {"bytes": len(raw), "write_s": statistics.median(times), "writes": len(times),
+                                        "gzip_bytes": len(gzip.compress(raw, 6))}
+                print(label, name, len(raw), statistics.median(times), flush=True)
             rows.append(row)
     write_json(args.out, {"runs": rows, "repeats": args.repeats, "machine": machine_info(),
                           "provenance": provenance(repeats=args.repeats)})
-    print("| run | format | size | gzip | vs 32-bit glb | write (median) |")
+    print("| run | file | size | gzip | vs frames | write (median) |")
     print("|---|---|---|---|---|---|")
     for row in rows:
-        base = row["formats"]["glb (32-bit keys)"]["bytes"]
-        print(f"| {row['run']} ({row['frames']:,} frames x {row['bodies']} bodies; simulated in "
-              f"{row['simulate_s']:.1f} s) | raw keys | {row['raw_keys_bytes'] / 1e6:.2f} MB | | | |")
+        base = row["formats"]["frames, every frame a key"]["bytes"]
+        print(f"| {row['run']} ({row['frames']:,} frames, {row['samples']:,} samples x {row['bodies']} bodies; "
+              f"simulated in {row['simulate_s']:.1f} s, rigs built in {row['build_rigs_s']:.1f} s) | | | | | |")
         for name, f in row["formats"].items():
             print(f"| | {name} | {f['bytes'] / 1e6:.2f} MB | {f['gzip_bytes'] / 1e6:.2f} MB | "
                   f"{f['bytes'] / base:.2f} | {f['write_s']:.2f} s |")

@@ -33,7 +33,7 @@ import pygltflib as g
 from lifelike_mj import __version__
 from lifelike_mj.errors import UserError
 from lifelike_mj.export.cameras import FOV_DEG, framing
-from lifelike_mj.export.keys import DEFAULT_TOLERANCE, Track, key_counts, tolerance_of
+from lifelike_mj.export.keys import DEFAULT_TOLERANCE, Track, body_tracks, key_counts, tolerance_of
 from lifelike_mj.export.poses import Poses, drawn_geoms, geom_looks, geom_rgba
 from lifelike_mj.export.rig import Look, Mesh, Rig
 from lifelike_mj.export.shapes import geom_shape, shape_key
@@ -102,7 +102,10 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
     if rotations not in ("short", "float"):
         raise UserError(f"rotations are stored as 'short' or 'float', got {rotations!r}.")
     tolerance = tolerance_of(tolerance)
-    tracks = poses.tracks(tolerance, rotations)
+    rigged = {bone.body for r in rigs or [] for bone in r.bones if bone.body is not None}
+    plain = [b for b, n in enumerate(poses.body_names) if n not in rigged]  # bodies written with their geoms
+    tracks = dict(zip(plain, body_tracks(poses.t_s, poses.position_m[:, plain], poses.quat_wxyz[:, plain], tolerance,
+                                         rotations))) if plain else {}
     m = poses.model
     prov = provenance(**(parameters or {}))
     span = float(poses.t_s[-1] - poses.t_s[0])
@@ -110,7 +113,7 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
                       "end_s": float(poses.t_s[-1]), "bodies": len(poses.body_ids), "rotations": rotations}
     prov["keys"] = {"tolerance_m": tolerance[0], "tolerance_deg": tolerance[1], "samples": poses.n_samples,
                     "samples_per_s": (poses.n_samples - 1) / span if span > 0 else 0.0,
-                    "per_body": key_counts(tracks, poses.body_names)}
+                    "per_body": key_counts([tracks[b] for b in plain], [poses.body_names[b] for b in plain])}
     gl = g.GLTF2(asset=g.Asset(version="2.0", generator=f"lifelike-mj {__version__}", extras=strict(prov)))
     gl.scenes = [g.Scene(name=name, nodes=[0])]
     gl.scene = 0
@@ -170,7 +173,6 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
         anim.channels.append(g.AnimationChannel(sampler=len(anim.samplers) - 1,
                                                 target=g.AnimationChannelTarget(node=node, path=path)))
 
-    rigged = {bone.body for r in rigs or [] for bone in r.bones if bone.body is not None}
     for b, (body, bname) in enumerate(zip(poses.body_ids, poses.body_names)):
         if bname in rigged:
             continue
@@ -192,7 +194,7 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
     if rigs:
         prov["rigs"] = _add_rigs(gl, root, buf, channel, poses, rigs, tolerance, rotations)
         gl.asset.extras = strict(prov)
-    _add_cameras(gl, root, poses, tracks, channel)
+    _add_cameras(gl, root, poses, tracks, channel, tolerance, rotations)
     gl.animations = [anim] if anim.channels else []
     gl.buffers = [g.Buffer(byteLength=len(buf.data))]
     gl.set_binary_blob(bytes(buf.data))
@@ -292,7 +294,8 @@ def _add_rigs(gl: g.GLTF2, root: g.Node, buf: _Buffer, channel, poses: Poses, ri
     return report
 
 
-def _add_cameras(gl: g.GLTF2, root: g.Node, poses: Poses, tracks: list[Track], channel) -> None:
+def _add_cameras(gl: g.GLTF2, root: g.Node, poses: Poses, tracks: dict[int, Track], channel, tolerance=DEFAULT_TOLERANCE,
+                 rotations: str = "short") -> None:
     """The overview camera and, for one creature, the follow camera (:mod:`lifelike_mj.export.cameras`), as
     nodes under the root (MuJoCo's world); the follow camera keeps its body's translation keys (it moves by
     the same path, shifted)."""
@@ -311,7 +314,9 @@ def _add_cameras(gl: g.GLTF2, root: g.Node, poses: Poses, tracks: list[Track], c
                                perspective=g.Perspective(yfov=yfov, znear=max(f.follow_m / 1000.0, 1e-4))))
     gl.nodes.append(g.Node(name="camera follow", camera=1, rotation=look, translation=[float(v) for v in path[0]]))
     root.children.append(len(gl.nodes) - 1)
-    keys = tracks[f.follow].translation
+    track = tracks.get(f.follow) or body_tracks(poses.t_s, poses.position_m[:, [f.follow]],
+                                                poses.quat_wxyz[:, [f.follow]], tolerance, rotations)[0]
+    keys = track.translation
     if keys is not None:
         channel(len(gl.nodes) - 1, "translation", keys, path[keys].astype(np.float32), g.VEC3)
 

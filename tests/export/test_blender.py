@@ -114,6 +114,30 @@ def test_blender_imports_an_armature_per_creature_whose_bones_follow_the_simulat
                 assert angle < 1e-3, (k, b.name, angle)
 
 
+@needs_blender
+def test_a_mesh_of_ones_own_bound_to_the_bones_follows_the_motion(runs, tmp_path):
+    """The artist's route (docs/animators.md): a new mesh, given a vertex group named as a bone and an Armature
+    modifier, moves with that bone: its centre is where the simulation has the left wing's hinge (1e-4 m)."""
+    from lifelike_mj.butterfly.look import rigs
+
+    _, poses = runs("butterfly3d")
+    path = write_poses(poses, tmp_path / "flight.glb", tolerance=TIGHT, rigs=rigs(poses))
+    samples = poses.frame_samples[[0, poses.n_frames // 2, poses.n_frames - 1]]
+    times = [repr(float(poses.t_s[k] - poses.t_s[0])) for k in samples]
+    out = tmp_path / "bind.json"
+    subprocess.run([BLENDER, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+                    str(Path(__file__).with_name("blender_bind.py")), "--", str(path), str(out), "butterfly rig",
+                    "wing_left", repr(poses.fps), *times], check=True, capture_output=True, timeout=300)
+    got = json.loads(out.read_text())
+    b = poses.body_names.index("wing_left")
+    moved = 0.0
+    for k, t in zip(samples, times):
+        np.testing.assert_allclose(got["cube"][t], poses.position_m[k, b], atol=1e-4)
+        np.testing.assert_allclose(got["cube"][t], got["head"][t], atol=1e-5)
+        moved = max(moved, float(np.linalg.norm(np.array(got["cube"][t]) - got["cube"][times[0]])))
+    assert moved > 0.05  # the flight carried it along
+
+
 SCRIPT = Path(__file__).resolve().parents[2] / "examples" / "blender" / "import_motion.py"
 
 
