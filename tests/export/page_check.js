@@ -61,7 +61,17 @@ const path = require("path");
         pages.push(other);
       }
       await Promise.all(pages.map((p, i) => p.goto(i === 0 ? target : empty)));
-      await page.waitForTimeout(20000); // the WASM client downloads and compiles first
+      // the WASM client downloads and compiles first: wait until the picture changes from one second to the next
+      // (the scene drawn and running), at most 30 s
+      const blank = await page.screenshot();
+      let last = blank;
+      for (let waited = 0; waited < 30000; waited += 1000) {
+        await page.waitForTimeout(1000);
+        const now = await page.screenshot();
+        if (!now.equals(blank) && !now.equals(last) && waited >= 3000) break;
+        last = now;
+      }
+      await page.waitForTimeout(1000);
       await shot("live1.png");
       if (empty) {
         const file = path.join(outdir, "empty.png");

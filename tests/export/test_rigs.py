@@ -170,7 +170,7 @@ def test_a_fish_beats_its_tail_at_bainbridges_frequency_in_its_bursts(tmp_path):
             for a, b in zip(edges[::2], edges[1::2]):
                 speed_bl = np.maximum(r.secondary["speed_m_s"][a:b], 0.0) / r.extras["length_m"]
                 f_expect = (4.0 * speed_bl + 4.0) / 3.0  # Bainbridge 1958: U = L (3 f - 4) / 4
-                if (t[b - 1] - t[a]) * f_expect.mean() < 2.0:
+                if (t[b - 1] - t[a]) * f_expect.mean() < 2.0 or b - a < 12:
                     continue  # fewer than two beats: no frequency to read
                 y = yaw[a:b] - np.convolve(yaw[a:b], np.ones(9) / 9, mode="same")  # the turning bend taken off
                 h = 0.2 * np.percentile(np.abs(y), 90)  # hysteresis: a beat is a swing from below -h to above 0
