@@ -43,8 +43,7 @@ def add_export_verb(sub) -> None:
                        help="glTF and web keyframes' rotations: 16-bit (within 6e-5 rad, half the bytes) or 32-bit")
         q.add_argument("--looks", default="rig", choices=("rig", "mjcf"),
                        help="rig: each creature a textured mesh on a skeleton of its MuJoCo bodies and the bones of "
-                            "its secondary motion (glTF and web page; USD is written with mjcf); mjcf: the model's "
-                            "own geoms on each body")
+                            "its secondary motion (glTF skins, UsdSkel); mjcf: the model's own geoms on each body")
         q.add_argument("--loop", action="store_true",
                        help="a clip whose last frame joins its first: a butterfly in level flight is cut at whole "
                             "wing beats (flying in place, its travel per loop recorded as root motion); anything "
@@ -94,7 +93,7 @@ def cmd_export(args) -> None:
     poses, parameters = mod.export_poses(args)
     t_sim = time.perf_counter() - t0
     loop = None
-    looks = "mjcf" if fmt == "usd" else args.looks
+    looks = args.looks
     if args.loop:
         from lifelike_mj.export import loop as looping
 

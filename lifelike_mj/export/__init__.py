@@ -36,7 +36,7 @@ def write_poses(poses, path: str | Path, fmt: str | None = None, name: str = "li
     """Write recorded poses (:class:`~lifelike_mj.export.poses.Poses`) in ``fmt`` (default: from the ending of
     ``path``; :data:`FORMATS`), atomically, with the provenance and ``parameters``; each body keyed within
     ``tolerance`` (m, deg) of every sample (:mod:`lifelike_mj.export.keys`); ``rigs``: the creatures as skinned
-    meshes on skeletons (:mod:`lifelike_mj.export.rig`; glTF and HTML), else the MJCF's geoms. Returns the path."""
+    meshes on skeletons (:mod:`lifelike_mj.export.rig`; glTF skins, UsdSkel), else the MJCF's geoms. Returns the path."""
     fmt = format_of(path, fmt)
     if fmt in ("glb", "gltf"):
         from lifelike_mj.export.gltf import write_gltf
@@ -45,7 +45,7 @@ def write_poses(poses, path: str | Path, fmt: str | None = None, name: str = "li
     if fmt == "usd":
         from lifelike_mj.export.usd import write_usd
 
-        return write_usd(poses, path, name, parameters, tolerance)
+        return write_usd(poses, path, name, parameters, tolerance, rigs)
     from lifelike_mj.export.html import write_html
 
     return write_html(poses, path, name, parameters, rotations, tolerance, rigs)

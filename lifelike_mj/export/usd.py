@@ -32,7 +32,7 @@ import mujoco
 import numpy as np
 
 from lifelike_mj.errors import UserError
-from lifelike_mj.export.keys import DEFAULT_TOLERANCE, key_counts, tolerance_of
+from lifelike_mj.export.keys import DEFAULT_TOLERANCE, body_tracks, key_counts, tolerance_of
 from lifelike_mj.export.poses import Poses, drawn_geoms, geom_looks, geom_rgba
 from lifelike_mj.export.shapes import geom_shape, shape_key
 from lifelike_mj.io import atomic_path, strict
@@ -62,7 +62,7 @@ def _ident(text: str, used: set[str]) -> str:
 
 
 def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | None = None,
-                tolerance=DEFAULT_TOLERANCE):
+                tolerance=DEFAULT_TOLERANCE, rigs: list | None = None):
     """The USD stage (module docstring) of ``poses``, in memory; :func:`write_usd` writes it. Each body's
     translation and orientation have their own time samples: the keys that keep interpolation (linear, and
     slerp, which USD uses for quaternions) within ``tolerance`` (m, deg) of every sample
@@ -73,7 +73,10 @@ def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | 
     span = float(poses.t_s[-1] - poses.t_s[0])
     fps = poses.fps if poses.fps > 0 else 1.0
     tolerance = tolerance_of(tolerance)
-    tracks = poses.tracks(tolerance, "float")
+    rigged = {bone.body for r in rigs or [] for bone in r.bones if bone.body is not None}
+    plain = [b for b, n in enumerate(poses.body_names) if n not in rigged]  # bodies written with their geoms
+    tracks = dict(zip(plain, body_tracks(poses.t_s, poses.position_m[:, plain], poses.quat_wxyz[:, plain], tolerance,
+                                         "float"))) if plain else {}
     stage = Usd.Stage.CreateInMemory()
     UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
     UsdGeom.SetStageMetersPerUnit(stage, 1.0)
@@ -86,7 +89,7 @@ def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | 
                       "bodies": len(poses.body_ids)}
     prov["keys"] = {"tolerance_m": tolerance[0], "tolerance_deg": tolerance[1], "samples": poses.n_samples,
                     "samples_per_s": (poses.n_samples - 1) / span if span > 0 else 0.0,
-                    "per_body": key_counts(tracks, poses.body_names)}
+                    "per_body": key_counts([tracks[b] for b in plain], [poses.body_names[b] for b in plain])}
     stage.GetRootLayer().customLayerData = {"lifelike_mj": json.dumps(strict(prov), allow_nan=False)}
     world = UsdGeom.Xform.Define(stage, "/World")
     stage.SetDefaultPrim(world.GetPrim())
@@ -116,18 +119,32 @@ def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | 
     look, look_names = geom_looks(m)
     look_used: set[str] = set()
 
+    def material(name: str, rgb, opacity: float, roughness: float):
+        mat = UsdShade.Material.Define(stage, f"/Looks/{_ident(name, look_used)}")
+        shader = UsdShade.Shader.Define(stage, mat.GetPath().AppendChild("surface"))
+        shader.CreateIdAttr("UsdPreviewSurface")
+        shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(Gf.Vec3f(*map(float, rgb)))
+        shader.CreateInput("opacity", Sdf.ValueTypeNames.Float).Set(float(opacity))
+        shader.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(float(roughness))
+        mat.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")
+        return mat
+
     def look_of(geom: int):
         colour = tuple(np.round(rgba[geom], 6).tolist())
         if look[geom] not in looks:
-            mat = UsdShade.Material.Define(stage, f"/Looks/{_ident(look_names[look[geom]], look_used)}")
-            shader = UsdShade.Shader.Define(stage, mat.GetPath().AppendChild("surface"))
-            shader.CreateIdAttr("UsdPreviewSurface")
-            shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(Gf.Vec3f(*colour[:3]))
-            shader.CreateInput("opacity", Sdf.ValueTypeNames.Float).Set(float(colour[3]))
-            shader.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(0.8)
-            mat.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")
-            looks[int(look[geom])] = mat
+            looks[int(look[geom])] = material(look_names[look[geom]], colour[:3], colour[3], 0.8)
         return looks[int(look[geom])]
+
+    rig_looks: dict[int, UsdShade.Material] = {}
+
+    def look_of_rig(lk):
+        """A rig's look: its colour times its texture's mean (a USD file holds no image of its own)."""
+        if id(lk) not in rig_looks:
+            rgb = np.asarray(lk.rgba[:3], dtype=float)
+            if lk.image is not None:
+                rgb = rgb * lk.image[..., :3].reshape(-1, 3).mean(axis=0) / 255.0
+            rig_looks[id(lk)] = material(lk.name, rgb, lk.rgba[3], lk.roughness)
+        return rig_looks[id(lk)]
 
     def still(parent: Sdf.Path, geom: int, used: set[str]) -> None:
         gname = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, geom) or f"geom{geom}"
@@ -145,7 +162,7 @@ def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | 
     for geom in drawn[m.geom_bodyid[drawn] == 0]:
         still(world.GetPath(), int(geom), used)
     ops = []
-    for body, bname in zip(poses.body_ids, poses.body_names):
+    for body, bname in zip(poses.body_ids[plain], [poses.body_names[b] for b in plain]):
         xf = UsdGeom.Xform.Define(stage, world.GetPath().AppendChild(_ident(bname, used)))
         xf.GetPrim().SetCustomDataByKey("mujoco_body", bname)
         # and as a user property, which Blender's USD importer turns into the object's custom property
@@ -158,7 +175,7 @@ def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | 
     quat = poses.quat_wxyz.astype(np.float32).astype(float)
     codes = (poses.t_s - poses.t_s[0]) * fps  # each sample's time code: frame k at code k
     with Sdf.ChangeBlock():  # the prims exist: only values change from here
-        for b, (translate, orient) in enumerate(ops):
+        for b, (translate, orient) in zip(plain, ops):
             track = tracks[b]
             for op, keys, values, kind in ((translate, track.translation, pos[:, b], Gf.Vec3f),
                                            (orient, track.rotation, quat[:, b], Gf.Quatf)):
@@ -167,17 +184,102 @@ def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | 
                     continue
                 for k in keys:
                     op.Set(kind(*values[k]), Usd.TimeCode(float(codes[k])))
+    if rigs:  # prims are defined: outside the change block
+        prov["rigs"] = _add_rigs(stage, world.GetPath(), rigs, poses.t_s, fps, tolerance, used, look_of_rig)
+        stage.GetRootLayer().customLayerData = {"lifelike_mj": json.dumps(strict(prov), allow_nan=False)}
     return stage
 
 
+def _add_rigs(stage, world_path, rigs, t, fps, tolerance, used, looks_of):
+    """Each rig as a UsdSkel SkelRoot under ``world_path`` (module docstring): a Skeleton whose joints are the
+    rig's bones (their MJCF names in ``jointNames``), its SkelAnimation (joint-local translations and rotations
+    sampled at every key time of any of its bones, between frames where they fall; each bone's value there is its
+    keys' interpolation, so within the tolerance), and the skinned mesh (``skel:jointIndices``/``jointWeights``,
+    ``primvars:st``) with one material per look. Returns each rig's keys per bone."""
+    from pxr import Gf, Sdf, UsdGeom, UsdShade, UsdSkel, Vt
+
+    from lifelike_mj.export.rig import lerp_at, slerp_at
+
+    report = {}
+    for rig in rigs:
+        rig.check()
+        keys = rig.keys(t, tolerance, "float")
+        root = UsdSkel.Root.Define(stage, Sdf.Path(world_path).AppendChild(_ident(f"{rig.name} rig", used)))
+        root.GetPrim().SetCustomDataByKey("lifelike_mj_rig", rig.name)
+        skel = UsdSkel.Skeleton.Define(stage, root.GetPath().AppendChild("Skeleton"))
+        paths, inner = [], {}
+        for b in rig.bones:
+            seen = inner.setdefault(b.parent, set())
+            own = _ident(b.name.rsplit("/", 1)[-1], seen)
+            paths.append(own if b.parent < 0 else f"{paths[b.parent]}/{own}")
+        skel.CreateJointsAttr(Vt.TokenArray(paths))
+        skel.CreateJointNamesAttr(Vt.TokenArray([b.name for b in rig.bones]))
+
+        def m4(M):
+            return Gf.Matrix4d(*np.asarray(M, dtype=float).T.reshape(-1).tolist())  # USD: row vectors
+
+        skel.CreateBindTransformsAttr(Vt.Matrix4dArray([m4(b.bind) for b in rig.bones]))
+        rest = [b.bind if b.parent < 0 else np.linalg.inv(rig.bones[b.parent].bind) @ b.bind for b in rig.bones]
+        skel.CreateRestTransformsAttr(Vt.Matrix4dArray([m4(M) for M in rest]))
+        anim = UsdSkel.Animation.Define(stage, skel.GetPath().AppendChild("Animation"))
+        anim.CreateJointsAttr(Vt.TokenArray(paths))
+        codes = (t - t[0]) * fps
+        tk = sorted({int(i) for k in keys if k.translation is not None for i in k.translation} | {0, len(t) - 1})
+        rk = sorted({int(i) for k in keys if k.rotation is not None for i in k.rotation} | {0, len(t) - 1})
+        trans = np.stack([np.repeat(k.still_translation[None], len(t), 0) if k.translation is None
+                          else lerp_at(t, k.translation, k.translation_values) for k in keys], axis=1)
+        rots = np.stack([np.repeat(k.still_rotation[None], len(t), 0) if k.rotation is None
+                         else slerp_at(t, k.rotation, k.rotation_values) for k in keys], axis=1)
+        ta, ra = anim.CreateTranslationsAttr(), anim.CreateRotationsAttr()
+        for i in tk:
+            ta.Set(Vt.Vec3fArray.FromNumpy(trans[i].astype(np.float32)), float(codes[i]))
+        for i in rk:
+            ra.Set(Vt.QuatfArray([Gf.Quatf(*map(float, q)) for q in rots[i]]), float(codes[i]))
+        anim.CreateScalesAttr().Set(Vt.Vec3hArray([Gf.Vec3h(1.0, 1.0, 1.0)] * len(paths)))
+        UsdSkel.BindingAPI.Apply(skel.GetPrim()).CreateAnimationSourceRel().SetTargets([anim.GetPath()])
+        mesh = rig.mesh
+        geom = UsdGeom.Mesh.Define(stage, root.GetPath().AppendChild("Mesh"))
+        tris = np.concatenate([tr for _, tr in mesh.parts])
+        geom.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(mesh.positions.astype(np.float32)))
+        geom.CreateNormalsAttr(Vt.Vec3fArray.FromNumpy(mesh.normals.astype(np.float32)))
+        geom.SetNormalsInterpolation(UsdGeom.Tokens.vertex)
+        geom.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(len(tris), 3, dtype=np.int32)))
+        geom.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(tris.reshape(-1).astype(np.int32)))
+        geom.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+        geom.CreateDoubleSidedAttr(True)
+        lo, hi = mesh.positions.min(axis=0), mesh.positions.max(axis=0)
+        geom.CreateExtentAttr(Vt.Vec3fArray([Gf.Vec3f(*map(float, lo)), Gf.Vec3f(*map(float, hi))]))
+        st = UsdGeom.PrimvarsAPI(geom).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.vertex)
+        st.Set(Vt.Vec2fArray.FromNumpy(np.column_stack([mesh.uv[:, 0], 1.0 - mesh.uv[:, 1]]).astype(np.float32)))
+        binding = UsdSkel.BindingAPI.Apply(geom.GetPrim())
+        binding.CreateSkeletonRel().SetTargets([skel.GetPath()])
+        binding.CreateJointIndicesPrimvar(False, 4).Set(Vt.IntArray.FromNumpy(mesh.joints.reshape(-1).astype(np.int32)))
+        binding.CreateJointWeightsPrimvar(False, 4).Set(Vt.FloatArray.FromNumpy(mesh.weights.reshape(-1).astype(np.float32)))
+        binding.CreateGeomBindTransformAttr(Gf.Matrix4d(1.0))
+        start = 0
+        if len(mesh.parts) == 1:
+            UsdShade.MaterialBindingAPI.Apply(geom.GetPrim()).Bind(looks_of(mesh.parts[0][0]))
+        else:
+            for n, (look, tr) in enumerate(mesh.parts):
+                subset = UsdGeom.Subset.CreateGeomSubset(geom, _ident(look.name, set()) + f"_{n}", UsdGeom.Tokens.face,
+                                                         Vt.IntArray(list(range(start, start + len(tr)))),
+                                                         UsdShade.Tokens.materialBind)
+                UsdShade.MaterialBindingAPI.Apply(subset.GetPrim()).Bind(looks_of(look))
+                start += len(tr)
+            UsdShade.MaterialBindingAPI.Apply(geom.GetPrim())
+            UsdGeom.Subset.SetFamilyType(geom, UsdShade.Tokens.materialBind, UsdGeom.Tokens.partition)
+        report[rig.name] = rig.key_counts(t, tolerance, "float")
+    return report
+
+
 def write_usd(poses: Poses, path: str | Path, name: str = "lifelike-mj run", parameters: dict | None = None,
-              tolerance=DEFAULT_TOLERANCE) -> Path:
+              tolerance=DEFAULT_TOLERANCE, rigs: list | None = None) -> Path:
     """Write ``poses`` as an animated USD stage (module docstring): ``.usda`` as text, ``.usdc`` or ``.usd``
     binary (crate), atomically, with the provenance. Returns the path."""
     path = Path(path)
     if path.suffix.lower() not in (".usda", ".usdc", ".usd"):
         raise UserError(f"a USD file ends in .usda, .usdc or .usd, got {path.name!r}.")
-    stage = build_stage(poses, name, parameters, tolerance)
+    stage = build_stage(poses, name, parameters, tolerance, rigs)
     with atomic_path(path) as tmp:  # the temporary file has the same ending, from which USD picks the format
         if not stage.GetRootLayer().Export(str(tmp)):
             raise UserError(f"USD could not write {path}.")

@@ -106,3 +106,39 @@ def test_usd_cores_validators_find_nothing_in_any_creatures_stage(runs, creature
     bare = Usd.Stage.CreateInMemory()  # the validators do speak: a stage without its metadata is refused
     UsdGeom.Xform.Define(bare, "/World")
     assert _usd_validation(bare)
+
+
+def test_a_rigged_stage_is_a_usdskel_whose_joints_follow_every_sample(runs, creature):
+    """Rigs as UsdSkel: a SkelRoot per creature, its Skeleton's joints named as the bones (MJCF names in
+    ``jointNames``), the skinned mesh bound to it; usd-core's validators find nothing, and usd-core's own skeleton
+    evaluation puts every joint of the first creature within the key tolerance of its bone at every sample."""
+    import importlib
+
+    from pxr import UsdSkel
+
+    _, poses = runs(creature)
+    looks = {"butterfly3d": "butterfly", "butterfly2d": "butterfly", "fish": "fish", "boids": "boids"}[creature]
+    rigs = importlib.import_module(f"lifelike_mj.{looks}.look").rigs(poses)[:20]  # a flock: 20 birds are plenty
+    stage = build_stage_rigged(poses, rigs)
+    assert _usd_validation(stage) == []
+    roots = [p for p in stage.Traverse() if p.GetTypeName() == "SkelRoot"]
+    assert sorted(r.GetCustomDataByKey("lifelike_mj_rig") for r in roots) == sorted(r.name for r in rigs)
+    rig = rigs[0]
+    root = next(r for r in roots if r.GetCustomDataByKey("lifelike_mj_rig") == rig.name)
+    skel = UsdSkel.Skeleton(root.GetChild("Skeleton"))
+    assert list(skel.GetJointNamesAttr().Get()) == [b.name for b in rig.bones]
+    binding = UsdSkel.BindingAPI(root.GetChild("Mesh"))
+    assert binding.GetSkeletonRel().GetTargets() == [skel.GetPath()]
+    query = UsdSkel.Cache().GetSkelQuery(skel)
+    for k in range(0, poses.n_samples, max(1, poses.n_samples // 200)):
+        xf = query.ComputeJointSkelTransforms(Usd.TimeCode(float((poses.t_s[k] - poses.t_s[0]) * poses.fps)))
+        for j, b in enumerate(rig.bones):
+            M = np.array(xf[j]).T  # USD: row vectors
+            assert np.linalg.norm(M[:3, 3] - b.position_m[k]) <= 0.0005, (k, b.name)
+            assert _rotation_error(M[:3, :3], b.quat_wxyz[k]) <= np.radians(0.5), (k, b.name)
+
+
+def build_stage_rigged(poses, rigs):
+    from lifelike_mj.export.usd import build_stage
+
+    return build_stage(poses, rigs=rigs)
