@@ -36,7 +36,7 @@ from lifelike_mj.export.cameras import FOV_DEG, framing
 from lifelike_mj.export.keys import DEFAULT_TOLERANCE, Track, body_tracks, key_counts, tolerance_of
 from lifelike_mj.export.poses import Poses, drawn_geoms, geom_looks, geom_rgba
 from lifelike_mj.export.rig import Look, Mesh, Rig
-from lifelike_mj.export.shapes import geom_shape, shape_key
+from lifelike_mj.export.shapes import geom_shape, geom_texture, geom_uv, shape_key
 from lifelike_mj.io import atomic_path, strict
 from lifelike_mj.provenance import provenance
 
@@ -130,11 +130,15 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
         colour = tuple(np.round(rgba[geom], 6).tolist())
         full = (key, int(look[geom]))
         if full not in meshes:
+            image = geom_texture(m, geom)
             if look[geom] not in materials:
                 mat = g.Material(name=look_names[look[geom]], doubleSided=True,
                                  pbrMetallicRoughness=g.PbrMetallicRoughness(
                                      baseColorFactor=[float(c) for c in colour], metallicFactor=0.0,
                                      roughnessFactor=0.8))
+                if image is not None:  # the model's own texture (a ground's checker), repeated
+                    mat.pbrMetallicRoughness.baseColorTexture = g.TextureInfo(index=_texture(
+                        gl, buf, image, look_names[look[geom]], repeat=True))
                 if colour[3] < 1.0:
                     mat.alphaMode = g.BLEND
                 gl.materials.append(mat)
@@ -142,9 +146,12 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
             pos, nrm, tri = geom_shape(m, geom)
             a_pos = buf.add(pos.astype(np.float32), g.VEC3, g.ARRAY_BUFFER, minmax=True)
             a_nrm = buf.add(nrm.astype(np.float32), g.VEC3, g.ARRAY_BUFFER)
+            a_uv = buf.add(geom_uv(m, geom, pos).astype(np.float32), g.VEC2, g.ARRAY_BUFFER) if image is not None \
+                else None
             idx = tri.reshape(-1).astype(np.uint16 if len(pos) < 65536 else np.uint32)
             a_idx = buf.add(idx, g.SCALAR, g.ELEMENT_ARRAY_BUFFER)
-            gl.meshes.append(g.Mesh(primitives=[g.Primitive(attributes=g.Attributes(POSITION=a_pos, NORMAL=a_nrm),
+            gl.meshes.append(g.Mesh(primitives=[g.Primitive(attributes=g.Attributes(POSITION=a_pos, NORMAL=a_nrm,
+                                                                                    TEXCOORD_0=a_uv),
                                                             indices=a_idx, material=materials[int(look[geom])])]))
             meshes[full] = len(gl.meshes) - 1
         return meshes[full]
@@ -211,6 +218,23 @@ def _png(image: np.ndarray) -> bytes:
     return out.getvalue()
 
 
+def _texture(gl: g.GLTF2, buf: _Buffer, image: np.ndarray, name: str, repeat: bool = False) -> int:
+    """An embedded PNG texture of ``image``: its index (a clamped or a repeating sampler)."""
+    png = _png(image)
+    while len(buf.data) % 4:
+        buf.data.append(0)
+    gl.bufferViews.append(g.BufferView(buffer=0, byteOffset=len(buf.data), byteLength=len(png)))
+    buf.data += png
+    gl.images.append(g.Image(name=name, mimeType="image/png", bufferView=len(gl.bufferViews) - 1))
+    wrap = g.REPEAT if repeat else g.CLAMP_TO_EDGE
+    sampler = next((i for i, sm in enumerate(gl.samplers) if sm.wrapS == wrap), None)
+    if sampler is None:
+        gl.samplers.append(g.Sampler(magFilter=g.LINEAR, minFilter=g.LINEAR_MIPMAP_LINEAR, wrapS=wrap, wrapT=wrap))
+        sampler = len(gl.samplers) - 1
+    gl.textures.append(g.Texture(sampler=sampler, source=len(gl.images) - 1, name=name))
+    return len(gl.textures) - 1
+
+
 def _add_rigs(gl: g.GLTF2, root: g.Node, buf: _Buffer, channel, poses: Poses, rigs: list[Rig], tolerance,
               rotations: str) -> dict:
     """Each rig as an armature node under ``root`` with its bones, a skin and a skinned mesh node at the scene's
@@ -228,17 +252,7 @@ def _add_rigs(gl: g.GLTF2, root: g.Node, buf: _Buffer, channel, poses: Poses, ri
             pbr = g.PbrMetallicRoughness(baseColorFactor=[float(c) for c in look.rgba], metallicFactor=0.0,
                                          roughnessFactor=float(look.roughness))
             if look.image is not None:
-                png = _png(look.image)
-                while len(buf.data) % 4:
-                    buf.data.append(0)
-                gl.bufferViews.append(g.BufferView(buffer=0, byteOffset=len(buf.data), byteLength=len(png)))
-                buf.data += png
-                gl.images.append(g.Image(name=look.name, mimeType="image/png", bufferView=len(gl.bufferViews) - 1))
-                if not gl.samplers:
-                    gl.samplers.append(g.Sampler(magFilter=g.LINEAR, minFilter=g.LINEAR_MIPMAP_LINEAR,
-                                                 wrapS=g.CLAMP_TO_EDGE, wrapT=g.CLAMP_TO_EDGE))
-                gl.textures.append(g.Texture(sampler=0, source=len(gl.images) - 1, name=look.name))
-                pbr.baseColorTexture = g.TextureInfo(index=len(gl.textures) - 1)
+                pbr.baseColorTexture = g.TextureInfo(index=_texture(gl, buf, look.image, look.name))
             mat = g.Material(name=look.name, doubleSided=look.double_sided, pbrMetallicRoughness=pbr)
             if look.rgba[3] < 1.0 or (look.image is not None and look.image[..., 3].min() < 255):
                 mat.alphaMode = g.BLEND

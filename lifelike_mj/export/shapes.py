@@ -138,3 +138,40 @@ def shape_key(model: mujoco.MjModel, geom: int) -> tuple:
         return (t, int(model.geom_dataid[geom]))
     return (t, *np.round(model.geom_size[geom], 12).tolist())
 
+
+
+# ---- textures -----------------------------------------------------------------------------------
+
+def geom_texture(model: mujoco.MjModel, geom: int) -> np.ndarray | None:
+    """The 2D texture image (``(H, W, 4)`` uint8 RGBA) of a geom's material, or None (no material, no 2D RGB
+    texture: a skybox or cube texture is not a surface's)."""
+    mat = int(model.geom_matid[geom])
+    if mat < 0:
+        return None
+    tex = int(model.mat_texid[mat, int(mujoco.mjtTextureRole.mjTEXROLE_RGB)])
+    if tex < 0 or int(model.tex_type[tex]) != int(mujoco.mjtTexture.mjTEXTURE_2D):
+        return None
+    h, w, c = int(model.tex_height[tex]), int(model.tex_width[tex]), int(model.tex_nchannel[tex])
+    data = np.asarray(model.tex_data[model.tex_adr[tex]: model.tex_adr[tex] + h * w * c], dtype=np.uint8)
+    img = data.reshape(h, w, c)
+    if c == 3:
+        img = np.concatenate([img, np.full((h, w, 1), 255, dtype=np.uint8)], axis=-1)
+    elif c == 1:
+        img = np.concatenate([np.repeat(img, 3, axis=-1), np.full((h, w, 1), 255, dtype=np.uint8)], axis=-1)
+    return img
+
+
+def geom_uv(model: mujoco.MjModel, geom: int, pos: np.ndarray) -> np.ndarray:
+    """Texture coordinates of a geom's vertices ``pos`` (in its own frame), laid flat in its x-y plane as MuJoCo
+    repeats a material's texture: ``texrepeat`` times per metre with ``texuniform``, else per the geom's size (an
+    infinite plane: per its grid spacing, the third size)."""
+    mat = int(model.geom_matid[geom])
+    rep = model.mat_texrepeat[mat] if mat >= 0 else np.ones(2)
+    size = model.geom_size[geom]
+    if mat >= 0 and model.mat_texuniform[mat]:
+        unit = np.ones(2)
+    elif int(model.geom_type[geom]) == int(mujoco.mjtGeom.mjGEOM_PLANE) and (size[0] <= 0 or size[1] <= 0):
+        unit = np.full(2, size[2] if size[2] > 0 else 1.0)
+    else:
+        unit = 2.0 * np.maximum(size[:2], 1e-9)
+    return np.column_stack([pos[:, 0] / unit[0] * rep[0], pos[:, 1] / unit[1] * rep[1]])

@@ -182,6 +182,10 @@ def test_every_creature_exports_with_one_mesh_per_shape_and_the_validators_bless
              "fish": {"fish_blue", "fish_fin", "fish_eye", "sand", "glass", "back"}, "boids": {"type0", "floor", "edge"}}
     names = [mat.name for mat in gl.materials]
     assert looks[creature] <= set(names) and len(names) == len(set(names)), names
+    # the model's ground texture (a checker) comes along as an image, repeated over the ground's coordinates
+    ground = gl.materials[names.index({"fish": "sand", "boids": "floor"}.get(creature, "grid"))]
+    tex = gl.textures[ground.pbrMetallicRoughness.baseColorTexture.index]
+    assert gl.images[tex.source].mimeType == "image/png" and gl.samplers[tex.sampler].wrapS == pygltflib.REPEAT
     # every sample of the simulation (every step: 1,200/s for the butterflies, 60/s for the fish, each step of
     # the flock): each body within the default tolerance, 0.5 mm and 0.5 deg, and no two neighbouring rotation
     # keys more than 20 deg apart (the wings' included) where the samples are closer than that (a flock's

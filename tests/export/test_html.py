@@ -32,6 +32,7 @@ def without_creature(page: Path, out: Path) -> Path:
     return out
 
 
+@pytest.mark.parametrize("creature", ["butterfly3d", "fish", "boids"])  # the planar butterfly wears the 3D one's rig
 def test_the_page_plays_each_rigged_creature_offline(runs, creature, tmp_path, chromium):
     """The page as ``lifelike-mj export`` writes it by default: the creatures rigged, skinned and textured."""
     import importlib
