@@ -15,6 +15,7 @@ import time
 import numpy as np
 
 from lifelike_mj.cli.common import Parser, add_json, add_overwrite, count, emit, num
+from lifelike_mj.errors import UserError
 
 #: The creatures that export, in the order of the help.
 EXPORTERS = ("butterfly", "butterfly3d", "fish", "boids")
@@ -88,6 +89,13 @@ def cmd_export(args) -> None:
     mod = _module(args.what)
     cut = args.loop and getattr(mod, "loop_cut_body", lambda a: None)(args)
     if args.loop:  # a lead-in recorded before the clip: the blend's, or the secondary motion's history for a cut
+        clip_s = (args.steps / (args.fps * args.steps_per_frame) if hasattr(args, "steps_per_frame")
+                  else args.duration)
+        need = 0.5 if cut else args.loop_blend
+        if clip_s <= need:
+            raise UserError(f"a looped clip of {clip_s:g} s is too short to " + (
+                "hold whole wing beats; give at least 0.5 s." if cut else
+                f"blend {args.loop_blend:g} s of its end into its start; give a longer clip or a shorter --loop-blend."))
         _lengthen(args, args.loop_blend)
     t0 = time.perf_counter()
     poses, parameters = mod.export_poses(args)

@@ -105,6 +105,12 @@ CASES = [
      "asks for 2,000,002,000 agent-steps; at most 2,000,000,000", {}),
     (["export", "fish", "--out", LONG + ".glb"], "this file system allows 255", {}),
     (["export", "fish", "--out", f"x/{LONG}/a.glb"], "this file system allows 255", {}),
+    # --- export's keys and loops
+    (["export", "fish", "--out", "a.glb", "--duration", "0.5", "--loop"], "too short to blend 1 s", {}),
+    (["export", "butterfly3d", "--out", "a.glb", "--task", "level", "--duration", "0.3", "--loop"],
+     "too short to hold whole wing beats", {}),
+    (["export", "fish", "--out", "a.glb", "--key-tolerance", "abc"], "a distance and an angle", {}),
+    (["export", "fish", "--out", "a.glb", "--key-tolerance", "1mm,90deg"], "angle must be a number in [0.01, 45]", {}),
     (["butterfly", "fly3d", "--out", LONG], "this file system allows 255", {}),
     # --- the viewers' options
     (["view", "butterfly3d", "--web", "--host", "10.255.255.1"], "is not an address of this machine", {}),
