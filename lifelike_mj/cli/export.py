@@ -51,8 +51,7 @@ def add_export_verb(sub) -> None:
                             "else is recorded --loop-blend longer and its end blended into its start")
         q.add_argument("--loop-blend", type=num(0.05, 60.0, unit="s"), default=1.0, metavar="S",
                        help="seconds of playback over which a looped clip's end fades into its start, recorded "
-                            "before the clip (for a cut, the lead-in that the secondary motion starts from; "
-                            "default 1)")
+                            "before the clip (for a cut, the lead-in that the secondary motion starts from)")
         q.add_argument("--key-tolerance", default="0.5mm,0.5deg", metavar="DIST,ANGLE",
                        help="how far the interpolated keys may stray from the simulation, sampled at every step: a "
                             "distance (um, mm, cm, m) and an angle (deg, rad)")
