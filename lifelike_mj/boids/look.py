@@ -28,7 +28,7 @@ import math
 import numpy as np
 
 from lifelike_mj.export.meshes import Piece, assemble, loft, rigid, sheet, sphere
-from lifelike_mj.export.rig import Bone, Look, Rig, body_bone, continuous, creatures, extra_bone, qaxis, qmul
+from lifelike_mj.export.rig import Bone, Look, Rig, body_bone, continuous, creatures, extra_bone, qaxis, qmul, smooth
 
 #: The path is smoothed over this many steps (a Gaussian's sigma) for the flight bone.
 SMOOTH_STEPS = 10.0
@@ -39,22 +39,11 @@ GLIDE_BELOW = 0.25
 G = 9.81
 
 
-def _gauss(x: np.ndarray, sigma: float) -> np.ndarray:
-    """``x`` (rows of samples) smoothed by a Gaussian of ``sigma`` samples, its ends held."""
-    if sigma <= 0 or len(x) < 3:
-        return np.array(x, dtype=float)
-    r = int(math.ceil(3 * sigma))
-    k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
-    k /= k.sum()
-    pad = np.concatenate([np.repeat(x[:1], r, 0), x, np.repeat(x[-1:], r, 0)])
-    return np.stack([np.convolve(pad[:, j], k, mode="valid") for j in range(x.shape[1])], axis=1)
-
-
 def flight_frame(t: np.ndarray, pos: np.ndarray, sigma: float = SMOOTH_STEPS):
     """The flight bone's world pose at every sample (module docstring) and what it came from: ``(position,
     quat_wxyz, series)`` with ``series`` holding speed (m/s), yaw rate (rad/s), bank (rad), climb (m/s) and
     acceleration (m/s^2) along the path."""
-    p = _gauss(pos, sigma)
+    p = smooth(pos, sigma)
     n = len(t)
     v = np.gradient(p, t, axis=0) if n > 2 else np.tile(np.array([1e-9, 0.0, 0.0]), (n, 1))
     speed = np.linalg.norm(v, axis=1)
@@ -77,7 +66,7 @@ def effort(series: dict) -> np.ndarray:
     (per unit of speed) and acceleration (per g), less when slowing or sinking."""
     v = np.maximum(series["speed_m_s"], 1e-9)
     e = 0.5 + 1.5 * series["climb_m_s"] / v + 2.0 * series["accel_m_s2"] / G
-    return np.clip(_gauss(e[:, None], 4.0)[:, 0], 0.0, 1.0)
+    return np.clip(smooth(e[:, None], 4.0)[:, 0], 0.0, 1.0)
 
 
 def _plumage(px: int = 128) -> np.ndarray:
@@ -141,7 +130,7 @@ def bird_rig(poses, i: int, length: float, looks: dict, meshes: dict, sigma: flo
     phase = 2 * np.pi * np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(t))]) if len(t) > 1 \
         else np.zeros(len(t))
     amp = np.radians(FLAP_DEG + (FLAP_DEG_MAX - FLAP_DEG) * e) * np.where(glide, 0.0, 1.0)
-    amp = _gauss(amp[:, None], 3.0)[:, 0]  # into and out of a glide smoothly
+    amp = smooth(amp[:, None], 3.0)[:, 0]  # into and out of a glide smoothly
     stroke = amp * np.sin(phase) + math.radians(8.0)  # a little dihedral
     fold = np.radians(25.0) * np.clip(np.cos(phase), 0.0, None) * (amp > 0.05)  # the outer wing folds going up
     wings = {}

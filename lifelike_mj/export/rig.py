@@ -310,6 +310,21 @@ def extra_bone(name: str, parent: int, bones: list[Bone], offset_m, turn_wxyz: n
     return Bone(name, parent, p.bind @ matrix(np.asarray(offset_m, dtype=float), rest), pos, continuous(quat))
 
 
+def smooth(x: np.ndarray, sigma: float) -> np.ndarray:
+    """``x`` (samples along its first axis: ``(n,)`` or ``(n, k)``) smoothed by a Gaussian of ``sigma`` samples,
+    its ends held; returned as it is where ``sigma`` is under half a sample or there are fewer than 3 samples."""
+    x = np.asarray(x, dtype=float)
+    if sigma < 0.5 or len(x) < 3:
+        return x.copy()
+    r = int(math.ceil(3 * sigma))
+    k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
+    k /= k.sum()
+    cols = x.reshape(len(x), -1)
+    pad = np.concatenate([np.repeat(cols[:1], r, 0), cols, np.repeat(cols[-1:], r, 0)])
+    out = np.stack([np.convolve(pad[:, j], k, mode="valid") for j in range(cols.shape[1])], axis=1)
+    return out.reshape(x.shape)
+
+
 def damped(signal: np.ndarray, dt: float, hz: float, zeta: float) -> np.ndarray:
     """The response of a damped oscillator (natural frequency ``hz``, damping ratio ``zeta``, unit static gain)
     to ``signal`` ``(n, k)`` sampled every ``dt`` s, from rest at the first sample's value: a lagging follower

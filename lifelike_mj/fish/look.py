@@ -28,7 +28,7 @@ import math
 import numpy as np
 
 from lifelike_mj.export.meshes import Piece, assemble, blend, loft, rigid, sheet, sphere
-from lifelike_mj.export.rig import Bone, Look, Rig, body_bone, creatures, extra_bone, qaxis, qconj, qmul, qrot
+from lifelike_mj.export.rig import Bone, Look, Rig, body_bone, creatures, extra_bone, qaxis, qconj, qmul, qrot, smooth
 
 #: Tail amplitude (one side) as a fraction of the body length, and the body wave's length (body lengths).
 TAIL_AMPLITUDE_L, WAVELENGTH_L = 0.1, 0.9
@@ -67,15 +67,6 @@ def kinematics(t: np.ndarray, pos: np.ndarray, quat: np.ndarray):
     return speed, accel, omega_body[:, 2]
 
 
-def _smooth(x: np.ndarray, sigma: float) -> np.ndarray:
-    """``x`` smoothed by a Gaussian of ``sigma`` samples, its ends held."""
-    if sigma < 0.5 or len(x) < 3:
-        return np.asarray(x, dtype=float)
-    r = int(math.ceil(3 * sigma))
-    k = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
-    return np.convolve(np.concatenate([np.full(r, x[0]), x, np.full(r, x[-1])]), k / k.sum(), mode="valid")
-
-
 def activity(t: np.ndarray, accel_bl: np.ndarray, yaw_deg_s: np.ndarray, speed_bl: np.ndarray) -> np.ndarray:
     """The body wave's weight (0 to 1): rising within :data:`WAVE_RISE_S` while the fish bursts (speeds up
     faster than :data:`BURST_ACCEL_BL_S2`) or turns sharply (faster than :data:`TURN_DEG_S` while swimming
@@ -104,7 +95,7 @@ def spine_angles(t, speed, yaw_rate, weight, length_m: float):
     # the bend that follows the path's curvature (yaw rate over speed): on a curved path each segment points
     # back along the curve, turned by the curvature times its distance behind the root (the centre of mass)
     dt = float(np.median(np.diff(t))) if len(t) > 1 else 1.0
-    kappa = _smooth(yaw_rate, BEND_SMOOTH_S / dt) / np.maximum(np.abs(_smooth(speed, BEND_SMOOTH_S / dt)), 0.5 * length_m)
+    kappa = smooth(yaw_rate, BEND_SMOOTH_S / dt) / np.maximum(np.abs(smooth(speed, BEND_SMOOTH_S / dt)), 0.5 * length_m)
     mid = 0.5 * (s[1:] + s[:-1])
     bend = -kappa[:, None] * length_m * (mid[None, :] - mid[0])
     cap = math.radians(MAX_BEND_DEG)
