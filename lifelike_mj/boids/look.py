@@ -39,13 +39,13 @@ GLIDE_BELOW = 0.25
 G = 9.81
 
 
-def flight_frame(t: np.ndarray, pos: np.ndarray, sigma: float = SMOOTH_STEPS):
+def flight_frame(t: np.ndarray, pos: np.ndarray, sigma: float = SMOOTH_STEPS, metres_per_unit: float = 1.0):
     """The flight bone's world pose at every sample (module docstring) and what it came from: ``(position,
     quat_wxyz, series)`` with ``series`` holding speed (m/s), yaw rate (rad/s), bank (rad), climb (m/s) and
-    acceleration (m/s^2) along the path."""
+    acceleration (m/s^2) along the path; ``pos`` in units of ``metres_per_unit`` metres (the series in m/s)."""
     p = smooth(pos, sigma)
     n = len(t)
-    v = np.gradient(p, t, axis=0) if n > 2 else np.tile(np.array([1e-9, 0.0, 0.0]), (n, 1))
+    v = metres_per_unit * np.gradient(p, t, axis=0) if n > 2 else np.tile(np.array([1e-9, 0.0, 0.0]), (n, 1))
     speed = np.linalg.norm(v, axis=1)
     horiz = np.linalg.norm(v[:, :2], axis=1)
     yaw = np.unwrap(np.arctan2(v[:, 1], v[:, 0]))
@@ -118,11 +118,13 @@ def bird_mesh(length: float, looks: dict, flight: int, wings: dict, tail: int) -
     return pieces
 
 
-def bird_rig(poses, i: int, length: float, looks: dict, meshes: dict, sigma: float = SMOOTH_STEPS) -> Rig:
-    """The rig of the flock's ``i``-th body (module docstring)."""
+def bird_rig(poses, i: int, length: float, looks: dict, meshes: dict, sigma: float = SMOOTH_STEPS,
+             metres_per_unit: float = 1.0) -> Rig:
+    """The rig of the flock's ``i``-th body (module docstring); ``metres_per_unit``: the flock's unit in metres
+    (its speeds, climbs and accelerations in m/s for the turn relation and the effort)."""
     t = poses.t_s
     body = body_bone(poses, i, -1)
-    p, q, series = flight_frame(t, body.position_m, sigma)
+    p, q, series = flight_frame(t, body.position_m, sigma, metres_per_unit)
     bones: list[Bone] = [body, Bone(f"{body.name}/flight", -1, np.eye(4), p, q)]
     e = effort(series)
     glide = e < GLIDE_BELOW
@@ -150,16 +152,23 @@ def bird_rig(poses, i: int, length: float, looks: dict, meshes: dict, sigma: flo
     return Rig(body.name, bones, meshes["mesh"], {}, {**series, "effort": e, "flap_hz": f, "glide": glide})
 
 
-def rigs(poses, length: float | None = None) -> list[Rig]:
-    """One rig per agent of the flock, all sharing one bird mesh (``length``: the bird's, default the agents'
-    drawn body length)."""
+def agent_length(poses) -> float:
+    """The agents' drawn body length (the flock's units): twice the first agent's geom's half length."""
     m = poses.model
+    g = int(np.nonzero(m.geom_bodyid == poses.body_ids[0])[0][0])
+    return 2.0 * float(m.geom_size[g, 0])
+
+
+def rigs(poses, length: float | None = None, metres_per_unit: float = 1.0) -> list[Rig]:
+    """One rig per agent of the flock, all sharing one bird mesh (``length``: the bird's, default the agents'
+    drawn body length, :func:`agent_length`); ``metres_per_unit``: the flock's unit in metres, 1 unless the flock
+    is scaled to a bird size (a scene), for the turn relation and the effort, which are in m/s."""
     if length is None:
-        g = int(np.nonzero(m.geom_bodyid == poses.body_ids[0])[0][0])
-        length = 2.0 * float(m.geom_size[g, 0])
+        length = agent_length(poses)
     looks = {"plumage": Look("plumage", (1, 1, 1, 1), _plumage(), double_sided=False, roughness=0.5),
              "wing": Look("wing", (1, 1, 1, 1), _plumage(), double_sided=True, roughness=0.6),
              "beak": Look("beak", (0.85, 0.7, 0.2, 1.0), roughness=0.4)}
     meshes: dict = {}
-    return [bird_rig(poses, idx[0], length, looks, meshes) for idx in creatures(poses).values()]
+    return [bird_rig(poses, idx[0], length, looks, meshes, metres_per_unit=metres_per_unit)
+            for idx in creatures(poses).values()]
 

@@ -5,7 +5,7 @@
 ``render``, ``reproduce`` and ``bench`` take the creature as their first word and then only that
 creature's options. Each creature module provides ``add_commands``, ``add_view_args``/``view``,
 ``add_render_args``/``render``, ``add_reproduce_args``/``reproduce``, ``add_bench_args``/``bench`` and
-``add_export_args``/``export_poses`` (:mod:`lifelike_mj.cli.export`; the 3D butterfly exports as ``butterfly3d``);
+``add_export_args``/``export_window`` (:mod:`lifelike_mj.cli.export`; the 3D butterfly exports as ``butterfly3d``);
 the commands call the creatures' library functions, so the command line and Python do the same thing.
 
 Every error a user can cause ends in one sentence on stderr and exit status 2; imports are lazy so

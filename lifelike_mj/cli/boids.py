@@ -257,10 +257,12 @@ def add_export_args(p: argparse.ArgumentParser) -> None:
                    help="playback frames per second (keys fall where the motion needs them, --key-tolerance)")
 
 
-def export_poses(args):
+def export_window(args):
+    """The run to export, built and checked, not yet simulated (:class:`~lifelike_mj.cli.export.Window`), and the
+    parameters that make it."""
     from lifelike_mj import checks
     from lifelike_mj.boids.sim import Flock
-    from lifelike_mj.cli.export import check_window, parameters_of, run_window
+    from lifelike_mj.cli.export import Window, check_window, parameters_of
 
     _check_size(args.n, args.start + args.steps)
     if args.steps < args.steps_per_frame:
@@ -268,12 +270,13 @@ def export_poses(args):
     check_window(args.start, args.steps, 1.0 / args.steps_per_frame, 1.0, unit="steps", bodies=args.n,
                  limit=checks.MAX_AGENT_STEPS, body_unit="agent-steps")
     flock = Flock(_params(args), args.n, args.seed)
-    return (run_window(flock, args.start, args.steps, 1.0 / args.steps_per_frame,
-                       1.0 / (args.steps_per_frame * args.fps), unit="steps"), parameters_of(args))
+    return (Window(flock, args.start, args.steps, 1.0 / args.steps_per_frame,
+                   1.0 / (args.steps_per_frame * args.fps), unit="steps"), parameters_of(args))
 
 
-def export_rigs(poses) -> list:
-    """The run's creatures as rigs (skinned, textured meshes on skeletons), for ``export --looks rig``."""
+def export_rigs(poses, metres_per_unit: float = 1.0) -> list:
+    """The run's creatures as rigs (skinned, textured meshes on skeletons), for ``export --looks rig``;
+    ``metres_per_unit``: the box unit's length where the flock is scaled to a bird size (a scene)."""
     from lifelike_mj.boids.look import rigs
 
-    return rigs(poses)
+    return rigs(poses, metres_per_unit=metres_per_unit)

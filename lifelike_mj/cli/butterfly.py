@@ -422,14 +422,16 @@ def add_export_args(p: argparse.ArgumentParser) -> None:
     add_window(p, MAX_VIDEO_S, 3.0)
 
 
-def export_poses(args):
+def export_window(args):
+    """The run to export, built and checked, not yet simulated (:class:`~lifelike_mj.cli.export.Window`), and the
+    parameters that make it."""
     from lifelike_mj.butterfly import Flight
-    from lifelike_mj.cli.export import check_window, parameters_of, run_window
+    from lifelike_mj.cli.export import Window, check_window, parameters_of
 
     check_window(args.start, args.duration, args.fps, 1.0 / 1200.0)
     flight = Flight(_controller(args), params(args), _condition(args), backend="mujoco", config=args.config,
                     force_mode=args.force_mode)
-    return run_window(flight, args.start, args.duration, args.fps), parameters_of(args)
+    return Window(flight, args.start, args.duration, args.fps), parameters_of(args)
 
 
 def loop_cut_body(args) -> str | None:

@@ -293,10 +293,12 @@ def add_export_args(p: argparse.ArgumentParser) -> None:
     add_window(p, MAX_DURATION_S, 5.0)
 
 
-def export_poses(args):
+def export_window(args):
+    """The run to export, built and checked, not yet simulated (:class:`~lifelike_mj.cli.export.Window`), and the
+    parameters that make it."""
     from lifelike_mj.butterfly.control3d import load_controller
     from lifelike_mj.butterfly.sim3d import DT_S
-    from lifelike_mj.cli.export import check_window, parameters_of, run_window
+    from lifelike_mj.cli.export import Window, check_window, parameters_of
 
     check_window(args.start, args.duration, args.fps, DT_S, bodies=args.garden or 1)
     ctrl = load_controller(args.controller)
@@ -309,7 +311,7 @@ def export_poses(args):
         from lifelike_mj.butterfly.sim3d import Flight3D
 
         sim = Flight3D(controller=ctrl, task=_task(args))
-    return run_window(sim, args.start, args.duration, args.fps), parameters_of(args)
+    return Window(sim, args.start, args.duration, args.fps), parameters_of(args)
 
 
 def loop_cut_body(args) -> str | None:

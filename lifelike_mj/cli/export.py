@@ -2,15 +2,17 @@
 
 The creatures are ``butterfly`` (the planar flight of the paper), ``butterfly3d`` (one 3D butterfly on a
 task, or a garden of them), ``fish`` (a tank) and ``boids`` (a flock). Each creature module gives
-``add_export_args`` (its scene's options and its time window) and ``export_poses(args)``, which runs the
-simulation and returns the sampled poses and the parameters that made them; this module checks the output
-before any work and writes the file (:mod:`lifelike_mj.export`).
+``add_export_args`` (its scene's options and its time window) and ``export_window(args)``, which checks them
+and builds the simulation (a :class:`Window`, not yet run) with the parameters that made it; this module checks
+the output before any work, records the window and writes the file (:mod:`lifelike_mj.export`). ``export scene
+SCENE.json`` composes several such runs into one file (:mod:`lifelike_mj.cli.scene`).
 """
 
 from __future__ import annotations
 
 import argparse
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -58,6 +60,9 @@ def add_export_verb(sub) -> None:
         add_overwrite(q)
         add_json(q)
         q.set_defaults(func=cmd_export)
+    from lifelike_mj.cli.scene import add_scene_command
+
+    add_scene_command(per)
 
 
 def add_window(p: argparse.ArgumentParser, max_s: float, default_s: float) -> None:
@@ -97,7 +102,8 @@ def cmd_export(args) -> None:
                 f"blend {args.loop_blend:g} s of its end into its start; give a longer clip or a shorter --loop-blend."))
         _lengthen(args, args.loop_blend)
     t0 = time.perf_counter()
-    poses, parameters = mod.export_poses(args)
+    window, parameters = mod.export_window(args)
+    poses = window.record()
     t_sim = time.perf_counter() - t0
     loop = None
     looks = args.looks
@@ -185,6 +191,24 @@ def check_window(start: float, duration: float, per_unit: float, dt: float, unit
     total = checks.steps_of(start + duration, dt) * bodies
     checks.work(f"simulating {start + duration:g} {unit} of {bodies:,} {'bodies' if bodies > 1 else 'body'}",
                 total, checks.MAX_BODY_STEPS if limit is None else limit, body_unit, "a shorter --start or --duration")
+
+
+@dataclass
+class Window:
+    """A run to export, built and checked but not yet simulated: ``stepper`` run ``start`` units of its time
+    unrecorded, then ``duration`` recorded at ``per_unit`` frames per unit, ``time_scale`` seconds of playback
+    per unit (:func:`run_window`)."""
+
+    stepper: object
+    start: float
+    duration: float
+    per_unit: float
+    time_scale: float = 1.0
+    unit: str = "s"
+
+    def record(self):
+        """Simulate and record the window: its :class:`~lifelike_mj.export.poses.Poses`."""
+        return run_window(self.stepper, self.start, self.duration, self.per_unit, self.time_scale, self.unit)
 
 
 def run_window(stepper, start: float, duration: float, per_unit: float, time_scale: float = 1.0, unit: str = "s"):

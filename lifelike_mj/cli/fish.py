@@ -172,15 +172,17 @@ def add_export_args(p: argparse.ArgumentParser) -> None:
     add_window(p, MAX_DURATION_S, 10.0)
 
 
-def export_poses(args):
-    from lifelike_mj.cli.export import check_window, parameters_of, run_window
+def export_window(args):
+    """The run to export, built and checked, not yet simulated (:class:`~lifelike_mj.cli.export.Window`), and the
+    parameters that make it."""
+    from lifelike_mj.cli.export import Window, check_window, parameters_of
     from lifelike_mj.fish.sim import Tank
 
     params = _preset(args)
     check_window(args.start, args.duration, args.fps, params.control_dt_s, bodies=args.fish * params.substeps,
                  body_unit="fish-steps (substeps included)")
     tank = Tank(params, args.fish, args.seed, _tank(args))
-    return run_window(tank, args.start, args.duration, args.fps), parameters_of(args)
+    return Window(tank, args.start, args.duration, args.fps), parameters_of(args)
 
 
 def export_rigs(poses) -> list:

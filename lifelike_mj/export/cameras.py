@@ -63,26 +63,57 @@ def _axes(back: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return right, np.cross(back, right), back
 
 
-def framing(poses: Poses) -> Framing:
-    """The framing (module docstring) of ``poses``."""
+def bounds(poses: Poses) -> tuple[np.ndarray, np.ndarray, float]:
+    """``(lo, hi, size)``: the box (m, MuJoCo's world) around every body at every sample, grown by ``size`` (the
+    farthest a drawn geom of a body reaches from the body's origin), and around the world's still geoms other
+    than a ground plane (a tank, a box, flowers)."""
     m = poses.model
     drawn = drawn_geoms(m)
-    size = 0.0  # the farthest a drawn geom of a body reaches from the body's origin (m)
+    size = 0.0
     for g in drawn[m.geom_bodyid[drawn] > 0]:
         size = max(size, float(np.linalg.norm(m.geom_pos[g]) + m.geom_rbound[g]))
     pts = poses.position_m.reshape(-1, 3)
     lo, hi = pts.min(axis=0) - size, pts.max(axis=0) + size
-    for g in drawn[m.geom_bodyid[drawn] == 0]:  # the world's still things: tank, box, flowers (not a ground)
-        if 0.0 < m.geom_rbound[g] < MAX_STILL_M and m.geom_type[g] != mujoco.mjtGeom.mjGEOM_PLANE:
-            R = np.empty(9)
-            mujoco.mju_quat2Mat(R, m.geom_quat[g])
-            R = R.reshape(3, 3)
-            centre_g = m.geom_pos[g] + R @ m.geom_aabb[g, :3]  # the geom's own box, turned into the world
-            half = np.abs(R) @ m.geom_aabb[g, 3:]
-            lo, hi = np.minimum(lo, centre_g - half), np.maximum(hi, centre_g + half)
-    centre = (lo + hi) / 2.0
+    for g in still_geoms(m):
+        R = np.empty(9)
+        mujoco.mju_quat2Mat(R, m.geom_quat[g])
+        R = R.reshape(3, 3)
+        centre_g = m.geom_pos[g] + R @ m.geom_aabb[g, :3]  # the geom's own box, turned into the world
+        half = np.abs(R) @ m.geom_aabb[g, 3:]
+        lo, hi = np.minimum(lo, centre_g - half), np.maximum(hi, centre_g + half)
+    return lo, hi, size
+
+
+def still_geoms(m: mujoco.MjModel) -> list[int]:
+    """The world's drawn still geoms that frame a view: not a ground plane, nothing :data:`MAX_STILL_M` or
+    larger."""
+    drawn = drawn_geoms(m)
+    return [int(g) for g in drawn[m.geom_bodyid[drawn] == 0]
+            if 0.0 < m.geom_rbound[g] < MAX_STILL_M and m.geom_type[g] != mujoco.mjtGeom.mjGEOM_PLANE]
+
+
+def view_direction() -> np.ndarray:
+    """The unit vector from what the cameras look at to the cameras (:data:`AZIMUTH_DEG`, :data:`ELEVATION_DEG`)."""
     az, el = math.radians(AZIMUTH_DEG), math.radians(ELEVATION_DEG)
-    direction = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+    return np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+
+
+def overview(lo: np.ndarray, hi: np.ndarray, direction: np.ndarray) -> tuple[np.ndarray, float]:
+    """``(centre, distance)``: the centre of the box ``lo``-``hi`` and the nearest distance from it along
+    ``direction`` that keeps the whole box in a picture of aspect :data:`ASPECT` (with 5 % to spare)."""
+    centre = (lo + hi) / 2.0
+    right, up, back = _axes(direction)
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]) - centre
+    tan_v = math.tan(math.radians(FOV_DEG) / 2.0)
+    need = corners @ back + np.maximum(np.abs(corners @ up) / tan_v, np.abs(corners @ right) / (tan_v * ASPECT))
+    return centre, 1.05 * float(need.max())
+
+
+def framing(poses: Poses) -> Framing:
+    """The framing (module docstring) of ``poses``."""
+    m = poses.model
+    lo, hi, size = bounds(poses)
+    direction = view_direction()
     roots = {int(m.body_rootid[b]) for b in poses.body_ids}
     follow, follow_m = None, 0.0
     if len(roots) == 1:
@@ -92,8 +123,5 @@ def framing(poses: Poses) -> Framing:
             follow = ids.index(root)
             reach = np.linalg.norm(poses.position_m[0] - poses.position_m[0, follow], axis=1).max() + size
             follow_m = max(FOLLOW_SIZES * float(reach), FOLLOW_MIN_M)
-    right, up, back = _axes(direction)
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]) - centre
-    tan_v = math.tan(math.radians(FOV_DEG) / 2.0)
-    need = corners @ back + np.maximum(np.abs(corners @ up) / tan_v, np.abs(corners @ right) / (tan_v * ASPECT))
-    return Framing(centre, direction, follow, follow_m, 1.05 * float(need.max()))
+    centre, distance = overview(lo, hi, direction)
+    return Framing(centre, direction, follow, follow_m, distance)

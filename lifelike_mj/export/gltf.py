@@ -23,6 +23,7 @@ way), atomically.
 
 from __future__ import annotations
 
+import hashlib
 import math
 from pathlib import Path
 
@@ -99,27 +100,96 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
     ``rigs``: the creatures as skinned meshes on skeletons (:mod:`lifelike_mj.export.rig`), in place of their
     bodies' MJCF geoms: each an armature node (the creature's name) holding its bones (MuJoCo bodies named as in
     the MJCF, and the extra bones), a skin, and a skinned mesh node at the scene's root."""
-    if rotations not in ("short", "float"):
-        raise UserError(f"rotations are stored as 'short' or 'float', got {rotations!r}.")
     tolerance = tolerance_of(tolerance)
+    prov = provenance(**(parameters or {}))
+    prov["frames"] = frames_record(poses, rotations)
+    doc = Doc(name, rotations)
+    part = add_poses(doc, doc.root, poses, rigs, tolerance)
+    prov["keys"] = {"tolerance_m": tolerance[0], "tolerance_deg": tolerance[1], **part["keys"]}
+    if rigs:
+        prov["rigs"] = part["rigs"]
+    _add_cameras(doc, poses, part["tracks"], tolerance)
+    return doc.finish(prov)
+
+
+def frames_record(poses: Poses, rotations: str) -> dict:
+    """The frames' count, rate and span of ``poses``, for the provenance."""
+    return {"count": poses.n_frames, "per_s": float(poses.fps), "start_s": float(poses.t_s[0]),
+            "end_s": float(poses.t_s[-1]), "bodies": len(poses.body_ids), "rotations": rotations}
+
+
+class Doc:
+    """A glTF document being built: its root node ``lifelike-mj`` (MuJoCo's Z-up world turned to glTF's Y-up),
+    one binary buffer, one animation whose channels share key times where their keys are the same."""
+
+    def __init__(self, name: str, rotations: str = "short") -> None:
+        if rotations not in ("short", "float"):
+            raise UserError(f"rotations are stored as 'short' or 'float', got {rotations!r}.")
+        self.rotations = rotations
+        self.gl = g.GLTF2(asset=g.Asset(version="2.0", generator=f"lifelike-mj {__version__}"))
+        self.gl.scenes = [g.Scene(name=name, nodes=[0])]
+        self.gl.scene = 0
+        self.root = g.Node(name="lifelike-mj", rotation=list(Z_UP_TO_Y_UP), children=[])
+        self.gl.nodes.append(self.root)
+        self.buf = _Buffer(self.gl)
+        self.anim = g.Animation(name=name, samplers=[], channels=[])
+        self._inputs: dict[tuple, int] = {}
+        self._times: dict[int, tuple] = {}  # the sample times seen (kept alive), by id, with their digest
+
+    def node(self, node: g.Node, parent: g.Node | None) -> int:
+        """Add ``node`` as a child of ``parent`` (or at the scene's root, for None); its index."""
+        self.gl.nodes.append(node)
+        idx = len(self.gl.nodes) - 1
+        if parent is None:
+            self.gl.scenes[0].nodes.append(idx)
+        else:
+            parent.children.append(idx)
+        return idx
+
+    def channel(self, t: np.ndarray, node: int, path: str, keys: np.ndarray, values: np.ndarray) -> None:
+        """Animate ``node``'s ``path`` (translation: ``values`` (n, 3) m; rotation: (n, 4) x, y, z, w) at the
+        samples ``keys`` of the times ``t`` (s; the file's time 0 is ``t[0]``), linearly."""
+        if id(t) not in self._times:
+            self._times[id(t)] = (t, hashlib.sha1(np.ascontiguousarray(t).tobytes()).hexdigest())
+        key = (self._times[id(t)][1], keys.tobytes())
+        if key not in self._inputs:
+            self._inputs[key] = self.buf.add((t[keys] - t[0]).astype(np.float32), g.SCALAR, minmax=True)
+        if path == "rotation":
+            out = self.buf.add(quantize_rotations(values) if self.rotations == "short" else values.astype(np.float32),
+                               g.VEC4)
+        else:
+            out = self.buf.add(values.astype(np.float32), g.VEC3)
+        self.anim.samplers.append(g.AnimationSampler(input=self._inputs[key], output=out, interpolation="LINEAR"))
+        self.anim.channels.append(g.AnimationChannel(sampler=len(self.anim.samplers) - 1,
+                                                     target=g.AnimationChannelTarget(node=node, path=path)))
+
+    def finish(self, provenance_record: dict) -> g.GLTF2:
+        """The document, with ``provenance_record`` as the asset's extras (strict JSON)."""
+        gl = self.gl
+        gl.asset.extras = strict(provenance_record)
+        gl.animations = [self.anim] if self.anim.channels else []
+        gl.buffers = [g.Buffer(byteLength=len(self.buf.data))]
+        gl.set_binary_blob(bytes(self.buf.data))
+        return gl
+
+
+def add_poses(doc: Doc, parent: g.Node, poses: Poses, rigs: list[Rig] | None, tolerance, ground: bool = True,
+              still: bool = True, prefix: str = "") -> dict:
+    """Add a run to ``doc`` under ``parent``: the world's still geoms (``still``; a ground plane only with
+    ``ground``), a node per plain body with its geoms, a rig per creature in ``rigs`` (keyed within
+    ``tolerance``, m and deg, in the run's own units; its armature, skin and mesh named with ``prefix``).
+    Returns ``{"tracks"}`` (the plain bodies' keys, by body index), ``{"keys"}`` (samples and keys per body)
+    and ``{"rigs"}`` (each rig's keys per bone)."""
     rigged = {bone.body for r in rigs or [] for bone in r.bones if bone.body is not None}
     plain = [b for b, n in enumerate(poses.body_names) if n not in rigged]  # bodies written with their geoms
+    rotations = doc.rotations
     tracks = dict(zip(plain, body_tracks(poses.t_s, poses.position_m[:, plain], poses.quat_wxyz[:, plain], tolerance,
                                          rotations))) if plain else {}
-    m = poses.model
-    prov = provenance(**(parameters or {}))
     span = float(poses.t_s[-1] - poses.t_s[0])
-    prov["frames"] = {"count": poses.n_frames, "per_s": float(poses.fps), "start_s": float(poses.t_s[0]),
-                      "end_s": float(poses.t_s[-1]), "bodies": len(poses.body_ids), "rotations": rotations}
-    prov["keys"] = {"tolerance_m": tolerance[0], "tolerance_deg": tolerance[1], "samples": poses.n_samples,
-                    "samples_per_s": (poses.n_samples - 1) / span if span > 0 else 0.0,
-                    "per_body": key_counts([tracks[b] for b in plain], [poses.body_names[b] for b in plain])}
-    gl = g.GLTF2(asset=g.Asset(version="2.0", generator=f"lifelike-mj {__version__}", extras=strict(prov)))
-    gl.scenes = [g.Scene(name=name, nodes=[0])]
-    gl.scene = 0
-    root = g.Node(name="lifelike-mj", rotation=list(Z_UP_TO_Y_UP), children=[])
-    gl.nodes.append(root)
-    buf = _Buffer(gl)
+    keys = {"samples": poses.n_samples, "samples_per_s": (poses.n_samples - 1) / span if span > 0 else 0.0,
+            "per_body": key_counts([tracks[b] for b in plain], [poses.body_names[b] for b in plain])}
+    gl, buf = doc.gl, doc.buf
+    m = poses.model
     meshes: dict[tuple, int] = {}
     materials: dict[int, int] = {}
     rgba = geom_rgba(m)
@@ -156,56 +226,30 @@ def build_gltf(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
             meshes[full] = len(gl.meshes) - 1
         return meshes[full]
 
-    def geom_node(geom: int) -> int:
+    def geom_node(geom: int, parent_node: g.Node) -> None:
         gname = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, geom) or f"geom{geom}"
-        gl.nodes.append(g.Node(name=gname, mesh=mesh_of(geom), translation=[float(v) for v in m.geom_pos[geom]],
-                               rotation=_xyzw(m.geom_quat[geom])))
-        return len(gl.nodes) - 1
+        doc.node(g.Node(name=gname, mesh=mesh_of(geom), translation=[float(v) for v in m.geom_pos[geom]],
+                        rotation=_xyzw(m.geom_quat[geom])), parent_node)
 
     drawn = drawn_geoms(m)
-    for geom in drawn[m.geom_bodyid[drawn] == 0]:  # the world's still geoms
-        root.children.append(geom_node(int(geom)))
-    anim = g.Animation(name=name, samplers=[], channels=[])
-    inputs: dict[bytes, int] = {}  # key times, shared by the channels that have the same keys
-
-    def times_of(keys: np.ndarray) -> int:
-        if keys.tobytes() not in inputs:
-            inputs[keys.tobytes()] = buf.add((poses.t_s[keys] - poses.t_s[0]).astype(np.float32), g.SCALAR,
-                                             minmax=True)
-        return inputs[keys.tobytes()]
-
-    def channel(node: int, path: str, keys: np.ndarray, values: np.ndarray, kind: str) -> None:
-        anim.samplers.append(g.AnimationSampler(input=times_of(keys), output=buf.add(values, kind),
-                                                interpolation="LINEAR"))
-        anim.channels.append(g.AnimationChannel(sampler=len(anim.samplers) - 1,
-                                                target=g.AnimationChannelTarget(node=node, path=path)))
-
+    for geom in drawn[m.geom_bodyid[drawn] == 0] if still else ():  # the world's still geoms
+        if ground or m.geom_type[geom] != mujoco.mjtGeom.mjGEOM_PLANE:
+            geom_node(int(geom), parent)
+    t = poses.t_s
     for b, (body, bname) in enumerate(zip(poses.body_ids, poses.body_names)):
         if bname in rigged:
             continue
         node = g.Node(name=bname, translation=[float(v) for v in poses.position_m[0, b]],
                       rotation=_xyzw(poses.quat_wxyz[0, b]), children=[], extras={"mujoco_body": bname})
-        gl.nodes.append(node)
-        idx = len(gl.nodes) - 1
-        root.children.append(idx)
+        idx = doc.node(node, parent)
         for geom in drawn[m.geom_bodyid[drawn] == body]:
-            node.children.append(geom_node(int(geom)))
+            geom_node(int(geom), node)
         track = tracks[b]
         if track.translation is not None:
-            channel(idx, "translation", track.translation,
-                    poses.position_m[track.translation, b].astype(np.float32), g.VEC3)
+            doc.channel(t, idx, "translation", track.translation, poses.position_m[track.translation, b])
         if track.rotation is not None:
-            rot = poses.quat_wxyz[track.rotation, b][:, [1, 2, 3, 0]]
-            channel(idx, "rotation", track.rotation,
-                    quantize_rotations(rot) if rotations == "short" else rot.astype(np.float32), g.VEC4)
-    if rigs:
-        prov["rigs"] = _add_rigs(gl, root, buf, channel, poses, rigs, tolerance, rotations)
-        gl.asset.extras = strict(prov)
-    _add_cameras(gl, root, poses, tracks, channel, tolerance, rotations)
-    gl.animations = [anim] if anim.channels else []
-    gl.buffers = [g.Buffer(byteLength=len(buf.data))]
-    gl.set_binary_blob(bytes(buf.data))
-    return gl
+            doc.channel(t, idx, "rotation", track.rotation, poses.quat_wxyz[track.rotation, b][:, [1, 2, 3, 0]])
+    return {"tracks": tracks, "keys": keys, "rigs": _add_rigs(doc, parent, poses, rigs, tolerance, prefix) if rigs else {}}
 
 
 def _png(image: np.ndarray) -> bytes:
@@ -235,11 +279,12 @@ def _texture(gl: g.GLTF2, buf: _Buffer, image: np.ndarray, name: str, repeat: bo
     return len(gl.textures) - 1
 
 
-def _add_rigs(gl: g.GLTF2, root: g.Node, buf: _Buffer, channel, poses: Poses, rigs: list[Rig], tolerance,
-              rotations: str) -> dict:
-    """Each rig as an armature node under ``root`` with its bones, a skin and a skinned mesh node at the scene's
-    root (glTF ignores a skinned mesh node's own place: its joints place it); meshes, textures and inverse bind
-    matrices shared between the rigs that share them. Returns each rig's bones and keys, for the provenance."""
+def _add_rigs(doc: Doc, parent: g.Node, poses: Poses, rigs: list[Rig], tolerance, prefix: str = "") -> dict:
+    """Each rig as an armature node under ``parent`` with its bones, a skin and a skinned mesh node at the scene's
+    root (glTF ignores a skinned mesh node's own place: its joints place it, with whatever ``parent`` and the
+    root add); meshes, textures and inverse bind matrices shared between the rigs that share them. Returns each
+    rig's bones and keys, for the provenance."""
+    gl, buf, rotations = doc.gl, doc.buf, doc.rotations
     R = np.eye(4)
     R[:3, :3] = Z_UP_TO_Y_UP_MATRIX  # the root's turn, which the joints' world transforms include
     looks: dict[int, int] = {}
@@ -282,9 +327,8 @@ def _add_rigs(gl: g.GLTF2, root: g.Node, buf: _Buffer, channel, poses: Poses, ri
     for rig in rigs:
         rig.check()
         keys = rig.keys(poses.t_s, tolerance, rotations)
-        arm = g.Node(name=f"{rig.name} rig", children=[], extras={"lifelike_mj_rig": rig.name, **rig.extras})
-        gl.nodes.append(arm)
-        root.children.append(len(gl.nodes) - 1)
+        arm = g.Node(name=f"{prefix}{rig.name} rig", children=[], extras={"lifelike_mj_rig": rig.name, **rig.extras})
+        doc.node(arm, parent)
         first = len(gl.nodes)
         for i, (bone, k) in enumerate(zip(rig.bones, keys)):
             extras = {"mujoco_body": bone.body} if bone.body is not None else {"secondary_motion": True}
@@ -292,47 +336,49 @@ def _add_rigs(gl: g.GLTF2, root: g.Node, buf: _Buffer, channel, poses: Poses, ri
                                    rotation=_xyzw(k.still_rotation), children=[], extras=extras))
             (arm if bone.parent < 0 else gl.nodes[first + bone.parent]).children.append(first + i)
             if k.translation is not None:
-                channel(first + i, "translation", k.translation, k.translation_values.astype(np.float32), g.VEC3)
+                doc.channel(poses.t_s, first + i, "translation", k.translation, k.translation_values)
             if k.rotation is not None:
-                rot = k.rotation_values[:, [1, 2, 3, 0]]
-                channel(first + i, "rotation", k.rotation,
-                        quantize_rotations(rot) if rotations == "short" else rot.astype(np.float32), g.VEC4)
+                doc.channel(poses.t_s, first + i, "rotation", k.rotation, k.rotation_values[:, [1, 2, 3, 0]])
         ibm = np.stack([np.linalg.inv(R @ b.bind).T for b in rig.bones]).astype(np.float32)  # column-major
         if ibm.tobytes() not in binds:
             binds[ibm.tobytes()] = buf.add(ibm, g.MAT4)
-        gl.skins.append(g.Skin(name=rig.name, joints=list(range(first, first + len(rig.bones))),
+        gl.skins.append(g.Skin(name=f"{prefix}{rig.name}", joints=list(range(first, first + len(rig.bones))),
                                inverseBindMatrices=binds[ibm.tobytes()]))
-        gl.nodes.append(g.Node(name=f"{rig.name} mesh", mesh=mesh_of(rig.mesh), skin=len(gl.skins) - 1))
-        gl.scenes[0].nodes.append(len(gl.nodes) - 1)
+        doc.node(g.Node(name=f"{prefix}{rig.name} mesh", mesh=mesh_of(rig.mesh), skin=len(gl.skins) - 1), None)
         report[rig.name] = rig.key_counts(poses.t_s, tolerance, rotations)
     return report
 
 
-def _add_cameras(gl: g.GLTF2, root: g.Node, poses: Poses, tracks: dict[int, Track], channel, tolerance=DEFAULT_TOLERANCE,
-                 rotations: str = "short") -> None:
+def add_camera(doc: Doc, parent: g.Node, name: str, quat_wxyz: np.ndarray, position_m: np.ndarray,
+               distance_m: float, t: np.ndarray | None = None, keys: np.ndarray | None = None) -> int:
+    """A perspective camera (field of view :data:`~lifelike_mj.export.cameras.FOV_DEG`) named ``name`` on a node
+    ``camera <name>`` under ``parent``, turned by ``quat_wxyz`` (it looks along its own -Z, +Y up), at
+    ``position_m`` (one place, or a path over the times ``t`` keyed at ``keys``); ``distance_m`` (from what it
+    looks at) sets its near plane. Returns the node."""
+    doc.gl.cameras.append(g.Camera(name=name, type="perspective", perspective=g.Perspective(
+        yfov=math.radians(FOV_DEG), znear=max(distance_m / 1000.0, 1e-4))))
+    position_m = np.asarray(position_m, dtype=float)
+    first = position_m if position_m.ndim == 1 else position_m[0]
+    idx = doc.node(g.Node(name=f"camera {name}", camera=len(doc.gl.cameras) - 1, rotation=_xyzw(quat_wxyz),
+                          translation=[float(v) for v in first]), parent)
+    if position_m.ndim == 2 and keys is not None:
+        doc.channel(t, idx, "translation", keys, position_m[keys])
+    return idx
+
+
+def _add_cameras(doc: Doc, poses: Poses, tracks: dict[int, Track], tolerance=DEFAULT_TOLERANCE) -> None:
     """The overview camera and, for one creature, the follow camera (:mod:`lifelike_mj.export.cameras`), as
     nodes under the root (MuJoCo's world); the follow camera keeps its body's translation keys (it moves by
     the same path, shifted)."""
     f = framing(poses)
-    look = _xyzw(f.look_quat_wxyz())
-    yfov = math.radians(FOV_DEG)
-    gl.cameras.append(g.Camera(name="overview", type="perspective",
-                               perspective=g.Perspective(yfov=yfov, znear=max(f.overview_m / 1000.0, 1e-4))))
-    gl.nodes.append(g.Node(name="camera overview", camera=0, rotation=look,
-                           translation=[float(v) for v in f.centre_m + f.direction * f.overview_m]))
-    root.children.append(len(gl.nodes) - 1)
+    look = f.look_quat_wxyz()
+    add_camera(doc, doc.root, "overview", look, f.centre_m + f.direction * f.overview_m, f.overview_m)
     if f.follow is None:
         return
     path = poses.position_m[:, f.follow] + f.direction * f.follow_m
-    gl.cameras.append(g.Camera(name="follow", type="perspective",
-                               perspective=g.Perspective(yfov=yfov, znear=max(f.follow_m / 1000.0, 1e-4))))
-    gl.nodes.append(g.Node(name="camera follow", camera=1, rotation=look, translation=[float(v) for v in path[0]]))
-    root.children.append(len(gl.nodes) - 1)
     track = tracks.get(f.follow) or body_tracks(poses.t_s, poses.position_m[:, [f.follow]],
-                                                poses.quat_wxyz[:, [f.follow]], tolerance, rotations)[0]
-    keys = track.translation
-    if keys is not None:
-        channel(len(gl.nodes) - 1, "translation", keys, path[keys].astype(np.float32), g.VEC3)
+                                                poses.quat_wxyz[:, [f.follow]], tolerance, doc.rotations)[0]
+    add_camera(doc, doc.root, "follow", look, path, f.follow_m, poses.t_s, track.translation)
 
 
 def write_gltf(poses: Poses, path: str | Path, name: str = "lifelike-mj run", parameters: dict | None = None,
@@ -343,7 +389,15 @@ def write_gltf(poses: Poses, path: str | Path, name: str = "lifelike-mj run", pa
     path = Path(path)
     if path.suffix.lower() not in (".glb", ".gltf"):
         raise UserError(f"a glTF file ends in .glb or .gltf, got {path.name!r}.")
-    gl = build_gltf(poses, name, parameters, rotations, tolerance, rigs)
+    return save(build_gltf(poses, name, parameters, rotations, tolerance, rigs), path)
+
+
+def save(gl: g.GLTF2, path: str | Path) -> Path:
+    """Write the document ``gl`` to ``path``, binary (``.glb``) or JSON with the buffer inside (``.gltf``),
+    atomically. Returns the path."""
+    path = Path(path)
+    if path.suffix.lower() not in (".glb", ".gltf"):
+        raise UserError(f"a glTF file ends in .glb or .gltf, got {path.name!r}.")
     with atomic_path(path) as tmp:
         if path.suffix.lower() == ".glb":
             gl.save_binary(str(tmp))

@@ -126,24 +126,37 @@ def build_html(poses: Poses, name: str = "lifelike-mj run", parameters: dict | N
     """The page (module docstring) of ``poses`` as text; :func:`write_html` writes it."""
     gl = build_gltf(poses, name, parameters, rotations, tolerance, rigs)
     f = framing(poses)
+    follow = None if f.follow is None else {"path_m": poses.frames().position_m[:, f.follow],
+                                            "distance_m": f.follow_m}
+    return page(gl, name, {"centre_m": f.centre_m, "direction": f.direction, "overview_m": f.overview_m,
+                           "span_s": float(poses.t_s[-1] - poses.t_s[0]), "follow": follow})
+
+
+def page(gl, name: str, view: dict) -> str:
+    """The page playing the glTF document ``gl``, framed by ``view``: ``centre_m``, ``direction`` (from what is
+    looked at to the camera) and ``overview_m`` (MuJoCo's world, m), ``span_s`` (s), and ``follow`` (None, or
+    ``path_m``: the followed creature's place at each playback frame, and ``distance_m``)."""
     y_up = Z_UP_TO_Y_UP_MATRIX
-    d = y_up @ f.direction  # model-viewer's orbit: theta about +Y from +Z, phi from +Y
+    d = y_up @ np.asarray(view["direction"], dtype=float)  # model-viewer's orbit: theta about +Y from +Z, phi from +Y
     theta, phi = math.degrees(math.atan2(d[0], d[2])), math.degrees(math.acos(max(-1.0, min(1.0, d[1]))))
-    follow = f.follow is not None
-    centre = y_up @ f.centre_m
-    frame = {"theta": round(theta, 3), "phi": round(phi, 3), "overview_m": f.overview_m, "follow_m": f.follow_m,
-             "centre": [float(v) for v in centre], "span_s": float(poses.t_s[-1] - poses.t_s[0]),
-             "follow_path": (np.round(poses.frames().position_m[:, f.follow] @ y_up.T, 5).tolist() if follow else None)}
+    follow = view["follow"]
+    centre = y_up @ np.asarray(view["centre_m"], dtype=float)
+    overview_m = float(view["overview_m"])
+    frame = {"theta": round(theta, 3), "phi": round(phi, 3), "overview_m": overview_m,
+             "follow_m": float(follow["distance_m"]) if follow else 0.0,
+             "centre": [float(v) for v in centre], "span_s": float(view["span_s"]),
+             "follow_path": (np.round(np.asarray(follow["path_m"]) @ y_up.T, 5).tolist() if follow else None)}
     glb = b"".join(gl.save_to_bytes())
     prov = json.dumps(gl.asset.extras, allow_nan=False)
+    target = (y_up @ np.asarray(follow["path_m"][0], dtype=float)) if follow else centre
     return _PAGE.format(generator=html.escape(gl.asset.generator), title=html.escape(name),
                         viewer=_inline(viewer_js()), glb=base64.b64encode(glb).decode("ascii"),
                         animation=html.escape(gl.animations[0].name if gl.animations else ""),
                         duration=frame["span_s"], provenance=_inline(prov),
                         framing=_inline(json.dumps(frame, allow_nan=False)), fov=FOV_DEG, theta=frame["theta"],
-                        phi=frame["phi"], radius=f.follow_m if follow else f.overview_m,
-                        target=" ".join(f"{v}m" for v in ((y_up @ poses.position_m[0, f.follow]) if follow else centre)),
-                        far=10.0 * f.overview_m, single="" if follow else " hidden")
+                        phi=frame["phi"], radius=frame["follow_m"] if follow else overview_m,
+                        target=" ".join(f"{v}m" for v in target), far=10.0 * overview_m,
+                        single="" if follow else " hidden")
 
 
 def write_html(poses: Poses, path: str | Path, name: str = "lifelike-mj run", parameters: dict | None = None,
