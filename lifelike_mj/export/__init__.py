@@ -12,7 +12,7 @@ from pathlib import Path
 from lifelike_mj.errors import UserError
 
 #: Each format and the file endings it is written to.
-FORMATS = {"glb": (".glb",), "gltf": (".gltf",), "usd": (".usda", ".usdc", ".usd"), "html": (".html",)}
+FORMATS = {"glb": (".glb",), "gltf": (".gltf",), "usd": (".usda", ".usdc", ".usd", ".usdz"), "html": (".html",)}
 
 
 def format_of(path: str | Path, fmt: str | None = None) -> str:

@@ -1,5 +1,5 @@
-"""Animated USD (``.usda`` text, ``.usdc``/``.usd`` binary) of recorded body poses, written with ``usd-core``
-(the ``usd`` extra: ``pip install "lifelike-mj[usd]"``).
+"""Animated USD (``.usda`` text, ``.usdc``/``.usd`` binary, ``.usdz`` a package with the textures) of recorded
+body poses, written with ``usd-core`` (the ``usd`` extra: ``pip install "lifelike-mj[usd]"``).
 
 Layout of the stage (Z up, metres, as MuJoCo's world; ``timeCodesPerSecond`` is the frame rate and time code
 ``k`` is frame ``k``):
@@ -62,11 +62,15 @@ def _ident(text: str, used: set[str]) -> str:
 
 
 def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | None = None,
-                tolerance=DEFAULT_TOLERANCE, rigs: list | None = None):
+                tolerance=DEFAULT_TOLERANCE, rigs: list | None = None, images: dict | None = None):
     """The USD stage (module docstring) of ``poses``, in memory; :func:`write_usd` writes it. Each body's
     translation and orientation have their own time samples: the keys that keep interpolation (linear, and
     slerp, which USD uses for quaternions) within ``tolerance`` (m, deg) of every sample
-    (:mod:`lifelike_mj.export.keys`), at fractional time codes where they fall between frames."""
+    (:mod:`lifelike_mj.export.keys`), at fractional time codes where they fall between frames.
+
+    ``images``: where a dict is given (a ``.usdz`` package), a rig's textured look reads its texture from
+    ``textures/<look>.png`` (a ``UsdUVTexture`` on the mesh's ``st``) and the image is put in ``images`` under
+    that path for the writer to package; otherwise it takes the texture's mean colour."""
     Gf, Sdf, Usd, UsdGeom, UsdShade, Vt = require_usd()
     m = poses.model
     n = poses.n_frames
@@ -138,12 +142,16 @@ def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | 
     rig_looks: dict[int, UsdShade.Material] = {}
 
     def look_of_rig(lk):
-        """A rig's look: its colour times its texture's mean (a USD file holds no image of its own)."""
+        """A rig's look: its texture where the file is a package (``images``), else its colour times its
+        texture's mean (a .usda or .usdc file holds no image of its own)."""
         if id(lk) not in rig_looks:
             rgb = np.asarray(lk.rgba[:3], dtype=float)
-            if lk.image is not None:
+            if lk.image is not None and images is None:
                 rgb = rgb * lk.image[..., :3].reshape(-1, 3).mean(axis=0) / 255.0
-            rig_looks[id(lk)] = material(lk.name, rgb, lk.rgba[3], lk.roughness)
+            mat = material(lk.name, rgb, lk.rgba[3], lk.roughness)
+            if lk.image is not None and images is not None:
+                _texture(stage, mat, lk, images)
+            rig_looks[id(lk)] = mat
         return rig_looks[id(lk)]
 
     def still(parent: Sdf.Path, geom: int, used: set[str]) -> None:
@@ -188,6 +196,32 @@ def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | 
         prov["rigs"] = _add_rigs(stage, world.GetPath(), rigs, poses.t_s, fps, tolerance, used, look_of_rig)
         stage.GetRootLayer().customLayerData = {"lifelike_mj": json.dumps(strict(prov), allow_nan=False)}
     return stage
+
+
+def _texture(stage, mat, look, images: dict) -> None:
+    """Feed ``look``'s texture (``textures/<material>.png``, put in ``images``) into ``mat``'s surface: a
+    ``UsdUVTexture`` read at the mesh's ``st`` by a ``UsdPrimvarReader_float2``, its colour times the look's
+    as the diffuse colour, its alpha times the look's as the opacity."""
+    from pxr import Gf, Sdf, UsdShade
+
+    file = f"textures/{mat.GetPath().name}.png"
+    images[file] = look.image
+    reader = UsdShade.Shader.Define(stage, mat.GetPath().AppendChild("st"))
+    reader.CreateIdAttr("UsdPrimvarReader_float2")
+    reader.CreateInput("varname", Sdf.ValueTypeNames.String).Set("st")
+    tex = UsdShade.Shader.Define(stage, mat.GetPath().AppendChild("texture"))
+    tex.CreateIdAttr("UsdUVTexture")
+    tex.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(Sdf.AssetPath(file))
+    tex.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(reader.ConnectableAPI(), "result")
+    tex.CreateInput("wrapS", Sdf.ValueTypeNames.Token).Set("clamp")
+    tex.CreateInput("wrapT", Sdf.ValueTypeNames.Token).Set("clamp")
+    r, g, b, a = (float(v) for v in look.rgba)
+    tex.CreateInput("scale", Sdf.ValueTypeNames.Float4).Set(Gf.Vec4f(r, g, b, a))
+    tex.CreateOutput("rgb", Sdf.ValueTypeNames.Float3)
+    tex.CreateOutput("a", Sdf.ValueTypeNames.Float)
+    surface = UsdShade.Shader(stage.GetPrimAtPath(mat.GetPath().AppendChild("surface")))
+    surface.GetInput("diffuseColor").ConnectToSource(tex.ConnectableAPI(), "rgb")
+    surface.GetInput("opacity").ConnectToSource(tex.ConnectableAPI(), "a")
 
 
 def _add_rigs(stage, world_path, rigs, t, fps, tolerance, used, looks_of):
@@ -275,12 +309,38 @@ def _add_rigs(stage, world_path, rigs, t, fps, tolerance, used, looks_of):
 def write_usd(poses: Poses, path: str | Path, name: str = "lifelike-mj run", parameters: dict | None = None,
               tolerance=DEFAULT_TOLERANCE, rigs: list | None = None) -> Path:
     """Write ``poses`` as an animated USD stage (module docstring): ``.usda`` as text, ``.usdc`` or ``.usd``
-    binary (crate), atomically, with the provenance. Returns the path."""
+    binary (crate), or ``.usdz``: a package (one zip file, as USD defines it) of the binary stage and the rigs'
+    texture images, which its materials read; atomically, with the provenance. Returns the path."""
     path = Path(path)
-    if path.suffix.lower() not in (".usda", ".usdc", ".usd"):
-        raise UserError(f"a USD file ends in .usda, .usdc or .usd, got {path.name!r}.")
+    if path.suffix.lower() not in (".usda", ".usdc", ".usd", ".usdz"):
+        raise UserError(f"a USD file ends in .usda, .usdc, .usd or .usdz, got {path.name!r}.")
+    if path.suffix.lower() == ".usdz":
+        return _write_usdz(poses, path, name, parameters, tolerance, rigs)
     stage = build_stage(poses, name, parameters, tolerance, rigs)
     with atomic_path(path) as tmp:  # the temporary file has the same ending, from which USD picks the format
         if not stage.GetRootLayer().Export(str(tmp)):
             raise UserError(f"USD could not write {path}.")
+    return path
+
+
+def _write_usdz(poses: Poses, path: Path, name: str, parameters: dict | None, tolerance, rigs: list | None) -> Path:
+    """The ``.usdz`` package of :func:`write_usd`: the stage and its textures written into a temporary folder,
+    then packaged by usd-core (``UsdUtils.CreateNewUsdzPackage``) into the file, atomically."""
+    import tempfile
+
+    from PIL import Image
+    from pxr import Sdf, UsdUtils
+
+    images: dict = {}
+    stage = build_stage(poses, name, parameters, tolerance, rigs, images)
+    with tempfile.TemporaryDirectory(prefix="lifelike-mj-usdz-") as folder:
+        layer = Path(folder) / "stage.usdc"
+        for file, image in images.items():
+            (Path(folder) / file).parent.mkdir(parents=True, exist_ok=True)
+            Image.fromarray(np.ascontiguousarray(image, dtype=np.uint8), "RGBA").save(Path(folder) / file, "PNG")
+        if not stage.GetRootLayer().Export(str(layer)):
+            raise UserError(f"USD could not write {path}.")
+        with atomic_path(path) as tmp:
+            if not UsdUtils.CreateNewUsdzPackage(Sdf.AssetPath(str(layer)), str(tmp)):
+                raise UserError(f"USD could not package {path}.")
     return path

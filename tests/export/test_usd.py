@@ -142,3 +142,41 @@ def build_stage_rigged(poses, rigs):
     from lifelike_mj.export.usd import build_stage
 
     return build_stage(poses, rigs=rigs)
+
+
+def test_a_usdz_package_holds_the_rigs_textures_which_its_materials_read(runs, tmp_path):
+    """``.usdz``: the stage and the rigs' texture images in one package; each textured look reads its own image
+    (the same pixels) at the mesh's ``st``; usd-core's validators (the package's among them) find nothing. A
+    ``.usdc`` of the same run holds no image (its looks take the mean colour)."""
+    import io
+    import zipfile
+
+    from PIL import Image
+    from pxr import UsdShade
+
+    from lifelike_mj.fish.look import rigs as fish_rigs
+
+    _, poses = runs("fish")
+    rigs = fish_rigs(poses)
+    path = write_usd(poses, tmp_path / "tank.usdz", rigs=rigs)
+    stage = Usd.Stage.Open(str(path))
+    assert _usd_validation(stage) == []
+    images = {lk.name: lk.image for r in rigs for lk, _ in r.mesh.parts if lk.image is not None}
+    assert images
+    read = {}
+    with zipfile.ZipFile(path) as z:
+        for prim in stage.Traverse():
+            shader = UsdShade.Shader(prim)
+            if prim.GetTypeName() == "Shader" and shader.GetIdAttr().Get() == "UsdUVTexture":
+                file = shader.GetInput("file").Get().path
+                look = prim.GetParent().GetName()
+                read[look] = np.asarray(Image.open(io.BytesIO(z.read(file))).convert("RGBA"))
+                surface = UsdShade.Shader(prim.GetParent().GetChild("surface"))
+                source = surface.GetInput("diffuseColor").GetConnectedSources()[0][0]
+                assert source.source.GetPath() == prim.GetPath()
+    assert set(read) == set(images)
+    for name, image in images.items():
+        np.testing.assert_array_equal(read[name], image)
+    plain = Usd.Stage.Open(str(write_usd(poses, tmp_path / "tank.usdc", rigs=rigs)))
+    assert not any(p.GetTypeName() == "Shader" and UsdShade.Shader(p).GetIdAttr().Get() == "UsdUVTexture"
+                   for p in plain.Traverse())
