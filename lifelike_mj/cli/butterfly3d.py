@@ -217,7 +217,7 @@ def add_commands(bf) -> None:
     p.set_defaults(func=cmd_fly3d)
     p = bf.add_parser("evolve3d", help="evolve a 3D controller (CMA-ES or the paper's GA) on the MuJoCo batch")
     p.add_argument("--optimizer", default="cmaes", choices=("cmaes", "rcga", "crs2", "esch", "isres"),
-                   help="cmaes (default) or rcga (the paper's GA), or an nlopt method")
+                   help="cmaes, rcga (the paper's GA) or an nlopt method")
     p.add_argument("--tasks", default="steer", choices=("steer", "cruise", "wind"),
                    help="the task set: steer (level at 1 and 2 m/s, turns of 90 and -180 deg), cruise (level at 1.5 "
                         "and 2 m/s, the turns, and two flights in 1 m/s wind with 0.5 m/s gusts) or wind (courses "
@@ -227,21 +227,21 @@ def add_commands(bf) -> None:
                    help="the network's speeds over the ground or through the air (default: the start's, else ground)")
     p.add_argument("--start", default=None, help="a 3D controller to start from (its network; genes are its changes)")
     p.add_argument("--gene-bound", type=num(0, 10, lo_open=True), default=0.4,
-                   help="bound of each gene (a weight's change from the start), default 0.4")
-    p.add_argument("--hidden", type=_hidden, default=[], help="hidden layer sizes, e.g. 16 (default: none, linear)")
-    p.add_argument("--population", type=count(2, 100_000), default=16, help="population size (default 16)")
-    p.add_argument("--generations", type=count(1, 1_000_000), default=300, help="generations (default 300)")
+                   help="bound of each gene (a weight's change from the start)")
+    p.add_argument("--hidden", type=_hidden, default=[], help="hidden layer sizes, e.g. 16 (default: none, a linear network)")
+    p.add_argument("--population", type=count(2, 100_000), default=16, help="population size")
+    p.add_argument("--generations", type=count(1, 1_000_000), default=300, help="generations")
     p.add_argument("--duration", type=num(0, 60, lo_open=True, unit="s"), default=4.0,
-                   help="seconds of each training flight (default 4)")
+                   help="seconds of each training flight")
     add_seed(p)
     add_run_files(p, "controller file to write (.json)")
     add_json(p)
     p.set_defaults(func=cmd_evolve3d)
     p = bf.add_parser("garden", help="a garden of 3D butterflies visiting flowers, filmed")
-    p.add_argument("--n", type=count(1, 500), default=20, help="butterflies, 1 to 500 (default 20)")
+    p.add_argument("--n", type=count(1, 500), default=20, help="butterflies, 1 to 500")
     p.add_argument("--controller", default="steer", help="a shipped 3D controller's name or a file")
     add_seed(p)
-    p.add_argument("--flutter", type=num(0, 1), default=0.1, help="each butterfly's flutter, 0 to 1 (default 0.1)")
+    p.add_argument("--flutter", type=num(0, 1), default=0.1, help="each butterfly's flutter, 0 to 1")
     _add_weather(p, "", "each butterfly's seed")
     p.add_argument("--duration", type=num(0, 600, lo_open=True, unit="s"), default=10.0, help="seconds of flight")
     p.add_argument("--out", default=None, help="video file (.mp4 or .gif)")
@@ -257,7 +257,7 @@ def add_commands(bf) -> None:
     p.add_argument("--controller", default="steer", help="a shipped 3D controller's name or a file")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s")
     p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=60.0,
-                   help="seconds of level flight (default 60)")
+                   help="seconds of level flight")
     p.add_argument("--courses", type=_seeds, default=[100, 101, 102], help="course seeds, e.g. 100-104")
     _add_weather(p, "the courses' ", "each course's seed")
     add_json(p)

@@ -9,14 +9,27 @@ from lifelike_mj.errors import UserError
 
 
 class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
-    """Help that shows every option's default (argparse's ``%(default)s``), except empty ones."""
+    """Help that shows every option's default once, readably (:func:`show_default`), except empty ones and where
+    the help already says it."""
 
     def _get_help_string(self, action: argparse.Action) -> str:
         text = action.help or ""
         empty = action.default is None or action.default is False or action.default == argparse.SUPPRESS
-        if "%(default)" in text or empty or not action.option_strings:
+        if "%(default)" in text or "default" in text.lower() or empty or not action.option_strings:
             return text
-        return f"{text} (default: %(default)s)"
+        return f"{text} (default: {show_default(action.default).replace('%', '%%')})"
+
+
+def show_default(value) -> str:
+    """A default as a reader wants it: ``1/1200`` for a small float that is one over a whole number, else at
+    most 6 significant digits; a list comma-joined (``none`` when empty)."""
+    if isinstance(value, float):
+        if 0.0 < abs(value) < 0.01 and abs(1.0 / value - round(1.0 / value)) < 1e-6 * abs(1.0 / value):
+            return f"1/{round(1.0 / value)}"
+        return f"{value:.6g}"
+    if isinstance(value, (list, tuple)):
+        return ", ".join(show_default(v) for v in value) if value else "none"
+    return str(value)
 
 
 class Parser(argparse.ArgumentParser):

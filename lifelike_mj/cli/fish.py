@@ -40,7 +40,7 @@ def _tank(args):
 
 def _add_fish(p) -> None:
     p.add_argument("--preset", default="default",
-                   help="fish motion preset: NB-ND, NB-D, B-ND, B-D, default (= B-D), or a JSON file")
+                   help="fish motion preset: NB-ND, NB-D, B-ND, B-D or a JSON file (default: B-D, also called 'default')")
     from lifelike_mj.fish.params import MAX_FISH
 
     p.add_argument("--n", "--fish", dest="fish", type=count(1, MAX_FISH), default=10,

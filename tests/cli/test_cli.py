@@ -135,7 +135,25 @@ def test_every_option_has_help_and_shows_its_default():
         assert a.help, f"{where} {a.option_strings[0]} has no help"
     text = build_parser()._subparsers._group_actions[0].choices["fish"]._subparsers._group_actions[0] \
         .choices["swim"].format_help()
-    assert "--n FISH, --fish FISH" in text and "(default: 30.0)" in text
+    assert "--n FISH, --fish FISH" in text and "(default: 30)" in text
+
+
+def test_no_help_says_its_default_twice_or_as_a_raw_float():
+    """Every option's help, as printed: "(default" at most once, no float with more than 6 significant digits
+    (1/1200 s is shown as "1/1200", not 0.0008333333333333334)."""
+    import re
+
+    from lifelike_mj.cli import build_parser
+    from lifelike_mj.cli.common import HelpFormatter, show_default
+
+    bad = []
+    for where, a in _options(build_parser()):
+        shown = " ".join(HelpFormatter("x")._expand_help(a).split())
+        if len(re.findall(r"\(default", shown, re.I)) > 1 or re.search(r"\d\.\d{7,}|\d{7,}e-", shown):
+            bad.append(f"{where} {a.option_strings[0]}: {shown}")
+    assert not bad, "\n".join(bad)
+    assert show_default(1.0 / 1200) == "1/1200" and show_default(0.1) == "0.1" and show_default([]) == "none"
+    assert show_default(2.0 / 3.0) == "0.666667" and show_default((1.5, 0.0)) == "1.5, 0"
 
 
 def test_negative_values_are_values(capsys):
