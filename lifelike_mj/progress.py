@@ -5,6 +5,8 @@
 * :func:`stage`: one named stage of a longer job: a bar whose elapsed time keeps moving even while
   the work inside reports nothing (a ticker thread refreshes it), closed with a line giving the
   stage's real duration. :class:`Stages` numbers the stages of a job (``[2/5] E4 trim ...``).
+* :func:`set_enabled`: the switch the command line's ``--quiet`` turns off, for every bar and stage at once;
+  the command then also leaves out its closing ``done in`` line (:func:`done_line`).
 """
 
 from __future__ import annotations
@@ -15,6 +17,25 @@ import threading
 import time
 from collections.abc import Iterator
 from typing import Any
+
+_ENABLED = True
+
+
+def set_enabled(on: bool) -> None:
+    """Show progress (bars, stages, the closing line) or not, for the whole process."""
+    global _ENABLED
+    _ENABLED = bool(on)
+
+
+def enabled() -> bool:
+    """Whether progress is shown (:func:`set_enabled`)."""
+    return _ENABLED
+
+
+def done_line(what: str, seconds: float) -> None:
+    """The closing line of a command on stderr, ``<what>: done in 12.3 s``, unless progress is off."""
+    if _ENABLED:
+        print(f"{what}: done in {duration_text(seconds)}", file=sys.stderr, flush=True)
 
 
 class _Quiet:
@@ -29,26 +50,32 @@ class _Quiet:
     def set_postfix_str(self, s: str = "", refresh: bool = True) -> None:
         pass
 
+    def set_postfix(self, *args: Any, **kwargs: Any) -> None:
+        pass
+
     def close(self) -> None:
         pass
 
 
-def bar(total: int | None, desc: str, enabled: bool = True, unit: str = "it") -> Any:
-    """A tqdm bar on stderr (a no-op object when not ``enabled``)."""
-    if not enabled:
+def bar(total: int | None, desc: str, enabled: bool = True, unit: str = "it", initial: int = 0,
+        leave: bool = False) -> Any:
+    """A tqdm bar on stderr (a no-op object when not ``enabled``, or when progress is off): every progress bar
+    of the project is one of these, so all look alike and ``--quiet`` silences all. ``leave``: keep the bar's last
+    state on screen when it closes (an evolution's: its best and mean)."""
+    if not (enabled and _ENABLED):
         return _Quiet()
     from tqdm import tqdm
 
     fmt = "{desc} [{elapsed}]" if total is None else None
-    return tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, dynamic_ncols=True, leave=False,
-                mininterval=0.5 if sys.stderr.isatty() else 10.0, bar_format=fmt)
+    return tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, dynamic_ncols=True, leave=leave,
+                mininterval=0.5 if sys.stderr.isatty() else 10.0, bar_format=fmt, initial=initial)
 
 
 @contextlib.contextmanager
 def stage(desc: str, total: int | None = None, enabled: bool = True, unit: str = "it") -> Iterator[Any]:
     """A named stage: a bar (of ``total`` items, or an elapsed-time counter) refreshed every second
     (every 10 s when stderr is not a terminal) while the block runs, then one line ``desc: 12.3 s``."""
-    if not enabled:
+    if not (enabled and _ENABLED):
         yield _Quiet()
         return
     b = bar(total, desc, True, unit)
@@ -91,9 +118,11 @@ class Stages:
         return stage(f"[{self.job} {self.i}/{self.count}] {name}", total, self.enabled, unit)
 
     def done(self, what: str) -> float:
+        """Say what the job made (``[job] what``; the command's closing line gives the time) and return the
+        job's duration (s)."""
         took = time.perf_counter() - self.t0
-        if self.enabled:
-            print(f"[{self.job}] {what} in {duration_text(took)}", file=sys.stderr, flush=True)
+        if self.enabled and _ENABLED:
+            print(f"[{self.job}] {what}", file=sys.stderr, flush=True)
         return took
 
 

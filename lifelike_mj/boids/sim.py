@@ -117,9 +117,9 @@ class Flock(StepCounter):
         done = 0
         bar = None
         if progress:
-            from tqdm import tqdm
+            from lifelike_mj.progress import bar as progress_bar
 
-            bar = tqdm(total=n_steps, unit="step", desc="boids", leave=False)
+            bar = progress_bar(n_steps, "boids", unit="step")
         try:
             while done < n_steps:
                 k = (rec[r] if r < len(rec) else n_steps) - done

@@ -14,6 +14,7 @@ that ``--help`` is instant and the GL backend can be chosen before MuJoCo is imp
 
 from __future__ import annotations
 
+import argparse
 import importlib
 import sys
 from pathlib import Path
@@ -88,6 +89,25 @@ def _bench_options(p) -> None:
     add_json(p)
 
 
+def _command_words(args) -> list[str]:
+    """The sub-command's words (``export fish``, ``butterfly evolve3d``) of parsed ``args``."""
+    return [w for w in (getattr(args, "command", None), getattr(args, "what", None) or getattr(args, "sub", None))
+            if isinstance(w, str)]
+
+
+def _add_quiet(parser: Parser) -> None:
+    """``--quiet`` on every command that runs (each leaf of the parser tree) that lacks one."""
+    subs = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    if not subs:
+        if "--quiet" not in parser._option_string_actions:
+            parser.add_argument("--quiet", action="store_true",
+                                help="no progress bars and no closing 'done in' line on stderr")
+        return
+    for a in subs:
+        for child in set(a.choices.values()):
+            _add_quiet(child)
+
+
 def build_parser() -> Parser:
     from lifelike_mj import __version__
 
@@ -113,6 +133,7 @@ def build_parser() -> Parser:
             creature(c).add_reproduce_args(q)
         _reproduce_options(q)
         q.set_defaults(func=cmd_reproduce)
+    _add_quiet(top)
     return top
 
 
@@ -170,9 +191,16 @@ def main(argv: list[str] | None = None) -> int:
     from lifelike_mj.io import held_claims, release_claims
 
     before = held_claims()
+    import time
+
+    from lifelike_mj import progress
+
     try:
         args = build_parser().parse_args(join_negative_values(argv))
+        progress.set_enabled(not getattr(args, "quiet", False))
+        t0 = time.perf_counter()
         args.func(args)
+        progress.done_line(" ".join(["lifelike-mj", *_command_words(args)]), time.perf_counter() - t0)
     except UserError as exc:
         print(f"lifelike-mj: error: {exc}", file=sys.stderr)
         return 2

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import copy
 import math
-import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -223,12 +222,11 @@ class Run:
     def open_progress(self) -> None:
         if not self.progress:
             return
-        from tqdm import tqdm
+        from lifelike_mj.progress import bar
 
         done = self.generations if self.budget.kind == "generations" else min(self.evaluations, self.budget.value)
         unit = "gen" if self.budget.kind == "generations" else "eval"
-        self._bar = tqdm(total=self.budget.value, initial=done, unit=unit, desc=self.optimizer, file=sys.stderr,
-                         dynamic_ncols=True)
+        self._bar = bar(self.budget.value, self.optimizer, unit=unit, initial=done, leave=True)
 
     def close_progress(self) -> None:
         if self._bar is not None:

@@ -604,9 +604,9 @@ class Tank(StepCounter):
         P, Q, M = [p0[None]], [q0[None]], [m0[None]]
         bar = None
         if progress:
-            from tqdm import tqdm
+            from lifelike_mj.progress import bar as progress_bar
 
-            bar = tqdm(total=total, unit="step", desc="swim", leave=False)
+            bar = progress_bar(total, "swim", unit="step")
         try:
             done = 0
             while done < total:

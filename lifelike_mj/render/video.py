@@ -92,9 +92,9 @@ def write_frames(out: Path, suffix: str, fps: float, n_frames: int, advance: Cal
     sim_s = render_s = encode_s = 0.0
     bar = None
     if progress:
-        from tqdm import tqdm
+        from lifelike_mj.progress import bar as progress_bar
 
-        bar = tqdm(total=n_frames, unit="frame", desc=desc, leave=False)
+        bar = progress_bar(n_frames, desc, unit="frame")
     try:
         with atomic_path(out) as tmp:
             writer = WRITERS[suffix](tmp, fps)

@@ -1,5 +1,6 @@
 """The command line: documented keys, and bad input as one sentence with exit status 2."""
 
+import argparse
 import json
 import subprocess
 import sys
@@ -173,3 +174,31 @@ def test_json_output_is_strict_with_undefined_values_named(capsys):
     d = json.loads(out, parse_constant=no_constant)
     assert d["burst_interval_mean_s"] is None
     assert d["undefined"]["burst_interval_mean_s"] == "not defined for this run (NaN)"
+
+
+def test_every_command_takes_quiet_and_ends_with_one_done_line(capsys, tmp_path):
+    """Every command that runs has ``--quiet``; a run ends with one "done in" line on stderr (its bars, all drawn
+    by lifelike_mj.progress, come before it), and ``--quiet`` leaves stderr empty."""
+    from lifelike_mj.cli import build_parser
+    from lifelike_mj.progress import set_enabled
+
+    def leaves(parser, path=()):
+        subs = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+        if not subs:
+            yield " ".join(path), parser
+        for a in subs:
+            for name, child in a.choices.items():
+                yield from leaves(child, (*path, name))
+
+    missing = [w for w, p in leaves(build_parser()) if "--quiet" not in p._option_string_actions]
+    assert not missing, missing
+    try:
+        for command in (["fish", "swim", "--n", "2", "--duration", "1"], ["boids", "run", "--n", "20", "--steps", "20"]):
+            assert main([*command, "--json"]) == 0
+            err = capsys.readouterr().err.strip().splitlines()
+            assert err[-1].startswith(f"lifelike-mj {command[0]} {command[1]}: done in ")
+            assert sum("done in" in line for line in err) == 1
+            assert main([*command, "--json", "--quiet"]) == 0
+            assert capsys.readouterr().err == ""
+    finally:
+        set_enabled(True)
