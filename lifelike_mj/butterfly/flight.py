@@ -114,6 +114,37 @@ class PitchObservation(NamedTuple):
     air_up_m_s: float  #: the air's vertical velocity, m/s (wind from above: < 0)
     air_forward_m_s: float  #: the air's forward velocity, m/s (head wind: < 0)
 
+    # the environment's names of before 0.3, kept one release (a pitch law run in Python may still read them)
+    @property
+    def phi_prev_rad(self) -> float:
+        return _renamed("phi_prev_rad", "phi_rad", self.phi_rad)
+
+    @property
+    def v_y_m_s(self) -> float:
+        return _renamed("v_y_m_s", "climb_m_s", self.climb_m_s)
+
+    @property
+    def y_m(self) -> float:
+        return _renamed("y_m", "altitude_m", self.altitude_m)
+
+    @property
+    def v_z_m_s(self) -> float:
+        return _renamed("v_z_m_s", "forward_m_s", self.forward_m_s)
+
+
+_WARNED: set[str] = set()
+
+
+def _renamed(old: str, new: str, value: float) -> float:
+    """``value``, with a one-line note (once per name and process) that ``old`` is now ``new``."""
+    if old not in _WARNED:
+        import warnings
+
+        _WARNED.add(old)
+        warnings.warn(f"PitchObservation.{old} is now called {new} (the name the environment also uses); the old "
+                      "name goes in the next release.", DeprecationWarning, stacklevel=3)
+    return value
+
 
 @njit(inline="always")
 def builtin_law(kind, cp, obs):

@@ -14,7 +14,28 @@ from lifelike_mj.butterfly import PAPER_FLAP, ButterflyController, ButterflyPara
 from lifelike_mj.errors import Diverged, UserError
 
 #: Names and units of the observation's six entries (the network's inputs, Oe 2010 section 6.1).
-OBSERVATION_NAMES = ("phi_prev_rad", "omega_rad_s", "theta_rad", "v_y_m_s", "y_m", "v_z_m_s")
+#: The six inputs, named as a pitch law's observation names them (:class:`~lifelike_mj.butterfly.flight.PitchObservation`).
+OBSERVATION_NAMES = ("phi_rad", "omega_rad_s", "theta_rad", "climb_m_s", "altitude_m", "forward_m_s")
+#: Their names before 0.3 (kept one release: :func:`observation_index` takes them, with a one-line note).
+OLD_OBSERVATION_NAMES = {"phi_prev_rad": "phi_rad", "v_y_m_s": "climb_m_s", "y_m": "altitude_m",
+                         "v_z_m_s": "forward_m_s"}
+
+
+def observation_index(name: str) -> int:
+    """The index of the input ``name`` in an observation (:data:`OBSERVATION_NAMES`; a name of before 0.3 works
+    for one more release, with a one-line note)."""
+    import warnings
+
+    if name in OLD_OBSERVATION_NAMES:
+        new = OLD_OBSERVATION_NAMES[name]
+        warnings.warn(f"the observation {name!r} is now called {new!r} (the pitch law's name); the old name goes "
+                      "in the next release.", DeprecationWarning, stacklevel=2)
+        name = new
+    if name not in OBSERVATION_NAMES:
+        from lifelike_mj.errors import UserError
+
+        raise UserError(f"the observation has no input {name!r}; its inputs are {', '.join(OBSERVATION_NAMES)}.")
+    return OBSERVATION_NAMES.index(name)
 ACTION_MODES = ("dphi", "phi")
 #: Speeds beyond this end the flight as a runaway (m/s); altitudes are bounded for the space's sake (m).
 RUNAWAY_M_S = 1.0e4
@@ -89,14 +110,18 @@ class ButterflyPitchEnv(gym.Env):
 
     | index | name | unit | meaning |
     |---|---|---|---|
-    | 0 | ``phi_prev_rad`` | rad | the pitch of the previous step |
+    | 0 | ``phi_rad`` | rad | the pitch of the previous step |
     | 1 | ``omega_rad_s`` | rad/s | flap rate (positive on the upstroke) |
     | 2 | ``theta_rad`` | rad | flap angle |
-    | 3 | ``v_y_m_s`` | m/s | vertical velocity, relative to the air or the ground (``inputs``) |
-    | 4 | ``y_m`` | m | altitude above the target altitude 0 m |
-    | 5 | ``v_z_m_s`` | m/s | forward velocity, relative to the air or the ground (``inputs``) |
+    | 3 | ``climb_m_s`` | m/s | vertical velocity, relative to the air or the ground (``inputs``) |
+    | 4 | ``altitude_m`` | m | altitude above the target altitude 0 m |
+    | 5 | ``forward_m_s`` | m/s | forward velocity, relative to the air or the ground (``inputs``) |
 
-    The names are also in ``info["observation_names"]`` at reset.
+    The names are also in ``info["observation_names"]`` at reset. They are the fields of a pitch law's
+    observation (:class:`~lifelike_mj.butterfly.flight.PitchObservation`), so a law written from this table runs
+    as a pitch law (with ``inputs="ground"``, the values too are the same). Before 0.3 they were
+    ``phi_prev_rad``, ``v_y_m_s``, ``y_m`` and ``v_z_m_s``: :func:`observation_index` still takes those, and a
+    pitch law may still read them for one release, each with a one-line note.
 
     ## Reward
 

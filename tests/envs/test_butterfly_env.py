@@ -156,3 +156,31 @@ def test_controller_policy_checks_the_env():
     obs, _ = env.reset()
     assert policy(obs).shape == (1,)
     env.step(policy(obs))
+
+
+def test_the_envs_inputs_are_named_as_a_pitch_laws_and_the_old_names_still_work_one_release():
+    """A law written from the env's table runs as a pitch law: the six names are PitchObservation's fields, and
+    with ground inputs the values are the same; the names of before 0.3 still work, each with a note."""
+    import warnings
+
+    from lifelike_mj.butterfly import flight
+    from lifelike_mj.butterfly.flight import PitchObservation
+    from lifelike_mj.envs.butterfly import OLD_OBSERVATION_NAMES, observation_index
+
+    flight._WARNED.clear()  # the note comes once per process: let this test see it
+
+    assert set(OBSERVATION_NAMES) <= set(PitchObservation._fields)
+    env = ButterflyPitchEnv(inputs="ground")
+    obs, _ = env.reset()
+    for _ in range(30):
+        obs, *_ = env.step(env.action_space.sample() * 0.0)
+    law_obs = env.flight.observation()
+    for i, name in enumerate(OBSERVATION_NAMES):
+        assert obs[i] == pytest.approx(getattr(law_obs, name)), name
+    for old, new in OLD_OBSERVATION_NAMES.items():
+        with pytest.warns(DeprecationWarning, match=new):
+            assert observation_index(old) == OBSERVATION_NAMES.index(new)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        with pytest.warns(DeprecationWarning, match="altitude_m"):
+            assert law_obs.y_m == law_obs.altitude_m
