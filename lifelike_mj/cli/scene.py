@@ -246,8 +246,10 @@ def cmd_scene(args) -> None:
 
     t0 = time.perf_counter()
     data = load_scene(args.scene)
+    from lifelike_mj.progress import enabled
+
     path = export_scene(args.scene, args.out, args.format, args.rotations, args.key_tolerance, args.overwrite,
-                        quiet=args.json)
+                        quiet=args.json or not enabled())
     size = path.stat().st_size
     info = {"out": str(path), "bytes": size, "parts": [p["name"] for p in data["parts"]],
             "duration_s": data["duration_s"], "seconds": time.perf_counter() - t0}
