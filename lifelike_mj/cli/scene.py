@@ -63,7 +63,7 @@ def json_schema() -> dict:
         "yaw_deg": number("the part's turn about the vertical, deg", -360, 360),
         "bird_length_m": number("a flock only: a bird's length in the scene, m", exclusive_minimum=0, maximum=10),
         "still": {"type": "boolean", "description": "draw the part's still geoms (tank, flowers; default true)"},
-        "follow": {"type": "array", "items": {"type": "string", "maxLength": 100}, "maxItems": 16,
+        "follow": {"type": "array", "items": {"type": "string", "maxLength": 100}, "maxItems": 16, "uniqueItems": True,
                    "description": "the creatures (rig names) that get a follow camera"}}}
     props = {"duration_s": number("seconds of playback every part is recorded for", exclusive_minimum=0,
                                   maximum=MAX_DURATION_S),

@@ -146,6 +146,8 @@ BAD = {
     "a creature not in the part": (lambda d: d["parts"][2].update(follow=["boid99"]), "boid99"),
     "a bird size for fish": (lambda d: d["parts"][1].update(bird_length_m=0.1), "bird_length_m"),
     "two parts of one name": (lambda d: d["parts"][1].update(name="garden"), "twice"),
+    "one creature followed twice": (lambda d: d["parts"][0].update(follow=["b0_butterfly"] * 2), "follow"),
+    "no parts": (lambda d: d.update(parts=[]), "parts"),
     "too long": (lambda d: d.update(duration_s=1e6), "duration_s"),
 }
 
