@@ -24,6 +24,8 @@ _configure_numba_cache()  # before anything imports numba: a cache that cannot s
 
 __getattr__, __dir__, __all__ = attach(__name__, {
     "butterfly": ".", "fish": ".", "boids": ".", "evolve": ".", "render": ".", "physics": ".", "stepper": ".",
+    "envs": ".", "export": ".", "checks": ".", "errors": ".", "io": ".", "machine": ".", "paths": ".",
+    "progress": ".", "provenance": ".", "schema": ".",
     "Stepper": "stepper", "Playback": "stepper", "UserError": "errors", "Diverged": "errors",
 }, globals())
 __all__ = [*__all__, "__version__"]

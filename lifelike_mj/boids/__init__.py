@@ -29,4 +29,5 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "view_boids": "render", "reproduce": "report",
     "engine": ".", "metrics": ".", "figures": ".", "render": ".", "presets": ".", "sim": ".", "scene": ".",
     "experiments": ".", "report": ".",
+    "bench": ".", "look": ".", "palette": ".",
 }, globals())

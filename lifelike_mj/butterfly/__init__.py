@@ -49,4 +49,6 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "experiments": ".", "ann_experiments": ".", "figures": ".", "ann_figures": ".", "backends": ".", "aero": ".",
     "controllers": ".", "ann": ".", "render": ".", "report": ".", "sim": ".", "flight": ".", "params": ".",
     "model": ".", "evolution": ".",
+    "bench": ".", "look": ".", "sim3d": ".", "control3d": ".", "evolve3d": ".", "kinematics3d": ".",
+    "validate3d": ".", "figures3d": ".", "garden": ".",
 }, globals())

@@ -21,6 +21,8 @@ starting state, episode end, arguments, version history).
 
 from __future__ import annotations
 
+from lifelike_mj._lazy import attach
+
 #: The registered ids and their entry points.
 ENVS = {
     "lifelike_mj/ButterflyPitch-v0": "lifelike_mj.envs.butterfly:ButterflyPitchEnv",
@@ -44,18 +46,10 @@ def register_envs() -> None:
                      vector_entry_point=_VECTOR.get(env_id))
 
 
-def __getattr__(name: str):
-    if name in ("ButterflyPitchEnv", "ButterflyPitchWindEnv"):
-        from lifelike_mj.envs import butterfly
-
-        return getattr(butterfly, name)
-    if name == "ButterflyPitchVectorEnv":
-        from lifelike_mj.envs.vector import ButterflyPitchVectorEnv
-
-        return ButterflyPitchVectorEnv
-    raise AttributeError(name)
-
-
-__all__ = ["ENVS", "ButterflyPitchEnv", "ButterflyPitchVectorEnv", "ButterflyPitchWindEnv", "register_envs"]
+__getattr__, __dir__, _names = attach(__name__, {
+    "ButterflyPitchEnv": "butterfly", "ButterflyPitchWindEnv": "butterfly", "ButterflyPitchVectorEnv": "vector",
+    "butterfly": ".", "vector": ".", "policies": ".",
+}, globals())
+__all__ = ["ENVS", "register_envs", *_names]
 
 register_envs()

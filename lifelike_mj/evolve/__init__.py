@@ -10,6 +10,7 @@
 
 from __future__ import annotations
 
+from lifelike_mj.evolve import checkpoint, cmaes, driver, evaluators, nloptalgs, optimizers, problem, rcga, testproblems
 from lifelike_mj.evolve.driver import OptimizationResult
 from lifelike_mj.evolve.evaluators import EXECUTORS, Evaluator, make_evaluator
 from lifelike_mj.evolve.optimizers import DEFAULT_GENERATIONS, OPTIMIZERS, default_population, minimum_population, optimize
@@ -19,4 +20,6 @@ from lifelike_mj.evolve.testproblems import Rastrigin, Sphere
 __all__ = [
     "DEFAULT_GENERATIONS", "EXECUTORS", "OPTIMIZERS", "Evaluator", "OptimizationResult", "Problem", "Rastrigin",
     "Sphere", "default_population", "make_evaluator", "minimum_population", "optimize",
+    # the submodules, for the API reference
+    "checkpoint", "cmaes", "driver", "evaluators", "nloptalgs", "optimizers", "problem", "rcga", "testproblems",
 ]

@@ -29,4 +29,5 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "view_fish": "render", "reproduce": "report",
     "metrics": ".", "figures": ".", "render": ".", "params": ".", "sim": ".", "scene": ".", "experiments": ".",
     "report": ".",
+    "aquarium": ".", "bench": ".", "look": ".",
 }, globals())

@@ -18,5 +18,5 @@ from lifelike_mj._lazy import attach
 __getattr__, __dir__, __all__ = attach(__name__, {
     "ensure_gl_backend": "gl", "Offscreen": "offscreen", "film": "video", "write_png": "video", "has_display": "viewer",
     "require_display": "viewer", "view": "viewer", "new_figure": "plot", "save": "plot",
-    "gl": ".", "offscreen": ".", "video": ".", "viewer": ".", "camera": ".", "plot": ".",
+    "gl": ".", "offscreen": ".", "video": ".", "viewer": ".", "camera": ".", "plot": ".", "web": ".",
 }, globals())
