@@ -20,7 +20,16 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
-from lifelike_mj.cli.common import Parser, add_json, add_overwrite, check_outputs, count, emit, join_negative_values
+from lifelike_mj.cli.common import (
+    Parser,
+    add_json,
+    add_overwrite,
+    check_outputs,
+    count,
+    emit,
+    join_negative_values,
+    take_notes,
+)
 from lifelike_mj.errors import UserError
 
 #: The creatures, in the order of ``reproduce all``.
@@ -200,8 +209,11 @@ def main(argv: list[str] | None = None) -> int:
         progress.set_enabled(not getattr(args, "quiet", False))
         t0 = time.perf_counter()
         args.func(args)
+        for text in take_notes():
+            print(f"note: {text}", file=sys.stderr)
         progress.done_line(" ".join(["lifelike-mj", *_command_words(args)]), time.perf_counter() - t0)
     except UserError as exc:
+        take_notes()  # an error is one sentence
         print(f"lifelike-mj: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:

@@ -14,6 +14,7 @@ from lifelike_mj.cli.common import (
     add_overwrite,
     add_run_files,
     add_seed,
+    add_wind,
     check_executor,
     check_outputs,
     count,
@@ -31,17 +32,6 @@ MAX_VIDEO_S = 600.0
 MAX_WIND_CELLS = 40_000
 FLY_FILES = ("trajectory.npz", "trajectory.csv", "flight.png", "summary.json")
 HELP = "the butterfly of Oe et al. 2010"
-
-
-def _wind(text: str) -> tuple[float, float]:
-    parts = text.split(",")
-    try:
-        a, b = (float(p) for p in parts)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"--wind needs two numbers A,B in m/s, got {text!r}") from None
-    if not (math.isfinite(a) and math.isfinite(b)):
-        raise argparse.ArgumentTypeError(f"--wind needs two finite numbers, got {text!r}")
-    return a, b
 
 
 def add_physics(p: argparse.ArgumentParser) -> None:
@@ -285,8 +275,7 @@ def add_commands(sub) -> None:
     add_physics(p)
     _add_backend(p)
     p.add_argument("--y0", type=num(-1000, 1000, unit="m"), default=0.0, help="start altitude, m, within +-1000")
-    p.add_argument("--wind", type=_wind, default=(0.0, 0.0),
-                   help="wind A,B in m/s, each within +-50: where it comes from (forward, up); e.g. --wind -2,0")
+    add_wind(p, 2, "from", "forward, up")
     p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=20.0,
                    help=f"seconds of flight, at most {MAX_DURATION_S:g}")
     p.add_argument("--dt", type=num(0, 0.0125, lo_open=True, unit="s"), default=1.0 / 1200.0,
@@ -358,7 +347,7 @@ def _add_scene(p: argparse.ArgumentParser) -> None:
     p.add_argument("--config", default="paper", choices=("paper", "rich"), help="MuJoCo configuration: paper or rich")
     p.add_argument("--force-mode", default=None, choices=("tip", "strip"), help="tip or strip (default: the configuration's)")
     p.add_argument("--y0", type=num(-1000, 1000, unit="m"), default=0.0, help="start altitude, m")
-    p.add_argument("--wind", type=_wind, default=(0.0, 0.0), help="wind A,B in m/s: where it comes from, e.g. -2,0")
+    add_wind(p, 2, "from", "forward, up")
 
 
 def add_view_args(p: argparse.ArgumentParser) -> None:

@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import math
 from pathlib import Path
 
-from lifelike_mj.cli.common import add_json, add_overwrite, add_run_files, add_seed, check_outputs, count, emit, num
+from lifelike_mj.cli.common import add_json, add_overwrite, add_run_files, add_seed, add_wind, check_outputs, count, emit, num
 from lifelike_mj.errors import UserError
 from lifelike_mj.progress import stage
 
@@ -16,16 +15,6 @@ MAX_DURATION_S = 3600.0
 #: The settling time of assess3d's level flight (s), and the most courses it flies.
 LEVEL_SETTLE_S = 5.0
 MAX_COURSES = 1000
-
-
-def _vector3(text: str) -> tuple[float, float, float]:
-    try:
-        v = tuple(float(x) for x in text.split(","))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected three numbers X,Y,Z in m/s, got {text!r}") from None
-    if len(v) != 3 or not all(math.isfinite(x) and abs(x) <= 50 for x in v):
-        raise argparse.ArgumentTypeError(f"expected three numbers X,Y,Z in m/s, each within +-50, got {text!r}")
-    return v  # type: ignore[return-value]
 
 
 def _task(args):
@@ -168,8 +157,7 @@ def cmd_garden(args) -> None:
 
 
 def _add_weather(p, what: str, seed: str) -> None:
-    p.add_argument("--wind", type=_vector3, default=(0.0, 0.0, 0.0),
-                   help=what + "mean wind X,Y,Z in m/s (where it blows to)")
+    add_wind(p, 3, "to", "x, y, z", what + "mean ", bound=50.0)
     p.add_argument("--gusts", type=num(0, 10, unit="m/s"), default=0.0,
                    help=what + f"gusts' standard deviation, m/s (horizontal; correlation time 1 s; drawn from {seed})")
     p.add_argument("--vertical-gusts", type=num(0, 10, unit="m/s"), default=None,

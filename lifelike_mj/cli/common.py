@@ -192,3 +192,88 @@ def check_outputs(args: argparse.Namespace, files: dict[str, tuple[str, ...]] | 
             value = getattr(args, opt.lstrip("-").replace("-", "_"), None)
             if value:
                 check_output_dir(value, opt, names, overwrite=overwrite, claim=claim)
+
+
+_NOTES: list[str] = []
+
+
+def note(text: str) -> None:
+    """A one-line note for the user (an old spelling still taken), printed on stderr once the command has run
+    (:func:`take_notes`), so that an error stays one sentence."""
+    if text not in _NOTES:
+        _NOTES.append(text)
+
+
+def take_notes() -> list[str]:
+    """The notes gathered so far, emptied."""
+    out = list(_NOTES)
+    _NOTES.clear()
+    return out
+
+
+class _WindAction(argparse.Action):
+    """Stores a wind given as where it comes from (``from``) or where it blows to (``to``) in the command's own
+    meaning (``native``); the old spelling ``--wind`` (``old``) stores it as given, with a one-line note."""
+
+    def __init__(self, *args, sense: str = "", native: str = "", **kwargs) -> None:
+        self.sense, self.native = sense, native
+        super().__init__(*args, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        if self.sense == "old":
+            meaning = "where it comes from" if self.native == "from" else "where it blows to"
+            note(f"--wind is now --wind-{self.native} ({meaning}); --wind goes in the next release.")
+            v = tuple(values)
+        else:
+            v = tuple(values) if self.sense == self.native else tuple(-x for x in values)
+        setattr(namespace, self.dest, tuple(x + 0.0 for x in v))  # + 0.0: no -0.0 from a negated 0
+
+
+def wind_vector(dims: int, names: str, bound: float | None = None):
+    """An argparse ``type``: ``dims`` finite numbers (m/s), comma-separated, named ``names`` in the message; each
+    within +-``bound`` where one is given."""
+    import math
+
+    word = {2: "two", 3: "three"}[dims]
+
+    def parse(text: str) -> tuple[float, ...]:
+        try:
+            v = tuple(float(x) for x in text.split(","))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"needs {word} numbers {names} in m/s, got {text!r}") from None
+        if len(v) != dims:
+            raise argparse.ArgumentTypeError(f"needs {word} numbers {names} in m/s, got {text!r}")
+        if not all(math.isfinite(x) for x in v):
+            raise argparse.ArgumentTypeError(f"needs {word} numbers {names} in m/s, all finite, got {text!r}")
+        if bound is not None and not all(abs(x) <= bound for x in v):
+            raise argparse.ArgumentTypeError(f"needs {word} numbers {names} in m/s, each within +-{bound:g}, "
+                                             f"got {text!r}")
+        return v
+
+    return parse
+
+
+def add_wind(p: argparse.ArgumentParser, dims: int, native: str, axes: str, what: str = "",
+             bound: float | None = None) -> None:
+    """``--wind-from`` and ``--wind-to`` (one or the other: the same wind, negated), stored in ``args.wind`` in the
+    command's own convention ``native`` (``"from"``: the planar flight's, where the paper's wind map says the wind
+    comes from; ``"to"``: the 3D flight's, the air's velocity); ``--wind``, the spelling of before 0.3, keeps the
+    command's own meaning for one more release, with a one-line note. ``axes``: the components' names;
+    ``bound``: the largest component (m/s), or None where the model checks it."""
+    names = ",".join(axes.split(", ")).upper()
+    kind = wind_vector(dims, names, bound)
+    g = p.add_mutually_exclusive_group()
+    zero = tuple(0.0 for _ in range(dims))
+    first = axes.split(", ")[0]
+    example = "2,0" + ",0" * (dims - 2)
+    ahead = "ahead: a head wind" if first == "forward" else f"+{first}"
+    behind = "forward: a tail wind" if first == "forward" else f"toward +{first}"
+    g.add_argument("--wind-from", dest="wind", type=kind, default=zero, action=_WindAction, sense="from",
+                   native=native, metavar=names,
+                   help=f"{what}wind ({axes}) in m/s, given as where it comes from ({example} comes from {ahead})")
+    g.add_argument("--wind-to", dest="wind", type=kind, default=zero, action=_WindAction, sense="to", native=native,
+                   metavar=names, help=f"{what}wind ({axes}) in m/s, given as where it blows to, the air's velocity "
+                                       f"({example} blows {behind})")
+    g.add_argument("--wind", dest="wind", type=kind, default=zero, action=_WindAction, sense="old", native=native,
+                   metavar=names, help=f"the older spelling of --wind-{native}")
+

@@ -202,3 +202,33 @@ def test_every_command_takes_quiet_and_ends_with_one_done_line(capsys, tmp_path)
             assert capsys.readouterr().err == ""
     finally:
         set_enabled(True)
+
+
+def test_wind_is_given_by_its_meaning_and_the_old_spelling_keeps_its_own_one_release(capsys):
+    """--wind-from (where it comes from) and --wind-to (the air's velocity) on the planar and the 3D flight: the
+    same wind either way; --wind keeps each command's old meaning (from in 2D, to in 3D) with a note that comes
+    after the run (so an error stays one sentence); two spellings at once are refused."""
+    from lifelike_mj.cli import build_parser
+    from lifelike_mj.cli.common import take_notes
+
+    p = build_parser()
+    fly = ["butterfly", "fly", "--controller", "simple_rule"]
+    assert p.parse_args([*fly, "--wind-from", "2,0.5"]).wind == (2.0, 0.5)
+    assert p.parse_args([*fly, "--wind-to=-2,-0.5"]).wind == (2.0, 0.5)
+    assert p.parse_args([*fly, "--wind", "2,0.5"]).wind == (2.0, 0.5)
+    assert take_notes() == ["--wind is now --wind-from (where it comes from); --wind goes in the next release."]
+    fly3d = ["butterfly", "fly3d"]
+    assert p.parse_args([*fly3d, "--wind-to", "1,0,0"]).wind == (1.0, 0.0, 0.0)
+    assert p.parse_args([*fly3d, "--wind-from=-1,0,0"]).wind == (1.0, 0.0, 0.0)
+    assert p.parse_args([*fly3d, "--wind", "1,0,0"]).wind == (1.0, 0.0, 0.0)
+    assert take_notes() == ["--wind is now --wind-to (where it blows to); --wind goes in the next release."]
+    runs = []
+    for spelling in (["--wind-from", "2,0"], ["--wind-to", "-2,0"], ["--wind", "2,0"]):
+        assert main([*fly, "--duration", "1", *spelling, "--json", "--quiet"]) == 0
+        out, err = capsys.readouterr()
+        runs.append(json.loads(out)["final_altitude_m"])
+        assert err == ("" if spelling[0] != "--wind" else
+                       "note: --wind is now --wind-from (where it comes from); --wind goes in the next release.\n")
+    assert runs[0] == runs[1] == runs[2]
+    assert main([*fly, "--wind-from", "2,0", "--wind-to", "1,0"]) == 2
+    assert "not allowed with" in capsys.readouterr().err
