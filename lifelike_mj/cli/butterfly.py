@@ -54,14 +54,33 @@ def params(args):
         rho=args.rho, cd=args.cd)
 
 
+def _inputs(words: tuple[str, ...]):
+    """An argparse ``type`` for ``--inputs``: the words the 3D flight also uses (``air``, ``ground``; ``both``
+    where given), returned as the planar model's own (``air`` is its ``relative``); ``relative``, the spelling of
+    before 0.3, is taken one more release with a note."""
+
+    def parse(text: str) -> str:
+        from lifelike_mj.cli.common import note
+
+        if text == "relative":
+            note("--inputs relative is now --inputs air (velocities through the air); 'relative' goes in the next "
+                 "release.")
+            return "relative"
+        if text not in words:
+            raise argparse.ArgumentTypeError(f"expected {', '.join(words[:-1])} or {words[-1]}, got {text!r}")
+        return "relative" if text == "air" else text
+
+    return parse
+
+
 def _add_controller(p: argparse.ArgumentParser, required: bool = True) -> None:
     p.add_argument("--controller", required=required, default=None if required else "simple_rule",
                    help="shipped controller name (e.g. simple_rule) or path to a controller JSON file")
     p.add_argument("--phi-up-deg", type=num(-90, 90, unit="deg"), help="override simple_rule's upstroke pitch, deg")
     p.add_argument("--phi-down-deg", type=num(-90, 90, unit="deg"), help="override simple_rule's downstroke pitch, deg")
     p.add_argument("--phi-deg", type=num(-90, 90, unit="deg"), help="override a constant controller's pitch, deg")
-    p.add_argument("--inputs", choices=("relative", "ground"), default=None,
-                   help="network controllers: feed relative (air) or ground velocities (section 7.2)")
+    p.add_argument("--inputs", type=_inputs(("air", "ground")), default=None, metavar="{air,ground}",
+                   help="network controllers: feed velocities through the air or over the ground (section 7.2)")
 
 
 def _controller(args):
@@ -299,8 +318,8 @@ def add_commands(sub) -> None:
                    help="budget in evaluations instead of generations, up to 10^9")
     add_seed(p)
     p.add_argument("--backend", default="paper", choices=("paper", "mujoco"), help="paper (compiled eq. 7-11) or mujoco")
-    p.add_argument("--inputs", default=None, choices=("relative", "ground", "both"),
-                   help="velocity inputs: relative (air), ground, or both (default: relative; robust task: both)")
+    p.add_argument("--inputs", default=None, type=_inputs(("air", "ground", "both")), metavar="{air,ground,both}",
+                   help="velocity inputs: through the air, over the ground, or both (default: air; robust task: both)")
     add_executor(p)
     add_run_files(p, "controller file to write (.json; default butterfly_OPT_TASK_sSEED.json)")
     add_json(p)

@@ -75,7 +75,7 @@ CASES = [
     (FLY + ["--rho", "inf"], "--rho", {}),
     (FLY + ["--cd", "1e6"], "(0, 10]", {}),
     (FLY + ["--phi-up-deg", "1000"], "[-90, 90] deg", {}),
-    (FLY + ["--inputs", "air"], "invalid choice: 'air'", {}),
+    (FLY + ["--inputs", "sky"], "expected air or ground", {}),
     (FLY + ["--out", "afile"], "is a file; give a folder", {"afile": "x"}),
     (FLY + ["--out", "done"], "already holds summary.json", {"done/summary.json": "{}"}),
     (FLY + ["--out", "/proc/lifelike"], "cannot be written", {}),
@@ -113,7 +113,7 @@ CASES = [
     (EVO + ["--hidden", "a,b"], "--hidden", {}),
     (EVO + ["--hidden", "0"], "hidden layers", {}),
     (EVO + ["--task", "elsewhere"], "unknown task", {}),
-    (EVO + ["--inputs", "sideways"], "invalid choice", {}),
+    (EVO + ["--inputs", "sideways"], "expected air, ground or both", {}),
     (EVO + ["--backend", "gpu"], "invalid choice", {}),
     # --- other butterfly commands
     (["butterfly", "windmap", "--controller", "simple_rule"], "network", {}),

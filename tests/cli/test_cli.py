@@ -232,3 +232,18 @@ def test_wind_is_given_by_its_meaning_and_the_old_spelling_keeps_its_own_one_rel
     assert runs[0] == runs[1] == runs[2]
     assert main([*fly, "--wind-from", "2,0", "--wind-to", "1,0"]) == 2
     assert "not allowed with" in capsys.readouterr().err
+
+
+def test_inputs_say_air_on_both_flights_and_relative_still_works_one_release():
+    from lifelike_mj.cli import build_parser
+    from lifelike_mj.cli.common import take_notes
+
+    p = build_parser()
+    fly = ["butterfly", "fly", "--controller", "ann_paper"]
+    assert p.parse_args([*fly, "--inputs", "air"]).inputs == "relative"  # the planar model's own word
+    assert p.parse_args([*fly, "--inputs", "ground"]).inputs == "ground" and take_notes() == []
+    assert p.parse_args([*fly, "--inputs", "relative"]).inputs == "relative"
+    assert take_notes() == ["--inputs relative is now --inputs air (velocities through the air); 'relative' goes "
+                            "in the next release."]
+    assert p.parse_args(["butterfly", "evolve", "--optimizer", "rcga", "--inputs", "both"]).inputs == "both"
+    assert p.parse_args(["butterfly", "evolve3d", "--inputs", "air"]).inputs == "air"
