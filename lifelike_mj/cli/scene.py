@@ -186,41 +186,39 @@ def scene_parts(scene: dict | str | Path, where: str = "the scene", quiet: bool 
             rigs = mod.export_rigs(poses, metres_per_unit=scale) if looks == "rig" else None
         elif looks == "rig":
             rigs = mod.export_rigs(poses)
+        made = {"creature": part["creature"], **parameters}
+        if part["creature"] == "boids":
+            made["bird_length_m"] = part.get("bird_length_m")
         parts.append(Part(part["name"], poses, rigs, tuple(part.get("at_m", (0.0, 0.0, 0.0))),
                           float(part.get("yaw_deg", 0.0)), scale, bool(part.get("still", True)),
-                          tuple(part.get("follow", ())),
-                          {"creature": part["creature"], **parameters, "bird_length_m": part.get("bird_length_m")}
-                          if part["creature"] == "boids" else {"creature": part["creature"], **parameters}))
+                          tuple(part.get("follow", ())), made))
         if not quiet:
             import sys
 
             print(f"part {part['name']}: {part['creature']}, {len(poses.body_ids)} bodies, {poses.n_samples:,} "
                   f"samples in {time.perf_counter() - t0:.1f} s", file=sys.stderr, flush=True)
-    for p in parts:  # the follow names exist: the rigs are named now
-        p.check()
     return parts
 
 
 def export_scene(scene: dict | str | Path, out: str | Path, fmt: str | None = None, rotations: str = "short",
-                 tolerance="0.5mm,0.5deg", overwrite: bool = False, quiet: bool = True) -> Path:
-    """Run ``scene`` (:func:`scene_parts`) and write it to ``out`` (glb, gltf or html; :func:`~lifelike_mj.export
-    .scene.write_scene`), the output checked first. Returns the path."""
-    from lifelike_mj.export import format_of
+                 tolerance="0.5mm,0.5deg", overwrite: bool = False, quiet: bool = True,
+                 where: str = "the scene") -> Path:
+    """Run ``scene`` (:func:`scene_parts`: a scene file's path, or its content, named ``where`` in messages) and
+    write it to ``out`` (glb, gltf or html; :func:`~lifelike_mj.export.scene.write_scene`), the output checked
+    first. Returns the path."""
     from lifelike_mj.export.keys import tolerance_of
-    from lifelike_mj.export.scene import write_scene
+    from lifelike_mj.export.scene import scene_format, write_scene
     from lifelike_mj.paths import check_output_file
 
-    fmt = format_of(out, fmt)
-    if fmt == "usd":
-        raise UserError("a scene is written as glTF (.glb, .gltf) or a web page (.html); USD takes one run "
-                        "(lifelike-mj export CREATURE --out FILE.usd).")
+    fmt = scene_format(out, fmt)
     tol = tolerance_of(tolerance)
     check_output_file(out, "--out", overwrite=overwrite)
-    data = scene if isinstance(scene, dict) else load_scene(scene)
-    parts = scene_parts(data, "the scene" if isinstance(scene, dict) else f"scene file {scene}", quiet=quiet)
-    return write_scene(parts, out, fmt, name=f"lifelike-mj scene {data.get('name', '')}".strip(),
-                       parameters={"scene": data}, rotations=rotations, tolerance=tol,
-                       ground_half_m=data.get("ground_half_m", 20.0))
+    if not isinstance(scene, dict):
+        scene, where = load_scene(scene), f"scene file {scene}"
+    parts = scene_parts(scene, where, quiet=quiet)
+    return write_scene(parts, out, fmt, name=f"lifelike-mj scene {scene.get('name', '')}".strip(),
+                       parameters={"scene": scene}, rotations=rotations, tolerance=tol,
+                       ground_half_m=scene.get("ground_half_m", 20.0))
 
 
 def add_scene_command(per) -> None:
@@ -248,8 +246,8 @@ def cmd_scene(args) -> None:
     data = load_scene(args.scene)
     from lifelike_mj.progress import enabled
 
-    path = export_scene(args.scene, args.out, args.format, args.rotations, args.key_tolerance, args.overwrite,
-                        quiet=args.json or not enabled())
+    path = export_scene(data, args.out, args.format, args.rotations, args.key_tolerance, args.overwrite,
+                        quiet=args.json or not enabled(), where=f"scene file {args.scene}")
     size = path.stat().st_size
     info = {"out": str(path), "bytes": size, "parts": [p["name"] for p in data["parts"]],
             "duration_s": data["duration_s"], "seconds": time.perf_counter() - t0}

@@ -49,12 +49,17 @@ class Framing:
         return _axes(self.direction)
 
     def look_quat_wxyz(self) -> np.ndarray:
-        """The cameras' orientation (w, x, y, z) in MuJoCo's world, for a glTF camera (it looks along its
-        own -Z, with +Y up): looking along ``-direction`` with the world's Z up in the picture."""
-        R = np.column_stack(self.axes())
-        q = np.empty(4)
-        mujoco.mju_mat2Quat(q, R.reshape(-1))
-        return q
+        """The cameras' orientation (:func:`look_quat_wxyz` of ``direction``)."""
+        return look_quat_wxyz(self.direction)
+
+
+def look_quat_wxyz(direction: np.ndarray) -> np.ndarray:
+    """A camera's orientation (w, x, y, z) in MuJoCo's world, for a glTF camera (it looks along its own -Z, with
+    +Y up): looking along ``-direction`` with the world's Z up in the picture."""
+    R = np.column_stack(_axes(direction))
+    q = np.empty(4)
+    mujoco.mju_mat2Quat(q, R.reshape(-1))
+    return q
 
 
 def _axes(back: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -33,7 +33,7 @@ import mujoco
 import numpy as np
 
 from lifelike_mj.errors import UserError
-from lifelike_mj.export.cameras import FOLLOW_MIN_M, FOLLOW_SIZES, bounds, overview, view_direction
+from lifelike_mj.export.cameras import FOLLOW_MIN_M, FOLLOW_SIZES, bounds, look_quat_wxyz, overview, view_direction
 from lifelike_mj.export.keys import DEFAULT_TOLERANCE, lerp_keys, tolerance_of
 from lifelike_mj.export.poses import Poses
 from lifelike_mj.export.rig import Rig, qaxis, qrot
@@ -177,7 +177,7 @@ def build_scene_gltf(parts: list[Part], name: str = "lifelike-mj scene", paramet
             "follow": list(part.follow), "parameters": part.parameters,
             "frames": frames_record(part.poses, rotations), "keys": done["keys"], "rigs": done["rigs"]}
     direction = view_direction()
-    look = _look(direction)
+    look = look_quat_wxyz(direction)
     centre, distance = overview(*scene_box(parts), direction)
     add_camera(doc, doc.root, "overview", look, centre + direction * distance, distance)
     for part in parts:
@@ -189,12 +189,6 @@ def build_scene_gltf(parts: list[Part], name: str = "lifelike-mj scene", paramet
             keys = lerp_keys(t, path, tolerance[0]) if len(t) > 1 else np.zeros(1, dtype=np.int64)
             add_camera(doc, doc.root, f"follow {part.name}/{who}", look, path, dist, t, keys)
     return doc.finish(prov)
-
-
-def _look(direction: np.ndarray) -> np.ndarray:
-    from lifelike_mj.export.cameras import Framing
-
-    return Framing(np.zeros(3), direction, None, 0.0, 0.0).look_quat_wxyz()
 
 
 def scene_view(parts: list[Part]) -> dict:
@@ -213,19 +207,24 @@ def scene_view(parts: list[Part]) -> dict:
     return view
 
 
+def scene_format(path: str | Path, fmt: str | None = None) -> str:
+    """The format a scene is written in, from ``path``'s ending (checked against ``fmt``): glb, gltf or html."""
+    from lifelike_mj.export import format_of
+
+    fmt = format_of(path, fmt)
+    if fmt == "usd":
+        raise UserError("a scene is written as glTF (.glb, .gltf) or a web page (.html); USD takes one run "
+                        "(lifelike-mj export CREATURE --out FILE.usd).")
+    return fmt
+
+
 def write_scene(parts: list[Part], path: str | Path, fmt: str | None = None, name: str = "lifelike-mj scene",
                 parameters: dict | None = None, rotations: str = "short", tolerance=DEFAULT_TOLERANCE,
                 ground_half_m: float | None = 20.0) -> Path:
     """Write the scene of ``parts`` (module docstring) as glTF (``.glb``, ``.gltf``) or a web page (``.html``),
     atomically. Returns the path."""
-    from lifelike_mj.export import format_of
-
     path = Path(path)
-    fmt = format_of(path, fmt)
-    if fmt == "usd":
-        raise UserError("a scene is written as glTF (.glb, .gltf) or a web page (.html); USD takes one run "
-                        "(lifelike-mj export CREATURE --out FILE.usd).")
-    _check(parts)
+    fmt = scene_format(path, fmt)
     gl = build_scene_gltf(parts, name, parameters, rotations, tolerance, ground_half_m)
     if fmt == "html":
         from lifelike_mj.export.html import page
@@ -239,4 +238,5 @@ def write_scene(parts: list[Part], path: str | Path, fmt: str | None = None, nam
     return save(gl, path)
 
 
-__all__ = ["GROUND_XML", "Part", "build_scene_gltf", "ground_poses", "scene_box", "scene_view", "write_scene"]
+__all__ = ["GROUND_XML", "Part", "build_scene_gltf", "ground_poses", "scene_box", "scene_format", "scene_view",
+           "write_scene"]
