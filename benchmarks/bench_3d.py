@@ -10,7 +10,7 @@ on every core by one compiled ``prange`` loop:
 * the same with the callback, each part alone: gravity and the joints' drive only (``none``), eq. 1 exactly
   (``exact``, the default: **the model's own step**, its physics included), eq. 1 on 48 and 144 panels per
   wing (``strip``), the quasi-steady law on 48 (``quasi_steady``);
-* **evaluation**: what an evolution runs, :func:`~lifelike_mj.butterfly.control3d.fly_batch` with the shipped
+* **evaluation**: what an evolution runs, :func:`~lifelike_mj.butterfly.flight3d.loop.fly_batch` with the shipped
   controller on a level-flight task (the default law, the network every step), paired with both floors;
 * the pipeline's own profile (``mjData.timer``) of one butterfly;
 * the garden: 20 butterflies flying their courses, simulated seconds per wall-clock second.
@@ -26,10 +26,9 @@ import mujoco
 import numpy as np
 from numba import njit, prange
 
-from lifelike_mj.butterfly import control3d as c3
-from lifelike_mj.butterfly import evolve3d as e3
-from lifelike_mj.butterfly.backends import mj3d
-from lifelike_mj.butterfly.kinematics3d import Kinematics
+from lifelike_mj.butterfly import flight3d
+from lifelike_mj.butterfly.flight3d import model as mj3d
+from lifelike_mj.butterfly.flight3d.kinematics import Kinematics
 from lifelike_mj.io import write_json
 from lifelike_mj.machine import machine_info
 from lifelike_mj.physics import mjabi
@@ -66,14 +65,14 @@ def stepped(m, n_copies: int, n_steps: int, callback: bool, **kw) -> float:
 
 def evaluation(m, ctl, n_copies: int, n_steps: int) -> float:
     """Butterfly-steps per second of the evolution's batch (the controller every step, level flight)."""
-    prob = e3.FlightProblem3D((e3.level(1.5),), ctl, duration_s=n_steps * DT)
+    prob = flight3d.FlightProblem3D((flight3d.level(1.5),), ctl, duration_s=n_steps * DT)
     prob._model = m
     w = np.tile(ctl.weights, (n_copies, 1))
     prob.fly(w[:2])  # compile
     t = time.perf_counter()
     recs = prob.fly(w)
     el = time.perf_counter() - t
-    assert np.all(recs[:, 0, c3.R_STEPS] == n_steps), "a benchmark flight tumbled or diverged"
+    assert np.all(recs[:, 0, flight3d.tasks.R_STEPS] == n_steps), "a benchmark flight tumbled or diverged"
     return n_copies * n_steps / el
 
 
@@ -91,7 +90,7 @@ def profile(m) -> dict:
 
 
 def garden_speed(ctl, n: int, seconds: float) -> float:
-    from lifelike_mj.butterfly.garden import Garden
+    from lifelike_mj.butterfly.flight3d.garden import Garden
 
     g = Garden(n, ctl, seed=0)
     g.step(12)
@@ -110,7 +109,7 @@ def main() -> None:
     args = ap.parse_args()
     m = mj3d.build_model()
     m.opt.timestep = DT
-    ctl = c3.load_controller(args.controller)
+    ctl = flight3d.load_controller(args.controller)
     cases = {
         "floor: bare mj_step": lambda: stepped(m, args.copies, args.steps, False),
         "callback, no air (drive only)": lambda: stepped(m, args.copies, args.steps, True, force_law="none"),

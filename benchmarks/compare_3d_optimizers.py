@@ -12,9 +12,8 @@ import argparse
 import time
 from pathlib import Path
 
-from lifelike_mj.butterfly import control3d as c3
-from lifelike_mj.butterfly import evolve3d as e3
-from lifelike_mj.butterfly.validate3d import course_check, level_check, turn_check
+from lifelike_mj.butterfly import flight3d
+from lifelike_mj.butterfly.flight3d.validate import course_check, level_check, turn_check
 from lifelike_mj.evolve import optimize
 from lifelike_mj.io import write_json
 from lifelike_mj.machine import machine_info
@@ -23,8 +22,8 @@ from lifelike_mj.provenance import provenance
 
 def run(optimizer: str, generations: int, seed: int) -> dict:
     layers = [10, 9]
-    template = c3.Controller3D(layers, e3.pd_prior(layers))
-    problem = e3.FlightProblem3D(e3.TASK_SETS["steer"](), template, duration_s=4.0, gene_bound=0.4)
+    template = flight3d.Controller3D(layers, flight3d.pd_prior(layers))
+    problem = flight3d.FlightProblem3D(flight3d.TASK_SETS["steer"](), template, duration_s=4.0, gene_bound=0.4)
     t = time.perf_counter()
     res = optimize(problem, optimizer, seed=seed, population=16, generations=generations, progress=False)
     wall = time.perf_counter() - t

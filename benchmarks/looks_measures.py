@@ -60,9 +60,9 @@ def main() -> None:
     from lifelike_mj.boids import Flock
     from lifelike_mj.boids.look import rigs as bird_rigs
     from lifelike_mj.boids.presets import load_preset
-    from lifelike_mj.butterfly import evolve3d
+    from lifelike_mj.butterfly import flight3d
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
     from lifelike_mj.butterfly.look import rigs as butterfly_rigs
-    from lifelike_mj.butterfly.sim3d import Flight3D
     from lifelike_mj.fish import Tank
     from lifelike_mj.fish.look import rigs as fish_rigs
 
@@ -104,7 +104,7 @@ def main() -> None:
                        "bank_deg": {"median": float(np.median(np.concatenate(banks))),
                                     "p90": float(np.percentile(np.concatenate(banks), 90))},
                        "flap_hz_median": float(np.nanmedian(flap)), "glide_share_median": float(np.median(glide))}
-    flight = Flight3D(controller="steer", task=evolve3d.course(103))
+    flight = Flight3D(controller="steer", task=flight3d.course(103))
     bp = record_poses(flight, 3.0)
     misses = {}
     with tempfile.TemporaryDirectory() as tmp:

@@ -117,10 +117,10 @@ CREATURES = ("butterfly3d", "butterfly2d", "fish", "boids")
 def _fresh(creature: str):
     """A new simulation of ``creature`` and its recording window: ``(sim, fps, time_scale, duration)``."""
     if creature == "butterfly3d":
-        from lifelike_mj.butterfly import evolve3d
-        from lifelike_mj.butterfly.sim3d import Flight3D
+        from lifelike_mj.butterfly import flight3d
+        from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
-        return Flight3D(controller="steer", task=evolve3d.course(100)), 30.0, 1.0, 1.0
+        return Flight3D(controller="steer", task=flight3d.course(100)), 30.0, 1.0, 1.0
     if creature == "butterfly2d":
         from lifelike_mj.butterfly import Flight
 

@@ -5,11 +5,13 @@ Each case is a command line of ``lifelike-mj`` (with ``--json``) and the files i
 factors, dates), plus a SHA-256 of every array in every ``.npz`` it writes and of the weights of
 every controller file it writes. ``tests/data/golden_cli.json`` holds the records made by
 ``python tests/golden_cases.py record`` on version 0.1.0 before the library reorganisation (issue
-12); ``tests/test_unchanged.py`` recomputes them and compares.
+12), and the 3D butterfly's cases (``fly3d_*``, ``evolve3d_*``, ``assess3d_*``) on commit 0e7f3e6, before the 3D
+flight became a slice of its own (issue 26); ``tests/cli/test_unchanged.py`` recomputes them and compares.
 
 Run as a script::
 
     python tests/golden_cases.py record [FILE]   # write the records of the installed code
+    python tests/golden_cases.py record FILE CASE ...   # (re)record these cases into FILE, keeping the others
     python tests/golden_cases.py check [FILE]    # recompute and compare bit for bit
 """
 
@@ -60,6 +62,16 @@ CASES: dict[str, tuple[list[str], list[str]]] = {
                              "--executor", "serial", "--quiet", "--out", "{out}/cmaes.json"], ["cmaes.json"]),
     "evolve_mujoco": (["butterfly", "evolve", "--optimizer", "rcga", "--backend", "mujoco", "--population", "4",
                        "--generations", "2", "--executor", "serial", "--quiet", "--out", "{out}/mj.json"], ["mj.json"]),
+    "fly3d_steer_turn": (["butterfly", "fly3d", "--controller", "steer", "--task", "turn", "--angle", "-90",
+                          "--duration", "4", "--out", "{out}"], ["path.npz"]),
+    "fly3d_wind_course": (["butterfly", "fly3d", "--controller", "wind", "--task", "course", "--seed", "3",
+                           "--wind-to", "1,0.5,0", "--gusts", "0.5", "--flutter", "0.1", "--duration", "4", "--out",
+                           "{out}"], ["path.npz"]),
+    "fly3d_cruise_level": (["butterfly", "fly3d", "--controller", "cruise", "--speed", "2", "--duration", "3"], []),
+    "evolve3d_cmaes": (["butterfly", "evolve3d", "--population", "4", "--generations", "2", "--duration", "0.5",
+                        "--quiet", "--out", "{out}/c3.json"], ["c3.json"]),
+    "assess3d_wind": (["butterfly", "assess3d", "--controller", "wind", "--duration", "6", "--courses", "100",
+                       "--gusts", "0.3"], []),
     "fish_swim": (["fish", "swim", "--fish", "5", "--duration", "4", "--out", "{out}"], ["tracks.npz"]),
     "fish_swim_nbnd": (["fish", "swim", "--preset", "NB-ND", "--fish", "3", "--duration", "3", "--seed", "2",
                         "--tank-scale", "0.5"], []),
@@ -89,7 +101,7 @@ def _digest(path: Path) -> dict:
         with np.load(path, allow_pickle=False) as z:
             return {k: hashlib.sha256(np.ascontiguousarray(z[k]).tobytes()).hexdigest() for k in sorted(z.files)}
     data = json.loads(path.read_text())
-    w = data.get("parameters", {}).get("weights")
+    w = data.get("parameters", {}).get("weights", data.get("weights"))
     prov = data.get("provenance", {})
     return {"weights": hashlib.sha256(np.asarray(w, dtype=float).tobytes()).hexdigest(),
             "best_fitness": prov.get("best_fitness"), "evaluations": prov.get("evaluations")}
@@ -152,7 +164,9 @@ def main(argv: list[str]) -> int:
     mode = argv[0] if argv else "check"
     path = Path(argv[1]) if len(argv) > 1 else GOLDEN
     if mode == "record":
-        records = {name: run_case(name) for name in CASES}
+        names = argv[2:] or list(CASES)
+        records = json.loads(path.read_text()) if argv[2:] and path.exists() else {}
+        records.update({name: run_case(name) for name in names})
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(records, indent=1, sort_keys=True) + "\n")
         print(f"wrote {len(records)} records to {path}")

@@ -16,13 +16,13 @@ NAN = math.nan
 
 
 def _flight3d(**kw):
-    from lifelike_mj.butterfly.sim3d import Flight3D
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
     return Flight3D(**kw)
 
 
 def _garden(**kw):
-    from lifelike_mj.butterfly.garden import Garden
+    from lifelike_mj.butterfly.flight3d.garden import Garden
 
     return Garden(2, "steer", **kw)
 
@@ -58,9 +58,9 @@ def _overrides(**kw):
 
 
 def _evolve3d(**kw):
-    from lifelike_mj.butterfly import evolve3d
+    from lifelike_mj.butterfly import flight3d
 
-    return evolve3d.evolve(**kw)
+    return flight3d.evolve(**kw)
 
 
 def _optimize(**kw):
@@ -79,13 +79,13 @@ def _env(**kw):
 
 
 def _task(**kw):
-    from lifelike_mj.butterfly import evolve3d
+    from lifelike_mj.butterfly import flight3d
 
-    return evolve3d.Task3D(**{"kind": "schedule", "rows": ((0.0, 0.0, 0.0, 1.5),), **kw})
+    return flight3d.Task3D(**{"kind": "schedule", "rows": ((0.0, 0.0, 0.0, 1.5),), **kw})
 
 
 def _record3d(dt_s, duration_s):
-    from lifelike_mj.butterfly.sim3d import Flight3D
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
     f = Flight3D(dt_s=dt_s, command=None)
     return f.record(duration_s=duration_s)

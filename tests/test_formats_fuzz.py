@@ -32,8 +32,8 @@ SETTINGS = settings(max_examples=120, deadline=None, derandomize=True,
 def _loaders():
     from lifelike_mj.boids.presets import load_grid
     from lifelike_mj.boids.presets import load_preset as boids_preset
-    from lifelike_mj.butterfly.control3d import load_controller
     from lifelike_mj.butterfly.controllers import load
+    from lifelike_mj.butterfly.flight3d.controllers import load_controller
     from lifelike_mj.fish.params import load_preset as fish_preset
 
     return {"butterfly-controller": load, "butterfly3d-controller": load_controller, "fish-preset": fish_preset,

@@ -20,7 +20,7 @@ measures and the classifier (:func:`measures`, :func:`classify`, :func:`classifi
 from lifelike_mj._lazy import attach
 
 __getattr__, __dir__, __all__ = attach(__name__, {
-    "Flock": "sim", "STATE_UNITS": "sim", "simulate": "engine", "BoidParams": "engine", "BoidRun": "engine",
+    "Flock": "sim", "STATE_UNITS": "sim", "simulate": "sim", "BoidParams": "engine", "BoidRun": "engine",
     "load_preset": "presets", "homogeneous": "presets", "PATTERNS": "presets",
     "measures": "metrics", "classify": "metrics", "classified_run": "experiments", "Sweep": "experiments",
     "run_sweep": "experiments", "write_trajectories": "experiments", "measured_run": "experiments",

@@ -21,8 +21,9 @@ import numba
 import numpy as np
 
 from lifelike_mj.boids import engine
-from lifelike_mj.boids.engine import BOX, N_AGENTS, BoidParams, initial_state, simulate, step_grid
+from lifelike_mj.boids.engine import BOX, N_AGENTS, BoidParams, initial_state, step_grid
 from lifelike_mj.boids.presets import PATTERNS, load_preset
+from lifelike_mj.boids.sim import simulate
 from lifelike_mj.machine import machine_info
 
 #: Steps timed from the random start in the scaling runs.

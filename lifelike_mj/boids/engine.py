@@ -720,14 +720,3 @@ class BoidRun:
     @property
     def n(self) -> int:
         return len(self.types)
-
-
-def simulate(params: BoidParams, n: int = N_AGENTS, n_steps: int = 3000, seed: int = 0, record_every: int = 1,
-             record_from: int = 0, progress: bool = False, extra_steps=()) -> BoidRun:
-    """Run ``n_steps`` steps from :func:`initial_state`; record the state every ``record_every``
-    steps from step ``record_from`` on (step 0 = the initial state), and at the ``extra_steps``
-    (:meth:`~lifelike_mj.boids.sim.Flock.record` of a new flock). Raises
-    :class:`~lifelike_mj.errors.Diverged` if the run diverges (section 2.2: w_a >= 10 or w_c >= 1)."""
-    from lifelike_mj.boids.sim import Flock
-
-    return Flock(params, n, seed).record(n_steps, record_every, record_from, extra_steps, progress)

@@ -17,9 +17,10 @@ from pathlib import Path
 import numpy as np
 
 from lifelike_mj import checks
-from lifelike_mj.boids.engine import N_AGENTS, BoidParams, BoidRun, simulate
+from lifelike_mj.boids.engine import N_AGENTS, BoidParams, BoidRun
 from lifelike_mj.boids.metrics import HOMOGENEOUS_LABELS
 from lifelike_mj.boids.presets import PATTERNS
+from lifelike_mj.boids.sim import simulate
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import atomic_path, write_npz
 

@@ -629,7 +629,8 @@ def simulate_and_measure(params, seed: int, n: int | None = None, n_steps: int =
                          window: int = WINDOW_STEPS, record_every: int = RECORD_EVERY) -> dict:
     """Run ``params`` (:class:`~lifelike_mj.boids.engine.BoidParams`) for ``n_steps`` steps, recording
     only the last ``window`` steps, and return :func:`measures` over that window."""
-    from lifelike_mj.boids.engine import N_AGENTS, simulate
+    from lifelike_mj.boids.engine import N_AGENTS
+    from lifelike_mj.boids.sim import simulate
 
     run = simulate(params, n=N_AGENTS if n is None else n, n_steps=n_steps, seed=seed, record_every=record_every,
                    record_from=max(0, n_steps - window + 1))

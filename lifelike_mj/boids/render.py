@@ -2,7 +2,7 @@
 
 The agents are the real run of a :class:`~lifelike_mj.boids.sim.Flock`, streamed: it is stepped
 between frames, so no trajectory is kept in memory and a rendered run is the run
-:func:`~lifelike_mj.boids.engine.simulate` computes with the same arguments. MuJoCo only draws:
+:func:`~lifelike_mj.boids.sim.simulate` computes with the same arguments. MuJoCo only draws:
 the agents are mocap bodies of :mod:`lifelike_mj.boids.scene`
 (ellipsoids along their velocities; A blue, B orange: :mod:`lifelike_mj.boids.palette`), placed by
 :func:`~lifelike_mj.boids.scene.update` before each frame.
@@ -125,7 +125,7 @@ def render_boids(out_path: str | Path, params: BoidParams, n: int = 300, n_steps
 
     ``params``: :class:`~lifelike_mj.boids.engine.BoidParams` (e.g.
     :func:`~lifelike_mj.boids.presets.load_preset`; 3D or 2D); ``seed``: the run's seed (initial
-    positions, velocities and types, as :func:`~lifelike_mj.boids.engine.simulate`). The run is
+    positions, velocities and types, as :func:`~lifelike_mj.boids.sim.simulate`). The run is
     streamed (module docstring): ``warmup_steps`` engine steps unrendered first (the patterns form
     within about 1,000-3,000 steps), then ``n_steps // steps_per_frame + 1`` frames, frame ``j``
     showing step ``warmup_steps + j * steps_per_frame``, played at ``fps`` frames/s. ``camera``:

@@ -41,7 +41,7 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "Condition": "flight", "Trajectory": "flight", "PitchObservation": "flight",
     "ButterflyController": "controllers", "ann_controller": "controllers",
     "load_controller": "_api", "controller_names": "_api",
-    "simulate": "backends", "fly": "experiments", "compare": "compare",
+    "simulate": "batch", "fly": "experiments", "compare": "compare",
     "PitchProblem": "evolution", "make_problem": "evolution", "evolve_controller": "evolution", "PAPER_FLAP": "evolution",
     "reproduce": "report",
     "render_butterfly": "render", "film_flight": "render", "playback": "render", "render_frame": "render",
@@ -49,6 +49,5 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "experiments": ".", "ann_experiments": ".", "figures": ".", "ann_figures": ".", "backends": ".", "aero": ".",
     "controllers": ".", "ann": ".", "render": ".", "report": ".", "sim": ".", "flight": ".", "params": ".",
     "model": ".", "evolution": ".",
-    "bench": ".", "look": ".", "sim3d": ".", "control3d": ".", "evolve3d": ".", "kinematics3d": ".",
-    "validate3d": ".", "figures3d": ".", "garden": ".",
+    "batch": ".", "bench": ".", "look": ".", "flight3d": ".",
 }, globals())

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from lifelike_mj.butterfly import backends, controllers
+from lifelike_mj.butterfly import batch, controllers
 from lifelike_mj.butterfly.backends.paper import compile_controllers, constants_row, run_batch
 from lifelike_mj.butterfly.controllers import ButterflyController
 from lifelike_mj.butterfly.flight import Condition, Trajectory
@@ -46,7 +46,7 @@ PAPER_E8_SINK_RATIO = 2.0
 
 
 def _fly(ctrl: ButterflyController, conds, backend: str, params, record_every: int = 1) -> list[Trajectory]:
-    return backends.simulate(backend, ctrl, params, conds, DURATION_S, DT_S, record_every)
+    return batch.simulate(backend, ctrl, params, conds, DURATION_S, DT_S, record_every)
 
 
 def flight_numbers(tr: Trajectory, band_m: float = LEVEL_BAND_M) -> dict:

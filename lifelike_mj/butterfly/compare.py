@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lifelike_mj.butterfly import batch
 from lifelike_mj.butterfly.backends import DEFAULT_FORCE_MODE, paper
-from lifelike_mj.butterfly.backends import mj as mjbackend
 from lifelike_mj.butterfly.controllers import ButterflyController
 from lifelike_mj.butterfly.flight import Condition, Trajectory
 from lifelike_mj.butterfly.params import ButterflyParams
@@ -63,7 +63,7 @@ def compare(controller: ButterflyController, config: str = "paper", params: Butt
     p = params or ButterflyParams()
     cond = condition or Condition()
     ref = paper.simulate(controller, p, cond, duration_s, dt_s)[0]
-    mj = mjbackend.simulate(controller, p, cond, duration_s, dt_s, config=config, force_mode=mode)[0]
+    mj = batch.simulate_mujoco(controller, p, cond, duration_s, dt_s, config=config, force_mode=mode)[0]
     dy, dz = ref.max_difference(mj)
     excursion = float(np.nanmax(np.abs(ref.y - ref.y0)))
     return CompareResult(config, mode, duration_s, dt_s, dy, dz, excursion, ref.summary(), mj.summary(), (ref, mj))

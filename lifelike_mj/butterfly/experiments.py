@@ -25,6 +25,7 @@ import numpy as np
 
 from lifelike_mj import checks
 from lifelike_mj.butterfly import aero, backends, controllers
+from lifelike_mj.butterfly.batch import simulate as simulate_batch
 from lifelike_mj.butterfly.flight import Trajectory
 from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.errors import UserError
@@ -336,7 +337,7 @@ def e4_trim(
     search_every = max(1, int(round(1e-3 / dt_s)))
 
     def climb_rates(angles: list[float]) -> list[float]:
-        trs = backends.simulate(
+        trs = simulate_batch(
             backend, [base.with_parameters(phi_up_deg=a) for a in angles], p, None, duration_s, dt_s, search_every,
             **backend_options,
         )
@@ -345,7 +346,7 @@ def e4_trim(
     batch = 16 if backend == "paper" else 1
     level, bracket, flown = _find_level_angle(climb_rates, float(lo_deg), float(hi_deg), float(tol_deg), batch)
     angles = [level, level - 0.5, level + 0.5]
-    lv, lo_tr, hi_tr = backends.simulate(
+    lv, lo_tr, hi_tr = simulate_batch(
         backend, [base.with_parameters(phi_up_deg=a) for a in angles], p, None, duration_s, dt_s, 1, **backend_options
     )
     s = lv.summary(_SETTLE_WINDOW_S)
@@ -435,7 +436,7 @@ def e5_timestep(
     ctrl = controllers.load("simple_rule").with_parameters(phi_up_deg=phi_up_deg, phi_down_deg=0.0)
     trs: dict[str, Trajectory] = {}
     for label, per_s in E5_STEPS_PER_S.items():
-        (tr,) = backends.simulate(backend, [ctrl], p, None, duration, 1.0 / per_s, per_s // 120, **backend_options)
+        (tr,) = simulate_batch(backend, [ctrl], p, None, duration, 1.0 / per_s, per_s // 120, **backend_options)
         trs[label] = tr
     per_second = 120  # samples per simulated second
     seconds = list(range(int(duration) + 1))
@@ -505,7 +506,7 @@ def fly(controller: controllers.ButterflyController, params: ButterflyParams | N
     backends.check_backend(backend)
     opts = backends.mujoco_options(config, force_mode) if backend == "mujoco" else {}
     check_timing(duration_s, dt_s)
-    traj = backends.simulate(backend, controller, params or ButterflyParams(), condition or Condition(), duration_s,
+    traj = simulate_batch(backend, controller, params or ButterflyParams(), condition or Condition(), duration_s,
                              dt_s, 1, **opts)[0]
     summary = {"controller": controller.name or name, **traj.summary(), **({"config": opts} if opts else {})}
     if traj.diverged_step >= 0:

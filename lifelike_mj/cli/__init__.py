@@ -15,30 +15,23 @@ that ``--help`` is instant and the GL backend can be chosen before MuJoCo is imp
 from __future__ import annotations
 
 import argparse
-import importlib
 import sys
 from pathlib import Path
-from types import ModuleType
 
 from lifelike_mj.cli.common import (
+    CREATURES,
+    SIMULATED,
     Parser,
     add_json,
     add_overwrite,
     check_outputs,
     count,
+    creature,
     emit,
     join_negative_values,
     take_notes,
 )
 from lifelike_mj.errors import UserError
-
-#: The creatures, in the order of ``reproduce all``.
-CREATURES = ("butterfly", "fish", "boids")
-
-
-def creature(name: str) -> ModuleType:
-    """The command-line module of creature ``name``."""
-    return importlib.import_module(f"lifelike_mj.cli.{name}")
 
 
 def _verb(sub, name: str, helptext: str, add: str, extra=None, creatures=CREATURES) -> None:
@@ -126,7 +119,7 @@ def build_parser() -> Parser:
     for c in CREATURES:
         creature(c).add_commands(sub)
     _verb(sub, "view", "open the MuJoCo viewer on a live simulation (--web: in a browser)", "add_view_args",
-          _view_options, creatures=(*CREATURES[:1], "butterfly3d", *CREATURES[1:]))
+          _view_options, creatures=SIMULATED)
     _verb(sub, "render", "render a video offscreen", "add_render_args", _render_options)
     _verb(sub, "bench", "speed benchmark", "add_bench_args", _bench_options)
     from lifelike_mj.cli.export import add_export_verb

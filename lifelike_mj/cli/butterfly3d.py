@@ -18,14 +18,14 @@ MAX_COURSES = 1000
 
 
 def _task(args):
-    from lifelike_mj.butterfly import evolve3d
+    from lifelike_mj.butterfly import flight3d
 
     if args.task == "level":
-        task = evolve3d.level(args.speed)
+        task = flight3d.level(args.speed)
     elif args.task == "turn":
-        task = evolve3d.turn(args.angle, 2.0, args.speed)
+        task = flight3d.turn(args.angle, 2.0, args.speed)
     else:
-        task = evolve3d.course(args.seed, speed_m_s=args.speed)
+        task = flight3d.course(args.seed, speed_m_s=args.speed)
     return task.with_weather(args.wind, gust_m_s=args.gusts, flutter=args.flutter, seed=args.seed,
                              gust_vertical_m_s=args.vertical_gusts)
 
@@ -33,8 +33,8 @@ def _task(args):
 def cmd_fly3d(args) -> None:
     import numpy as np
 
-    from lifelike_mj.butterfly.control3d import load_controller
-    from lifelike_mj.butterfly.sim3d import Flight3D
+    from lifelike_mj.butterfly.flight3d.controllers import load_controller
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
     ctrl = load_controller(args.controller)
     check_outputs(args, folders={"--out": FLY3D_FILES})
@@ -50,7 +50,7 @@ def cmd_fly3d(args) -> None:
          "pitch_range_deg": [float(np.degrees(att[:, 1].min())), float(np.degrees(att[:, 1].max()))],
          "mean_reward": flight.reward / max(flight.time, 1e-12), "waypoints_passed": flight.waypoints_passed}
     if args.out:
-        from lifelike_mj.butterfly.figures3d import write_flight
+        from lifelike_mj.butterfly.flight3d.figures import write_flight
 
         write_flight(args.out, rec, s, flight.task)
     human = (f"{s['task']}: {s['path_length_m']:.1f} m flown over ground in {s['duration_s']:.1f} s, ending "
@@ -63,8 +63,8 @@ def cmd_fly3d(args) -> None:
 
 
 def cmd_evolve3d(args) -> None:
-    from lifelike_mj.butterfly.control3d import load_controller
-    from lifelike_mj.butterfly.evolve3d import TASK_SETS, evolve
+    from lifelike_mj.butterfly.flight3d.controllers import load_controller
+    from lifelike_mj.butterfly.flight3d.evolution import TASK_SETS, evolve
 
     layers = [10, *args.hidden, 9]
     start = load_controller(args.start) if args.start else None
@@ -88,8 +88,8 @@ def cmd_evolve3d(args) -> None:
 
 
 def cmd_assess3d(args) -> None:
-    from lifelike_mj.butterfly.control3d import load_controller
-    from lifelike_mj.butterfly.validate3d import check_window, course_check, level_check, turn_check
+    from lifelike_mj.butterfly.flight3d.controllers import load_controller
+    from lifelike_mj.butterfly.flight3d.validate import check_window, course_check, level_check, turn_check
 
     check_window("the level flight (--duration)", args.duration, LEVEL_SETTLE_S, 1.0,
                  "it measures the speed each second after settling")
@@ -115,9 +115,9 @@ def cmd_garden(args) -> None:
     import numpy as np
 
     from lifelike_mj import checks
-    from lifelike_mj.butterfly.control3d import load_controller
-    from lifelike_mj.butterfly.garden import Garden, film_garden
-    from lifelike_mj.butterfly.sim3d import DT_S
+    from lifelike_mj.butterfly.flight3d.controllers import load_controller
+    from lifelike_mj.butterfly.flight3d.flight import DT_S
+    from lifelike_mj.butterfly.flight3d.garden import Garden, film_garden
 
     checks.work(f"a garden of {args.n} butterflies for {args.duration:g} s",
                 args.n * checks.steps_of(args.duration, DT_S), checks.MAX_BODY_STEPS, "butterfly-steps")
@@ -146,7 +146,7 @@ def cmd_garden(args) -> None:
     d.update({"duration_s": garden.time, "flowers_visited_min": int(passed.min()),
               "flowers_visited_mean": float(passed.mean()), "flowers_visited_max": int(passed.max())})
     if args.paths:
-        from lifelike_mj.butterfly.figures3d import fig_paths
+        from lifelike_mj.butterfly.flight3d.figures import fig_paths
 
         track = np.array(garden.track)
         fig_paths([{"position_m": track[:, i]} for i in range(args.n)], waypoints=garden.blossoms,
@@ -259,7 +259,7 @@ VIEW_HELP = ("one 3D butterfly flying level at --speed with --controller, the ca
 
 def view_keys() -> str:
     """The 3D scene's keys, for ``view butterfly3d --help``."""
-    from lifelike_mj.butterfly.render import FLIGHT3D_KEYS
+    from lifelike_mj.butterfly.flight3d.view import FLIGHT3D_KEYS
     from lifelike_mj.render.viewer import keys_text
 
     return "keys in the window (buttons in the web viewer with --web): " + keys_text(FLIGHT3D_KEYS) + "."
@@ -284,19 +284,19 @@ def add_export_args(p: argparse.ArgumentParser) -> None:
 def export_window(args):
     """The run to export, built and checked, not yet simulated (:class:`~lifelike_mj.cli.export.Window`), and the
     parameters that make it."""
-    from lifelike_mj.butterfly.control3d import load_controller
-    from lifelike_mj.butterfly.sim3d import DT_S
+    from lifelike_mj.butterfly.flight3d.controllers import load_controller
+    from lifelike_mj.butterfly.flight3d.flight import DT_S
     from lifelike_mj.cli.export import Window, check_window, parameters_of
 
     check_window(args.start, args.duration, args.fps, DT_S, bodies=args.garden or 1)
     ctrl = load_controller(args.controller)
     if args.garden:
-        from lifelike_mj.butterfly.garden import Garden
+        from lifelike_mj.butterfly.flight3d.garden import Garden
 
         sim = Garden(args.garden, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_m_s=args.wind,
                      gust_vertical_m_s=args.vertical_gusts)
     else:
-        from lifelike_mj.butterfly.sim3d import Flight3D
+        from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
         sim = Flight3D(controller=ctrl, task=_task(args))
     return Window(sim, args.start, args.duration, args.fps), parameters_of(args)
@@ -322,8 +322,8 @@ def add_view_args(p: argparse.ArgumentParser) -> None:
 
 
 def view(args) -> None:
-    from lifelike_mj.butterfly.control3d import load_controller
-    from lifelike_mj.butterfly.render import view_flight3d
+    from lifelike_mj.butterfly.flight3d.controllers import load_controller
+    from lifelike_mj.butterfly.flight3d.view import view_flight3d
     from lifelike_mj.cli import web_options
 
     web = web_options(args)

@@ -277,3 +277,16 @@ def add_wind(p: argparse.ArgumentParser, dims: int, native: str, axes: str, what
     g.add_argument("--wind", dest="wind", type=kind, default=zero, action=_WindAction, sense="old", native=native,
                    metavar=names, help=f"the older spelling of --wind-{native}")
 
+
+#: The creatures, in the order of ``reproduce all``: each a module ``lifelike_mj.cli.NAME``.
+CREATURES = ("butterfly", "fish", "boids")
+#: Every simulated creature that ``view``, ``export`` and scenes take, in the order of the help: the creatures,
+#: with the 3D butterfly (``butterfly3d``, a part of ``lifelike-mj butterfly``) after the planar one.
+SIMULATED = ("butterfly", "butterfly3d", "fish", "boids")
+
+
+def creature(name: str):
+    """The command-line module of creature ``name`` (one of :data:`SIMULATED`)."""
+    import importlib
+
+    return importlib.import_module(f"lifelike_mj.cli.{name}")

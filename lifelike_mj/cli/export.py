@@ -16,17 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lifelike_mj.cli.common import Parser, add_json, add_overwrite, count, emit, num
+from lifelike_mj.cli.common import SIMULATED, Parser, add_json, add_overwrite, count, creature, emit, num
 from lifelike_mj.errors import UserError
-
-#: The creatures that export, in the order of the help.
-EXPORTERS = ("butterfly", "butterfly3d", "fish", "boids")
-
-
-def _module(name: str):
-    import importlib
-
-    return importlib.import_module(f"lifelike_mj.cli.{name}")
 
 
 def add_export_verb(sub) -> None:
@@ -35,8 +26,8 @@ def add_export_verb(sub) -> None:
 
     p = sub.add_parser("export", help="write a run's motion as glTF (glb, gltf), USD or a web page")
     per = p.add_subparsers(dest="what", required=True, parser_class=Parser, metavar="CREATURE")
-    for c in EXPORTERS:
-        mod = _module(c)
+    for c in SIMULATED:
+        mod = creature(c)
         q = per.add_parser(c, help=mod.HELP)
         mod.add_export_args(q)
         q.add_argument("--out", required=True, help="the file: " + ", ".join(s for v in FORMATS.values() for s in v))
@@ -90,7 +81,7 @@ def cmd_export(args) -> None:
         from lifelike_mj.export.usd import require_usd
 
         require_usd()
-    mod = _module(args.what)
+    mod = creature(args.what)
     cut = args.loop and getattr(mod, "loop_cut_body", lambda a: None)(args)
     if args.loop:  # a lead-in recorded before the clip: the blend's, or the secondary motion's history for a cut
         clip_s = (args.steps / (args.fps * args.steps_per_frame) if hasattr(args, "steps_per_frame")

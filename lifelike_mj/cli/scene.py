@@ -47,7 +47,7 @@ MAX_DURATION_S = 600.0
 
 def json_schema() -> dict:
     """The JSON Schema of a scene file (``docs/schemas/scene.schema.json``)."""
-    from lifelike_mj.cli.export import EXPORTERS
+    from lifelike_mj.cli.common import SIMULATED
     from lifelike_mj.schema import document_schema, number
 
     option = {"anyOf": [{"type": "string"}, {"type": "number"}, {"type": "boolean"},
@@ -55,7 +55,7 @@ def json_schema() -> dict:
     part = {"type": "object", "additionalProperties": False, "required": ["name", "creature"], "properties": {
         "name": {"type": "string", "pattern": "^[A-Za-z0-9_.-]{1,40}$",
                  "description": "the part's name, unique in the scene (letters, digits, _ . -)"},
-        "creature": {"enum": list(EXPORTERS), "description": "what runs: as lifelike-mj export CREATURE"},
+        "creature": {"enum": list(SIMULATED), "description": "what runs: as lifelike-mj export CREATURE"},
         "options": {"type": "object", "maxProperties": 40, "additionalProperties": option,
                     "description": "the options of lifelike-mj export CREATURE, without their dashes"},
         "at_m": {"type": "array", "items": number("", -10_000, 10_000), "minItems": 3, "maxItems": 3,
@@ -108,7 +108,7 @@ def _tokens(options: dict, where: str) -> list[str]:
 
 def _parse_part(part: dict, scene: dict, where: str) -> argparse.Namespace:
     from lifelike_mj.cli.common import Parser
-    from lifelike_mj.cli.export import _module
+    from lifelike_mj.cli.common import creature as _module
 
     creature = part["creature"]
     mod = _module(creature)
@@ -147,7 +147,7 @@ def scene_parts(scene: dict | str | Path, where: str = "the scene", quiet: bool 
     """Run every part of ``scene`` (a scene file's path, or its content as a dict, checked as a file's) and
     return them as :class:`~lifelike_mj.export.scene.Part`, each recorded and rigged; every part is checked
     before any is simulated."""
-    from lifelike_mj.cli.export import _module
+    from lifelike_mj.cli.common import creature as _module
     from lifelike_mj.export.scene import Part
     from lifelike_mj.schema import check_header, validate
 

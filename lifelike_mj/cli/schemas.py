@@ -10,8 +10,8 @@ def write_schemas(folder: str | Path) -> list[Path]:
     """Write every file format's JSON Schema into ``folder`` (for editors); returns the paths."""
     from lifelike_mj.boids.presets import grid_json_schema
     from lifelike_mj.boids.presets import json_schema as boids_schema
-    from lifelike_mj.butterfly.control3d import json_schema as butterfly3d_schema
     from lifelike_mj.butterfly.controllers import json_schema as butterfly_schema
+    from lifelike_mj.butterfly.flight3d.controllers import json_schema as butterfly3d_schema
     from lifelike_mj.cli.scene import json_schema as scene_schema
     from lifelike_mj.evolve.checkpoint import json_schema as checkpoint_schema
     from lifelike_mj.fish.params import json_schema as fish_schema

@@ -183,6 +183,8 @@ def guarded_run_files(out: str | Path, checkpoint: str | Path | None, *, resume:
 
 #: The optimisers whose state a checkpoint holds, and the layout of each state.
 _NLOPT = ("crs2", "esch", "isres")
+#: The optimisers by name (:func:`lifelike_mj.evolve.optimize`), each with its own state in a checkpoint.
+OPTIMIZERS = ("rcga", "cmaes", *_NLOPT)
 
 
 def json_schema() -> dict:
@@ -191,8 +193,6 @@ def json_schema() -> dict:
     (``{"__array__": "a0"}``), its kind and shape under the keyword ``x-array`` (``"dim"`` and ``"population"``
     stand for the checkpoint's own values, ``"*"`` for any length). :func:`load_checkpoint` enforces it before any
     value is used."""
-    from lifelike_mj.evolve.optimizers import OPTIMIZERS
-
     nonfinite = {"type": "object", "properties": {"__float__": {"enum": ["nan", "inf", "-inf"]}},
                  "required": ["__float__"], "additionalProperties": False}
     real = {"anyOf": [{"type": "number"}, nonfinite]}

@@ -33,13 +33,11 @@ import numpy as np
 from lifelike_mj.checks import known_keywords
 from lifelike_mj.errors import UserError
 from lifelike_mj.evolve import cmaes, nloptalgs, rcga
-from lifelike_mj.evolve.checkpoint import check_checkpoint_path
+from lifelike_mj.evolve.checkpoint import OPTIMIZERS, check_checkpoint_path
 from lifelike_mj.evolve.driver import Budget, OptimizationResult, Run
 from lifelike_mj.evolve.evaluators import Evaluator, make_evaluator
 from lifelike_mj.evolve.problem import check_problem
 
-#: Names accepted by :func:`optimize`.
-OPTIMIZERS = ("rcga", "cmaes", "crs2", "esch", "isres")
 #: Budget used when neither ``generations`` nor ``evaluations`` is given.
 DEFAULT_GENERATIONS = 100
 

@@ -6,8 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lifelike_mj.boids.engine import BoidParams, initial_state, parse_matrix, simulate, step_grid, step_reference
+from lifelike_mj.boids.engine import BoidParams, initial_state, parse_matrix, step_grid, step_reference
 from lifelike_mj.boids.presets import PATTERNS, homogeneous, load_grid, load_preset
+from lifelike_mj.boids.sim import simulate
 from lifelike_mj.errors import UserError
 
 

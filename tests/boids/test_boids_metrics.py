@@ -274,8 +274,8 @@ def test_window_frames_and_majority():
 def test_short_real_run_of_5a_is_a_mixed_flock():
     """Preset 5a (the mixed flock settles within ~500 steps): 1500 steps of 300 agents, measures over
     the last 1000 steps."""
-    from lifelike_mj.boids.engine import simulate
     from lifelike_mj.boids.presets import load_preset
+    from lifelike_mj.boids.sim import simulate
 
     run = simulate(load_preset("5a"), n=300, n_steps=1500, seed=3, record_every=25, record_from=500)
     m = M.measures(run, window=1000)

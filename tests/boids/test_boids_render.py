@@ -11,9 +11,9 @@ from PIL import Image
 from lifelike_mj.boids import figures as boids_figures
 from lifelike_mj.boids import render as boids_video
 from lifelike_mj.boids import scene
-from lifelike_mj.boids.engine import BoidParams, BoidRun, simulate
+from lifelike_mj.boids.engine import BoidParams, BoidRun
 from lifelike_mj.boids.presets import PATTERNS, homogeneous, load_preset
-from lifelike_mj.boids.sim import Flock
+from lifelike_mj.boids.sim import Flock, simulate
 from lifelike_mj.errors import UserError
 from lifelike_mj.render.video import advance_to
 

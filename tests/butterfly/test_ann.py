@@ -8,8 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from lifelike_mj.butterfly import ann, controllers
-from lifelike_mj.butterfly.backends import mj as mjbackend
+from lifelike_mj.butterfly import ann, batch, controllers
 from lifelike_mj.butterfly.backends import paper
 from lifelike_mj.butterfly.evolution import PitchProblem, make_problem
 from lifelike_mj.butterfly.flight import Condition
@@ -66,11 +65,11 @@ def test_relative_and_ground_inputs_agree_without_wind_and_differ_with():
 def test_mujoco_backend_flies_the_network_like_the_paper_backend():
     c = controllers.ann_controller(_weights(3))
     ref = paper.simulate(c, duration_s=1.0)[0]
-    mj = mjbackend.simulate(c, duration_s=1.0)[0]
+    mj = batch.simulate_mujoco(c, duration_s=1.0)[0]
     assert np.max(np.abs(ref.y - mj.y)) < 0.01
     assert mj.fitness == pytest.approx(ref.fitness, rel=0.01)
-    py = mjbackend.simulate(c, duration_s=0.05, callback="python")[0]
-    co = mjbackend.simulate(c, duration_s=0.05)[0]
+    py = batch.simulate_mujoco(c, duration_s=0.05, callback="python")[0]
+    co = batch.simulate_mujoco(c, duration_s=0.05)[0]
     assert np.max(np.abs(py.y - co.y)) < 1e-12 and py.fitness == pytest.approx(co.fitness, abs=1e-12)
 
 
@@ -98,7 +97,7 @@ def test_mujoco_problem_batch_matches_fly_one():
     X = np.stack([_weights(s) for s in range(3)])
     f = prob.evaluate(X)
     for i in range(3):
-        assert f[i] == pytest.approx(mjbackend.simulate(prob.controller(X[i]), duration_s=0.25)[0].fitness, rel=1e-12)
+        assert f[i] == pytest.approx(batch.simulate_mujoco(prob.controller(X[i]), duration_s=0.25)[0].fitness, rel=1e-12)
 
 
 def test_fingerprint_names_the_problem():

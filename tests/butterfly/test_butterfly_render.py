@@ -7,7 +7,7 @@ import pytest
 from conftest import gif_frames
 from PIL import Image
 
-from lifelike_mj.butterfly import controllers
+from lifelike_mj.butterfly import batch, controllers
 from lifelike_mj.butterfly import render as video
 from lifelike_mj.butterfly.backends import mj as mjbackend
 from lifelike_mj.butterfly.sim import Flight
@@ -50,7 +50,7 @@ def test_chunked_stepping_equals_fly_one(rule):
     for config, mode in (("paper", "tip"), ("rich", "strip")):
         m = mjbackend.build_model(None, config)
         m.opt.timestep = 1.0 / 1200.0
-        ref = mjbackend.fly_one(m, rule, duration_s=0.5, force_mode=mode)
+        ref = batch.fly_one(m, rule, duration_s=0.5, force_mode=mode)
         flight = Flight(rule, backend="mujoco", config=config, force_mode=mode)
         for k in (1, 37, 40, 41, 400, 600):  # uneven chunks, drawing-refresh between them
             advance_to(flight, k)

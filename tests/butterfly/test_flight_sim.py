@@ -10,8 +10,8 @@ import pytest
 from numba import njit
 
 from lifelike_mj import butterfly
-from lifelike_mj.butterfly import ann, controllers
-from lifelike_mj.butterfly.backends import mj, paper
+from lifelike_mj.butterfly import ann, batch, controllers
+from lifelike_mj.butterfly.backends import paper
 from lifelike_mj.butterfly.flight import Condition
 from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.butterfly.sim import STATE_UNITS, Flight
@@ -34,7 +34,7 @@ def nb_rule(obs):
 def _reference(backend: str, duration_s: float, cond=None):
     if backend == "paper":
         return paper.simulate(RULE, conditions=cond, duration_s=duration_s)[0]
-    return mj.simulate(RULE, conditions=cond, duration_s=duration_s)[0]
+    return batch.simulate_mujoco(RULE, conditions=cond, duration_s=duration_s)[0]
 
 
 @pytest.mark.parametrize("backend", ["paper", "mujoco"])

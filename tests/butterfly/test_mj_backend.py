@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from lifelike_mj.butterfly import controllers
+from lifelike_mj.butterfly import batch, controllers
 from lifelike_mj.butterfly.backends import mj as mjbackend
 from lifelike_mj.butterfly.backends import paper
 from lifelike_mj.butterfly.compare import compare
@@ -27,8 +27,8 @@ def test_data_offsets_verified_against_bindings():
 # the suite about 2 s per simulated second
 @pytest.mark.parametrize("config,mode,duration", [("paper", "tip", 20.0), ("rich", "strip", 5.0)])
 def test_compiled_callback_equals_python_reference_on_full_flight(rule, config, mode, duration):
-    fast = mjbackend.simulate(rule, duration_s=duration, config=config, force_mode=mode)[0]
-    ref = mjbackend.simulate(rule, duration_s=duration, config=config, force_mode=mode, callback="python")[0]
+    fast = batch.simulate_mujoco(rule, duration_s=duration, config=config, force_mode=mode)[0]
+    ref = batch.simulate_mujoco(rule, duration_s=duration, config=config, force_mode=mode, callback="python")[0]
     assert fast.finite and ref.finite
     for name in ("y", "z", "vy", "vz", "phi", "theta"):
         np.testing.assert_allclose(getattr(fast, name), getattr(ref, name), rtol=0, atol=1e-12, err_msg=name)
@@ -44,20 +44,20 @@ def test_paper_equivalent_model_matches_paper_backend_at_level_angle(rule):
 def test_wind_and_start_altitude_agree_between_backends(rule):
     cond = Condition(3.0, (1.0, 0.5))
     a = paper.simulate(rule, conditions=cond, duration_s=3.0)[0]
-    b = mjbackend.simulate(rule, conditions=cond, duration_s=3.0)[0]
+    b = batch.simulate_mujoco(rule, conditions=cond, duration_s=3.0)[0]
     assert b.y[0] == pytest.approx(3.0)
     dy, dz = a.max_difference(b)
     assert dy < 2e-3 and dz < 2e-3
 
 
 def test_wings_follow_flap_pattern(rule):
-    tr = mjbackend.simulate(rule, duration_s=1.0)[0]
+    tr = batch.simulate_mujoco(rule, duration_s=1.0)[0]
     np.testing.assert_allclose(tr.theta, rule.flap.theta(tr.t), atol=1e-5)  # 1e-5 rad = 0.0006 deg
 
 
 def test_strip_mode_differs_from_tip_formula(rule):
-    tip = mjbackend.simulate(rule, duration_s=5.0, force_mode="tip")[0]
-    strip = mjbackend.simulate(rule, duration_s=5.0, force_mode="strip")[0]
+    tip = batch.simulate_mujoco(rule, duration_s=5.0, force_mode="tip")[0]
+    strip = batch.simulate_mujoco(rule, duration_s=5.0, force_mode="strip")[0]
     assert abs(tip.y[-1] - strip.y[-1]) > 0.05  # the paper's simplifications of eq. 7 matter
 
 
@@ -65,11 +65,11 @@ def test_callback_is_restored_after_flight(rule):
     import mujoco
 
     before = mujoco.get_mjcb_passive()
-    mjbackend.simulate(rule, duration_s=0.01)
+    batch.simulate_mujoco(rule, duration_s=0.01)
     assert mujoco.get_mjcb_passive() is before
 
 
 def test_rich_model_pitch_servo_tracks_command(rule):
-    tr = mjbackend.simulate(rule, duration_s=2.0, config="rich", force_mode="strip")[0]
+    tr = batch.simulate_mujoco(rule, duration_s=2.0, config="rich", force_mode="strip")[0]
     assert np.degrees(np.nanmax(tr.phi)) == pytest.approx(12.77, abs=1.0)
     assert np.degrees(np.nanmin(tr.phi)) > -2.0

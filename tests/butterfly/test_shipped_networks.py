@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 
 from lifelike_mj.butterfly import ann_experiments as ax
-from lifelike_mj.butterfly import controllers
-from lifelike_mj.butterfly.backends import mj as mjbackend
+from lifelike_mj.butterfly import batch, controllers
 from lifelike_mj.butterfly.backends import paper
 from lifelike_mj.butterfly.evolution import make_problem
 from lifelike_mj.butterfly.flight import Condition
@@ -49,7 +48,7 @@ def test_ann_paper_fails_from_minus_10m_like_the_paper_e9(ann_paper):
 
 def test_ann_paper_on_mujoco_matches_the_paper_backend(ann_paper):
     ref = paper.simulate(ann_paper)[0]
-    mj = mjbackend.simulate(ann_paper)[0]
+    mj = batch.simulate_mujoco(ann_paper)[0]
     assert np.max(np.abs(ref.y - mj.y)) < 0.02
 
 

@@ -7,8 +7,8 @@ import numpy as np
 import pygltflib
 import pytest
 
-from lifelike_mj.butterfly import evolve3d
-from lifelike_mj.butterfly.sim3d import Flight3D
+from lifelike_mj.butterfly import flight3d
+from lifelike_mj.butterfly.flight3d.flight import Flight3D
 from lifelike_mj.errors import UserError
 from lifelike_mj.export.gltf import Z_UP_TO_Y_UP, write_gltf
 from lifelike_mj.export.poses import drawn_geoms, record_poses
@@ -44,7 +44,7 @@ def _rot(q_xyzw):
 
 @pytest.fixture(scope="module")
 def flight():
-    f = Flight3D(controller="steer", task=evolve3d.course(100))
+    f = Flight3D(controller="steer", task=flight3d.course(100))
     poses = record_poses(f, 1.0, fps=30.0)
     return f, poses
 

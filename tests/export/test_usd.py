@@ -6,8 +6,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from lifelike_mj.butterfly import evolve3d
-from lifelike_mj.butterfly.sim3d import Flight3D
+from lifelike_mj.butterfly import flight3d
+from lifelike_mj.butterfly.flight3d.flight import Flight3D
 from lifelike_mj.errors import UserError
 from lifelike_mj.export.poses import drawn_geoms, record_poses
 from lifelike_mj.export.usd import write_usd
@@ -25,7 +25,7 @@ def _rotation_error(R, q_wxyz):
 
 @pytest.mark.parametrize("suffix", [".usda", ".usdc"])
 def test_the_stage_read_back_puts_every_body_and_geom_where_the_simulation_had_it(tmp_path, suffix):
-    f = Flight3D(controller="steer", task=evolve3d.course(100))
+    f = Flight3D(controller="steer", task=flight3d.course(100))
     poses = record_poses(f, 1.0, fps=30.0)
     path = write_usd(poses, tmp_path / f"run{suffix}", parameters={"controller": "steer"})
     stage = Usd.Stage.Open(str(path))

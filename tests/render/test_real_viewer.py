@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 from lifelike_mj.boids.render import KEYS as BOIDS_KEYS
-from lifelike_mj.butterfly.render import FLIGHT3D_KEYS
+from lifelike_mj.butterfly.flight3d.view import FLIGHT3D_KEYS
 from lifelike_mj.fish.aquarium import KEYS as FISH_KEYS
 
 CHILD = Path(__file__).with_name("real_viewer_child.py")

@@ -5,9 +5,8 @@
 * :mod:`~lifelike_mj.butterfly.backends.mj`: the MuJoCo model (``models/butterfly/``) with the wing
   force in a compiled passive callback.
 
-``simulate(backend, controllers, params, conditions, duration_s, dt_s, record_every)`` returns a
-list of :class:`~lifelike_mj.butterfly.flight.Trajectory`, sampled every ``record_every`` steps
-from ``t = 0``, whatever the backend. Importing this package imports neither backend.
+This package names the backends and the MuJoCo configurations; flying a batch on either is
+:func:`lifelike_mj.butterfly.batch.simulate`, above the stepper. Importing this package imports neither backend.
 """
 
 from __future__ import annotations
@@ -34,16 +33,3 @@ def mujoco_options(config: str = "paper", force_mode: str | None = None) -> dict
     if config not in DEFAULT_FORCE_MODE:
         raise UserError(f"unknown configuration {config!r}; choose paper or rich.")
     return {"config": config, "force_mode": force_mode or DEFAULT_FORCE_MODE[config]}
-
-
-def simulate(backend: str, controllers, params=None, conditions=None, duration_s: float = 20.0,
-             dt_s: float = 1.0 / 1200.0, record_every: int = 1, **options):
-    """Fly on the named backend. ``options`` go to the MuJoCo backend (``config``, ``force_mode``)."""
-    check_backend(backend)
-    if backend == "paper":
-        from lifelike_mj.butterfly.backends import paper
-
-        return paper.simulate(controllers, params, conditions, duration_s, dt_s, record_every)
-    from lifelike_mj.butterfly.backends import mj
-
-    return mj.simulate(controllers, params, conditions, duration_s, dt_s, record_every, **options)

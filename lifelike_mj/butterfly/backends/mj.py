@@ -45,9 +45,7 @@ from lifelike_mj.butterfly.controllers import KIND_CONSTANT, ButterflyController
 from lifelike_mj.butterfly.flight import (
     Condition,
     PitchObservation,
-    Trajectory,
     builtin_law,
-    check_timing,
     fitness_term,
     pitch_command,
 )
@@ -504,38 +502,6 @@ def steppers_with(law) -> tuple[Callable, Callable]:
     return adv, rec
 
 
-def fly_one(m: mujoco.MjModel, controller: ButterflyController, params: ButterflyParams | None = None,
-            condition: Condition | None = None, duration_s: float = 20.0, record_every: int = 1,
-            force_mode: str = "tip", n_strips: int = 16, callback: str = "compiled") -> Trajectory:
-    """Fly one butterfly on model ``m`` (its timestep is the step). ``callback``: ``compiled`` (a
-    :class:`~lifelike_mj.butterfly.sim.Flight` on this model) or ``python`` (the Python reference)."""
-    cond = condition or Condition()
-    dt = float(m.opt.timestep)
-    check_timing(duration_s, dt, record_every)
-    if callback == "compiled":
-        from lifelike_mj.butterfly.sim import Flight
-
-        config = "rich" if layout(m).rich else "paper"
-        flight = Flight(controller, params, cond, backend="mujoco", config=config, force_mode=force_mode, dt_s=dt,
-                        n_strips=n_strips, _model=m)
-        return flight.record(duration_s=duration_s, every=record_every)
-    if callback != "python":
-        raise UserError(f"unknown callback kind {callback!r}; choose compiled or python.")
-    n_steps = check_timing(duration_s, dt, record_every)
-    d = setup_data(m, controller, params, cond, force_mode, n_strips)
-    lay = layout(m)
-    n_rec = n_steps // record_every + 1
-    out = np.empty((n_rec, 6))
-    out[0] = (d.qpos[lay.q_height], d.qpos[lay.q_forward], 0.0, 0.0, 0.0, d.qpos[lay.q_flap_left])
-    diverged = np.full(1, -1, dtype=np.int64)
-    fit = np.zeros(1)
-    _run_python(m, d, n_steps, record_every, controller, cond, lay, dt, out, diverged, fit)
-    t = np.arange(n_rec) * (record_every * dt)
-    return Trajectory(t=t, y=out[:, 0], z=out[:, 1], vy=out[:, 2], vz=out[:, 3], phi=out[:, 4], theta=out[:, 5],
-                      y0=cond.y0_m, flap_period_s=1.0 / controller.flap.frequency_hz, backend="mujoco",
-                      diverged_step=int(diverged[0]), fitness=float(fit[0]))
-
-
 _MODEL_CACHE: dict = {}
 
 
@@ -604,27 +570,3 @@ def _run_python(m, d, n_steps, record_every, controller, cond, lay, dt, out, div
                 out[r] = (qpos[lay.q_height], qpos[lay.q_forward], qvel[lay.d_height], qvel[lay.d_forward], ph,
                           qpos[lay.q_flap_left])
                 r += 1
-
-
-def simulate(controllers, params=None, conditions=None, duration_s: float = 20.0, dt_s: float = 1.0 / 1200.0,
-             record_every: int = 1, config: str = "paper", force_mode: str = "tip", n_strips: int = 16,
-             callback: str = "compiled") -> list[Trajectory]:
-    """Fly a batch (one after another) on the MuJoCo backend; same interface as ``paper.simulate``."""
-    check_config(config, force_mode)
-    ctrls = [controllers] if isinstance(controllers, ButterflyController) else list(controllers)
-    ps = [params] if params is None or isinstance(params, ButterflyParams) else list(params)
-    cs = [conditions] if conditions is None or isinstance(conditions, Condition) else list(conditions)
-    n = max(len(ctrls), len(ps), len(cs))
-    if any(len(x) not in (1, n) for x in (ctrls, ps, cs)):
-        raise UserError("batch sizes disagree between controllers, parameters and conditions.")
-    ctrls, ps, cs = (x * n if len(x) == 1 else x for x in (ctrls, ps, cs))
-    check_timing(duration_s, dt_s, record_every)
-    models: dict = {}
-    out = []
-    for c, p, cond in zip(ctrls, ps, cs):
-        key = p or ButterflyParams()
-        if key not in models:
-            models[key] = build_model(key, config)
-            models[key].opt.timestep = dt_s
-        out.append(fly_one(models[key], c, key, cond, duration_s, record_every, force_mode, n_strips, callback))
-    return out

@@ -69,7 +69,7 @@ class KinematicsCommand:
         for f in fields(KinematicsCommand)[1:]:
             props[f.name] = number("rad", -math.pi, math.pi)
         return {"type": "object", "properties": props, "additionalProperties": False,
-                "description": "the kinematics (module lifelike_mj.butterfly.kinematics3d); missing ones take the "
+                "description": "the kinematics (module lifelike_mj.butterfly.flight3d.kinematics); missing ones take the "
                                "defaults: 10 Hz over [-60, 75] deg"}
 
     def as_array(self) -> np.ndarray:

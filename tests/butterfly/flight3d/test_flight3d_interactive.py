@@ -6,9 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from lifelike_mj.butterfly import evolve3d
-from lifelike_mj.butterfly.backends import mj3d
-from lifelike_mj.butterfly.sim3d import Flight3D
+from lifelike_mj.butterfly import flight3d
+from lifelike_mj.butterfly.flight3d import model as mj3d
+from lifelike_mj.butterfly.flight3d.flight import Flight3D
 from lifelike_mj.errors import UserError
 
 
@@ -18,7 +18,7 @@ def _fly(f, seconds):
 
 
 def test_a_new_altitude_course_and_wind_are_flown_to():
-    f = Flight3D(controller="wind", task=evolve3d.level(1.5))
+    f = Flight3D(controller="wind", task=flight3d.level(1.5))
     _fly(f, 3.0)
     f.set_reference(altitude_m=1.0)
     assert f.reference == (0.0, 1.0, 1.5)

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from lifelike_mj.butterfly.kinematics3d import JOINTS, Kinematics, KinematicsCommand
+from lifelike_mj.butterfly.flight3d.kinematics import JOINTS, Kinematics, KinematicsCommand
 from lifelike_mj.errors import UserError
 
 DT = 1.0 / 1200.0

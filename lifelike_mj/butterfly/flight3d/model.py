@@ -26,7 +26,7 @@ passive callback, which MuJoCo calls at every Runge-Kutta stage:
   along the thorax's own axes (``drag_frame="body"``, areas ``A_x, A_y, A_z``) or the world's (``"world"``,
   as the planar backends).
 
-* **the joints' drive**: the five driven joints (:data:`~lifelike_mj.butterfly.kinematics3d.JOINTS`)
+* **the joints' drive**: the five driven joints (:data:`~lifelike_mj.butterfly.flight3d.kinematics.JOINTS`)
   follow the kinematics' references, evaluated at the stage's own time from the filter's closed form,
   with the exact torques of :mod:`lifelike_mj.physics.drive` (reference acceleration plus a PD term on
   the error). The torques act on the joints only: the body feels them as reactions.
@@ -53,7 +53,7 @@ from numba import njit
 
 from lifelike_mj import checks
 from lifelike_mj.butterfly.aero import strip_nodes
-from lifelike_mj.butterfly.kinematics3d import JOINTS, N_PARAMS, Kinematics, filter_at, joint_refs
+from lifelike_mj.butterfly.flight3d.kinematics import JOINTS, N_PARAMS, Kinematics, filter_at, joint_refs
 from lifelike_mj.butterfly.model import CP_FRACTION
 from lifelike_mj.butterfly.params import PARAM_MAX, ButterflyParams
 from lifelike_mj.errors import UserError

@@ -6,11 +6,10 @@ import math
 import numpy as np
 import pytest
 
-from lifelike_mj.butterfly import control3d as c3
-from lifelike_mj.butterfly import evolve3d as e3
-from lifelike_mj.butterfly.backends import mj3d
-from lifelike_mj.butterfly.kinematics3d import KinematicsCommand
-from lifelike_mj.butterfly.sim3d import Flight3D, euler_from_quat
+from lifelike_mj.butterfly import flight3d
+from lifelike_mj.butterfly.flight3d import model as mj3d
+from lifelike_mj.butterfly.flight3d.flight import Flight3D, euler_from_quat
+from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
 from lifelike_mj.errors import UserError
 
 
@@ -31,7 +30,7 @@ def _quat(roll, pitch, yaw):
 @pytest.mark.parametrize("angles", [(0.3, 0.2, 1.0), (-0.5, -0.4, -2.5), (0.0, 0.7, 3.0)])
 def test_attitude_reads_roll_pitch_yaw_back(angles):
     q = _quat(*angles)
-    np.testing.assert_allclose(c3.attitude(q), angles, atol=1e-12)
+    np.testing.assert_allclose(flight3d.loop.attitude(q), angles, atol=1e-12)
     np.testing.assert_allclose(euler_from_quat(q), angles, atol=1e-12)
 
 
@@ -42,25 +41,25 @@ def test_the_observation_is_relative_to_the_reference():
     qvel = np.zeros(11)
     qvel[0:3] = (2.0 * math.cos(math.radians(30)), 2.0 * math.sin(math.radians(30)), -0.3)
     qvel[3:6] = (1.0, -2.0, 3.0)
-    obs = np.empty(c3.N_OBS)
-    c3.observe(qpos, qvel, math.radians(90), 0.1, 1.5, np.zeros(3), obs)
+    obs = np.empty(flight3d.N_OBS)
+    flight3d.loop.observe(qpos, qvel, math.radians(90), 0.1, 1.5, np.zeros(3), obs)
     want = [0.1, 0.2, math.radians(60), 1.0, 2.0, 3.0, 0.5, 0.0, -0.3, 0.3]
     np.testing.assert_allclose(obs, want, atol=1e-12)
-    c3.observe(qpos, qvel, math.radians(90), -5.0, 1.5, np.zeros(3), obs)
-    assert obs[9] == c3.ALTITUDE_CLIP_M
+    flight3d.loop.observe(qpos, qvel, math.radians(90), -5.0, 1.5, np.zeros(3), obs)
+    assert obs[9] == flight3d.controllers.ALTITUDE_CLIP_M
     # through the air: a wind of 1 m/s from behind and 0.5 m/s from the right (heading 30 deg), and a rising
     # gust the climb rate ignores (the altitude is the ground's)
     c, s = math.cos(math.radians(30)), math.sin(math.radians(30))
     wind = np.array([1.0 * c - 0.5 * -s, 1.0 * s - 0.5 * c, 0.4])
-    c3.observe(qpos, qvel, math.radians(90), 0.1, 1.5, wind, obs)
+    flight3d.loop.observe(qpos, qvel, math.radians(90), 0.1, 1.5, wind, obs)
     np.testing.assert_allclose(obs, [0.1, 0.2, math.radians(60), 1.0, 2.0, 3.0, -0.5, 0.5, -0.3, 0.3], atol=1e-12)
 
 
 def test_air_inputs_fly_as_ground_inputs_in_still_air_and_differently_in_wind():
-    ctl = c3.load_controller("steer")
+    ctl = flight3d.load_controller("steer")
     air = ctl.with_weights(ctl.weights, inputs="air")
     assert air.air_inputs and not ctl.air_inputs and air.to_dict()["inputs"] == "air"
-    calm, windy = e3.course(100), e3.course(100).with_weather((0.0, 1.0, 0.0))
+    calm, windy = flight3d.course(100), flight3d.course(100).with_weather((0.0, 1.0, 0.0))
     f = [Flight3D(controller=c, task=t, n_strips=4, n_chord=1) for t in (calm, windy) for c in (ctl, air)]
     for x in f:
         x.step(600)
@@ -69,19 +68,19 @@ def test_air_inputs_fly_as_ground_inputs_in_still_air_and_differently_in_wind():
 
 
 def test_a_linear_network_is_tanh_of_the_scaled_inputs_and_the_command_maps_each_action():
-    layers = np.array([c3.N_OBS, c3.N_ACT])
+    layers = np.array([flight3d.N_OBS, flight3d.N_ACT])
     rng = np.random.default_rng(0)
-    w = rng.normal(size=c3.n_weights(layers))
-    x = rng.normal(size=c3.N_OBS)
-    out = np.empty(c3.N_ACT)
-    c3.network(layers, w, x, out, np.empty(2 * c3.N_OBS))
-    W = w.reshape(c3.N_ACT, c3.N_OBS + 1)
-    np.testing.assert_allclose(out, np.tanh(W[:, :-1] @ (x / c3.INPUT_SCALE) + W[:, -1]), rtol=1e-14)
+    w = rng.normal(size=flight3d.n_weights(layers))
+    x = rng.normal(size=flight3d.N_OBS)
+    out = np.empty(flight3d.N_ACT)
+    flight3d.loop.network(layers, w, x, out, np.empty(2 * flight3d.N_OBS))
+    W = w.reshape(flight3d.N_ACT, flight3d.N_OBS + 1)
+    np.testing.assert_allclose(out, np.tanh(W[:, :-1] @ (x / flight3d.controllers.INPUT_SCALE) + W[:, -1]), rtol=1e-14)
     base = KinematicsCommand().as_array()
     scale = np.arange(1.0, 10.0) / 10
     u = np.array([1.0, 0.5, -1.0, 0.25, 0.2, -0.4, 1.0, -1.0, 0.5])
     target = np.empty(13)
-    c3.command(base, scale, u, target)
+    flight3d.loop.command(base, scale, u, target)
     d = target - base
     np.testing.assert_allclose(d[[1, 2]], [0.1 + 0.1, 0.1 - 0.1])
     np.testing.assert_allclose(d[[3, 4]], [-0.3 + 0.1, -0.3 - 0.1])
@@ -91,88 +90,89 @@ def test_a_linear_network_is_tanh_of_the_scaled_inputs_and_the_command_maps_each
 
 
 def test_a_controller_file_round_trips_and_bad_ones_are_one_sentence(tmp_path):
-    ctl = c3.Controller3D([10, 4, 9], np.linspace(-1, 1, c3.n_weights([10, 4, 9])), provenance={"note": "test"})
-    again = c3.controller_from_dict(json.loads(json.dumps(ctl.to_dict())))
+    ctl = flight3d.Controller3D([10, 4, 9], np.linspace(-1, 1, flight3d.n_weights([10, 4, 9])), provenance={"note": "test"})
+    again = flight3d.controller_from_dict(json.loads(json.dumps(ctl.to_dict())))
     np.testing.assert_array_equal(again.weights, ctl.weights)
     assert again.to_dict() == ctl.to_dict()
     good = ctl.to_dict()
     with pytest.raises(UserError, match="layers must be whole numbers running from 10 inputs to 9 outputs"):
-        c3.controller_from_dict(dict(good, layers=[6, 1]))
+        flight3d.controller_from_dict(dict(good, layers=[6, 1]))
     with pytest.raises(UserError, match="need 89 finite weights"):
-        c3.controller_from_dict(dict(good, weights=[0.0] * 84))
+        flight3d.controller_from_dict(dict(good, weights=[0.0] * 84))
     with pytest.raises(UserError, match="unknown key 'wieghts'"):
-        c3.controller_from_dict(dict(good, wieghts=good["weights"]))
+        flight3d.controller_from_dict(dict(good, wieghts=good["weights"]))
     with pytest.raises(UserError, match="inputs must be 'ground' or 'air', got 'sky'"):
-        c3.controller_from_dict(dict(good, inputs="sky"))
-    assert c3.controller_from_dict({k: v for k, v in good.items() if k != "inputs"}).inputs == "ground"
+        flight3d.controller_from_dict(dict(good, inputs="sky"))
+    assert flight3d.controller_from_dict({k: v for k, v in good.items() if k != "inputs"}).inputs == "ground"
     with pytest.raises(UserError, match="scale has an unknown key 'yaw'"):
-        c3.controller_from_dict(dict(good, scale={"yaw": 0.1}))
+        flight3d.controller_from_dict(dict(good, scale={"yaw": 0.1}))
     with pytest.raises(UserError, match="base has an unknown key 'flap_hz'"):
-        c3.controller_from_dict(dict(good, base={"flap_hz": 10.0}))
+        flight3d.controller_from_dict(dict(good, base={"flap_hz": 10.0}))
     path = tmp_path / "c.json"
     path.write_text(json.dumps(dict(good, weights=[float("nan")] + good["weights"][1:])).replace("NaN", "NaN"))
     with pytest.raises(UserError, match="not readable JSON"):
-        c3.load_controller(path)
+        flight3d.load_controller(path)
 
 
 def test_tasks_are_checked_and_courses_are_drawn_by_seed():
-    a, b, c = e3.course(3), e3.course(3), e3.course(4)
+    a, b, c = flight3d.course(3), flight3d.course(3), flight3d.course(4)
     assert a == b and a != c and len(a.rows) == 10
     legs = np.diff(np.array([(0.0, 0.0)] + [r[:2] for r in a.rows]), axis=0)
     np.testing.assert_allclose(np.linalg.norm(legs, axis=1), 1.5)
     assert max(abs(r[2]) for r in a.rows) <= 0.3
     with pytest.raises(UserError, match="first row starts at 0 s"):
-        e3.Task3D("schedule", ((1.0, 0.0, 0.0, 1.0),))
+        flight3d.Task3D("schedule", ((1.0, 0.0, 0.0, 1.0),))
     with pytest.raises(UserError, match="rows of 3 numbers"):
-        e3.Task3D("waypoints", ((1.0, 0.0),))
+        flight3d.Task3D("waypoints", ((1.0, 0.0),))
 
 
 def test_the_schedule_and_the_waypoints_give_the_references():
-    rec = e3.new_record(1, 2)[0]
-    task = e3.turn(90.0, at_s=2.0, speed_m_s=1.2, climb_m=0.3).as_array(2)
-    assert c3.reference(task, 1.9, np.zeros(3), rec) == (0.0, 0.0, 1.2)
-    assert c3.reference(task, 2.0, np.zeros(3), rec) == (pytest.approx(math.pi / 2), 0.3, 1.2)
-    wp = e3.Task3D("waypoints", ((1.0, 1.0, 0.2), (2.0, 0.0, 0.0)), radius_m=0.3, speed_m_s=1.0).as_array(2)
-    h, z, v = c3.reference(wp, 0.0, np.zeros(3), rec)
-    assert (h, z, v) == (pytest.approx(math.pi / 4), 0.2, 1.0) and rec[c3.R_PASSED] == 0
-    c3.reference(wp, 0.0, np.array([0.9, 0.9, 0.2]), rec)  # within 0.3 m: passed, aim at the next
-    assert rec[c3.R_PASSED] == 1 and rec[c3.R_WP] == pytest.approx(math.sqrt(0.02))
-    h, _, _ = c3.reference(wp, 0.0, np.array([0.9, 0.9, 0.2]), rec)
+    rec = flight3d.new_record(1, 2)[0]
+    task = flight3d.turn(90.0, at_s=2.0, speed_m_s=1.2, climb_m=0.3).as_array(2)
+    assert flight3d.loop.reference(task, 1.9, np.zeros(3), rec) == (0.0, 0.0, 1.2)
+    assert flight3d.loop.reference(task, 2.0, np.zeros(3), rec) == (pytest.approx(math.pi / 2), 0.3, 1.2)
+    wp = flight3d.Task3D("waypoints", ((1.0, 1.0, 0.2), (2.0, 0.0, 0.0)), radius_m=0.3, speed_m_s=1.0).as_array(2)
+    h, z, v = flight3d.loop.reference(wp, 0.0, np.zeros(3), rec)
+    assert (h, z, v) == (pytest.approx(math.pi / 4), 0.2, 1.0) and rec[flight3d.tasks.R_PASSED] == 0
+    flight3d.loop.reference(wp, 0.0, np.array([0.9, 0.9, 0.2]), rec)  # within 0.3 m: passed, aim at the next
+    assert rec[flight3d.tasks.R_PASSED] == 1 and rec[flight3d.tasks.R_WP] == pytest.approx(math.sqrt(0.02))
+    h, _, _ = flight3d.loop.reference(wp, 0.0, np.array([0.9, 0.9, 0.2]), rec)
     assert h == pytest.approx(math.atan2(-0.9, 1.1))
 
 
 def test_the_evolution_scores_what_the_stepper_flies():
     """The fitness of a controller in the batch (threads, many copies) is the reward its Flight3D earns."""
     layers = [10, 9]
-    w = np.random.default_rng(1).normal(0, 0.2, c3.n_weights(layers))
+    w = np.random.default_rng(1).normal(0, 0.2, flight3d.n_weights(layers))
     w[4 * 11 + 1] += 1.0
-    tmpl = c3.Controller3D(layers, np.zeros(len(w)))
-    tasks = (e3.level(1.0), e3.turn(90.0, 0.2))
-    prob = e3.FlightProblem3D(tasks, tmpl, duration_s=0.3)
+    tmpl = flight3d.Controller3D(layers, np.zeros(len(w)))
+    tasks = (flight3d.level(1.0), flight3d.turn(90.0, 0.2))
+    prob = flight3d.FlightProblem3D(tasks, tmpl, duration_s=0.3)
     fit = prob.evaluate(np.stack([w, w * 0.5]))
     for task, rec in zip(tasks, prob.fly(w[None, :])[0]):
         f = Flight3D(controller=tmpl.with_weights(w), task=task, n_strips=8, n_chord=2)
         f.step(360)
-        assert f.reward == rec[c3.R_FIT]
-    assert fit[0] == pytest.approx(np.mean(prob.fly(w[None, :])[0][:, c3.R_FIT]) / 0.3, rel=1e-15)
+        assert f.reward == rec[flight3d.tasks.R_FIT]
+    assert fit[0] == pytest.approx(np.mean(prob.fly(w[None, :])[0][:, flight3d.tasks.R_FIT]) / 0.3, rel=1e-15)
     assert prob.evaluate(w[None, :])[0] == fit[0]  # the same row scores the same in another batch
 
 
 def test_the_counter_based_numbers_are_uniform_normal_and_repeatable():
-    u = np.array([c3.uniform(7, k, 3) for k in range(20000)])
-    n = np.array([c3.normal(7, k, 1) for k in range(20000)])
+    u = np.array([flight3d.loop.uniform(7, k, 3) for k in range(20000)])
+    n = np.array([flight3d.loop.normal(7, k, 1) for k in range(20000)])
     assert 0.0 < u.min() and u.max() < 1.0
     assert abs(u.mean() - 0.5) < 0.01 and abs(u.std() - math.sqrt(1 / 12)) < 0.01
     assert abs(n.mean()) < 0.03 and abs(n.std() - 1.0) < 0.03
     assert abs(np.corrcoef(n[:-1], n[1:])[0, 1]) < 0.03
-    assert c3.normal(7, 5, 1) == n[5] and c3.normal(8, 5, 1) != n[5] and c3.normal(7, 5, 2) != n[5]
+    normal = flight3d.loop.normal
+    assert normal(7, 5, 1) == n[5] and normal(8, 5, 1) != n[5] and normal(7, 5, 2) != n[5]
 
 
 def test_gusts_are_a_gauss_markov_process_of_the_stated_deviation_and_time():
     sigma, tau, dt = 0.5, 1.0, 0.01
     x, xs = 0.0, []
     for k in range(200_000):
-        x = c3.ou_step(x, sigma, tau, dt, c3.normal(3, k, 0))
+        x = flight3d.loop.ou_step(x, sigma, tau, dt, flight3d.loop.normal(3, k, 0))
         xs.append(x)
     xs = np.array(xs[1000:])
     assert xs.std() == pytest.approx(sigma, rel=0.1)
@@ -181,9 +181,9 @@ def test_gusts_are_a_gauss_markov_process_of_the_stated_deviation_and_time():
 
 
 def test_vertical_gusts_have_their_own_deviation():
-    task = e3.level(1.5).with_weather((1.0, 0.0, 0.0), gust_m_s=0.5, seed=2,
-                                      gust_vertical_m_s=0.5 * e3.DRYDEN_VERTICAL_RATIO)
-    assert task.vertical_gust_m_s == 0.25 and e3.level(1.5).with_weather(gust_m_s=0.4).vertical_gust_m_s == 0.4
+    task = flight3d.level(1.5).with_weather((1.0, 0.0, 0.0), gust_m_s=0.5, seed=2,
+                                      gust_vertical_m_s=0.5 * flight3d.DRYDEN_VERTICAL_RATIO)
+    assert task.vertical_gust_m_s == 0.25 and flight3d.level(1.5).with_weather(gust_m_s=0.4).vertical_gust_m_s == 0.4
     f = Flight3D(controller=None, task=task.with_weather((1.0, 0.0, 0.0), 0.5, gust_tau_s=0.05, seed=2,
                                                         gust_vertical_m_s=0.25), n_strips=2, n_chord=1)
     airs = []
@@ -195,12 +195,12 @@ def test_vertical_gusts_have_their_own_deviation():
     assert sd[0] == pytest.approx(0.5, rel=0.1) and sd[1] == pytest.approx(0.5, rel=0.1)
     assert sd[2] == pytest.approx(0.25, rel=0.1) and airs.mean(axis=0)[0] == pytest.approx(1.0, abs=0.1)  # 3 standard errors
     with pytest.raises(UserError, match="gust_vertical_m_s"):
-        e3.level(1.5).with_weather(gust_m_s=0.5, gust_vertical_m_s=-1.0)
+        flight3d.level(1.5).with_weather(gust_m_s=0.5, gust_vertical_m_s=-1.0)
 
 
 def test_a_gusty_flight_is_the_same_for_the_same_seed_and_feels_the_gusts():
-    ctl = c3.Controller3D([10, 9], e3.pd_prior([10, 9]))
-    task = e3.level(1.5).with_weather(wind_m_s=(1.0, 0.0, 0.0), gust_m_s=0.5, flutter=0.2, seed=4)
+    ctl = flight3d.Controller3D([10, 9], flight3d.pd_prior([10, 9]))
+    task = flight3d.level(1.5).with_weather(wind_m_s=(1.0, 0.0, 0.0), gust_m_s=0.5, flutter=0.2, seed=4)
     runs = []
     for seed in (4, 4, 5):
         f = Flight3D(controller=ctl, task=task.with_weather((1.0, 0.0, 0.0), 0.5, flutter=0.2, seed=seed),
@@ -217,22 +217,22 @@ def test_a_gusty_flight_is_the_same_for_the_same_seed_and_feels_the_gusts():
 
 
 def test_a_moving_target_is_aimed_at_where_it_is_now():
-    task = e3.moving_target(centre_m=(3.0, 0.0, 0.0), radius_m=2.0, speed_m_s=0.5, bob_m=0.0, cruise_m_s=1.5)
+    task = flight3d.moving_target(centre_m=(3.0, 0.0, 0.0), radius_m=2.0, speed_m_s=0.5, bob_m=0.0, cruise_m_s=1.5)
     arr = task.as_array(2)
-    rec = e3.new_record(1, 2)[0]
+    rec = flight3d.new_record(1, 2)[0]
     t = math.pi  # a quarter of the way round at 0.25 rad/s: the target is at (3 + 2 cos(pi/4), 2 sin(pi/4), 0)
-    h, z, v = c3.reference(arr, t, np.zeros(3), rec)
+    h, z, v = flight3d.loop.reference(arr, t, np.zeros(3), rec)
     tx, ty = 3.0 + 2.0 * math.cos(0.25 * t), 2.0 * math.sin(0.25 * t)
     assert h == pytest.approx(math.atan2(ty, tx)) and z == 0.0 and v == 1.5  # far: the cruise speed
-    assert rec[c3.R_WP + 1] == pytest.approx(math.hypot(tx, ty)) and rec[c3.R_PASSED] == 0
-    _, _, v = c3.reference(arr, t, np.array([tx - 0.2, ty, 0.0]), rec)  # close: slower, and counted
-    assert v == pytest.approx(1.0) and rec[c3.R_PASSED] == 1
+    assert rec[flight3d.tasks.R_WP + 1] == pytest.approx(math.hypot(tx, ty)) and rec[flight3d.tasks.R_PASSED] == 0
+    _, _, v = flight3d.loop.reference(arr, t, np.array([tx - 0.2, ty, 0.0]), rec)  # close: slower, and counted
+    assert v == pytest.approx(1.0) and rec[flight3d.tasks.R_PASSED] == 1
 
 
 def test_a_folder_named_like_a_shipped_controller_does_not_hide_it(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "wind").mkdir()
-    assert c3.load_controller("wind").inputs == "air"  # the shipped file, not the folder
+    assert flight3d.load_controller("wind").inputs == "air"  # the shipped file, not the folder
     (tmp_path / "mine").mkdir()
     with pytest.raises(UserError, match="is a folder"):
-        c3.load_controller("mine")
+        flight3d.load_controller("mine")

@@ -16,7 +16,7 @@ from lifelike_mj.render.plot import finish, new_figure
 def fig_paths(paths: list[dict], labels: list[str] | None = None, waypoints=None,
               path: str | os.PathLike | None = None, title: str = "", waypoint_label: str = "waypoints") -> Figure:
     """Top view (x, y; m) and side view (distance flown over ground, altitude; m) of one or more recorded 3D
-    flights (:meth:`~lifelike_mj.butterfly.sim3d.Flight3D.record`), with the task's waypoints if given."""
+    flights (:meth:`~lifelike_mj.butterfly.flight3d.flight.Flight3D.record`), with the task's waypoints if given."""
     fig = new_figure(12.0, 4.8)
     top, side = fig.subplots(1, 2, width_ratios=[1.2, 1])
     for i, rec in enumerate(paths):
@@ -71,10 +71,10 @@ def force_breakdown(controller, force_law: str = "strip", speed_m_s: float = 1.5
     ``settle_s``: ``t_s``, ``lift_N``, ``drag_N``, ``rotational_N``, ``total_N`` (rows per step, x forward at
     the start, z up) and ``flap_rad``. The default law is eq. 1 on panels, which splits the force panel by
     panel (the exact law splits it by the flow at the wing's centroid)."""
-    from lifelike_mj.butterfly import evolve3d
-    from lifelike_mj.butterfly.sim3d import Flight3D
+    from lifelike_mj.butterfly.flight3d import tasks
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
-    f = Flight3D(controller=controller, task=evolve3d.level(speed_m_s), force_law=force_law, **flight)
+    f = Flight3D(controller=controller, task=tasks.level(speed_m_s), force_law=force_law, **flight)
     f.step(int(round(settle_s / f.dt)))
     n = int(round(beats / f.kinematics.p[0] / f.dt))
     rows = {"t_s": [], "lift_N": [], "drag_N": [], "rotational_N": [], "total_N": [], "flap_rad": []}

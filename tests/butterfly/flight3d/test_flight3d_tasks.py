@@ -2,9 +2,9 @@
 
 import pytest
 
-from lifelike_mj.butterfly import control3d as c3
-from lifelike_mj.butterfly.evolve3d import DRYDEN_VERTICAL_RATIO
-from lifelike_mj.butterfly.validate3d import course_check, kinematics_check, level_check, turn_check
+from lifelike_mj.butterfly import flight3d
+from lifelike_mj.butterfly.flight3d.tasks import DRYDEN_VERTICAL_RATIO
+from lifelike_mj.butterfly.flight3d.validate import course_check, kinematics_check, level_check, turn_check
 from lifelike_mj.paths import shipped_names
 
 SHIPPED = shipped_names("butterfly3d")
@@ -13,7 +13,7 @@ SHIPPED = shipped_names("butterfly3d")
 def test_the_controllers_are_shipped_with_their_provenance():
     assert {"steer", "cruise", "wind"} <= set(SHIPPED)
     for name in SHIPPED:
-        prov = c3.load_controller(name).provenance
+        prov = flight3d.load_controller(name).provenance
         assert prov["evolution_wall_time_s"] > 0 and prov["generations_done"] > 0
         assert prov["problem"]["problem"] == "butterfly3d-flight" and "machine" in prov
 

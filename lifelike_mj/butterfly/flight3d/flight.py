@@ -1,24 +1,23 @@
 """The 3D butterfly in free flight, in the stepper shape every creature shares.
 
 :class:`Flight3D` flies ``models/butterfly/butterfly3d.xml``: a free body that only the air, gravity and
-its own joints move (:mod:`lifelike_mj.butterfly.backends.mj3d`). It is steered by its kinematics alone
-(:class:`~lifelike_mj.butterfly.kinematics3d.KinematicsCommand`: flap frequency, each wing's stroke
+its own joints move (:mod:`lifelike_mj.butterfly.flight3d.model`). It is steered by its kinematics alone
+(:class:`~lifelike_mj.butterfly.flight3d.kinematics.KinematicsCommand`: flap frequency, each wing's stroke
 amplitude and offset, feathering, the abdomen), which change smoothly whenever a new command is set::
 
-    from lifelike_mj.butterfly.sim3d import Flight3D
-    from lifelike_mj.butterfly.kinematics3d import KinematicsCommand
+    from lifelike_mj.butterfly.flight3d import Flight3D, KinematicsCommand
 
     flight = Flight3D(KinematicsCommand(frequency_hz=10.0))
     flight.step(1200)                       # one second
     print(flight.state()["position_m"])     # x forward, y to the left, z up (m)
 
-A controller is a 3D controller file (:mod:`~lifelike_mj.butterfly.control3d`: a network from the body's
+A controller is a 3D controller file (:mod:`~lifelike_mj.butterfly.flight3d.controllers`: a network from the body's
 attitude and motion to changes of the kinematics, flown in the compiled loop towards a task's references),
 or any callable ``controller(flight) -> KinematicsCommand | None``, called from Python before every
 ``control_every``-th step (``None``: keep the command)::
 
-    from lifelike_mj.butterfly import evolve3d
-    Flight3D(controller="level", task=evolve3d.turn(90.0)).step(6000)
+    from lifelike_mj.butterfly.flight3d import turn
+    Flight3D(controller="steer", task=turn(90.0)).step(6000)
 
 World frame: x forward at the start, y to the left, z up; the body's pitch is nose-up positive, its roll
 right-wing-down positive, its yaw to the left positive.
@@ -34,13 +33,15 @@ import mujoco
 import numpy as np
 
 from lifelike_mj import checks
-from lifelike_mj.butterfly.backends import mj3d
-from lifelike_mj.butterfly.kinematics3d import JOINTS, N_PARAMS, Kinematics, KinematicsCommand
+from lifelike_mj.butterfly.flight3d import model as mj3d
+from lifelike_mj.butterfly.flight3d.controllers import Controller3D, load_controller
+from lifelike_mj.butterfly.flight3d.kinematics import JOINTS, N_PARAMS, Kinematics, KinematicsCommand
+from lifelike_mj.butterfly.flight3d.loop import Batch
+from lifelike_mj.butterfly.flight3d.tasks import R_DIVERGED, R_PASSED, R_WP, T_ROW0, T_WIND, Task3D, level, new_record
 from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.errors import Diverged, UserError
-from lifelike_mj.physics import mjabi
 from lifelike_mj.physics.callbacks import passive_callback
-from lifelike_mj.physics.stability import describe, watching
+from lifelike_mj.physics.stability import describe
 from lifelike_mj.stepper import StepCounter
 
 #: Names of :meth:`Flight3D.state` and their units.
@@ -53,7 +54,6 @@ STATE_UNITS = {
     "joint_rates_rad_s": "rad/s: the same joints' rates",
 }
 
-_NO_PATH = np.empty((0, 7))
 #: The 3D flight's time step (s): 120 steps per 10 Hz wing beat.
 DT_S = 1.0 / 1200.0
 #: The fewest time steps per wing beat a 3D flight accepts.
@@ -83,12 +83,12 @@ class Flight3D(StepCounter):
 
     ``command``: the kinematics at the start (default: the controller's base command, else the paper's
     10 Hz flap over [-60, 75] deg, no feathering); ``params``: the physical constants (mass, wing size,
-    air; Oe 2010 Table 1). ``controller``: a 3D controller (:class:`~lifelike_mj.butterfly.control3d.Controller3D`,
+    air; Oe 2010 Table 1). ``controller``: a 3D controller (:class:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D`,
     or the name or path of a controller file), flown in the compiled loop towards ``task``'s references
-    (:class:`~lifelike_mj.butterfly.evolve3d.Task3D`; default level flight at 1.5 m/s), or any callable
+    (:class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`; default level flight at 1.5 m/s), or any callable
     ``controller(flight) -> KinematicsCommand | None`` run from Python before every ``control_every``-th
     step. ``wind_m_s``: the mean wind (world frame, m/s, where it blows to), replacing the task's (gusts and
-    flutter are the task's: :class:`~lifelike_mj.butterfly.evolve3d.Task3D`); ``start_m``: the thorax's start
+    flutter are the task's: :class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`); ``start_m``: the thorax's start
     position.
     Model options: ``force_law`` (``exact``: eq. 1 integrated exactly over each wing; ``strip``: eq. 1 on wing
     panels; ``quasi_steady``: blade elements on the panels; ``tip``: the paper's tip-speed formula; ``none``),
@@ -107,12 +107,10 @@ class Flight3D(StepCounter):
                  body_areas_m2=None, masses: str = "animal", dt_s: float = DT_S, n_strips: int = 8,
                  n_chord: int = 2, drive_hz: float = 50.0, omega_c: float | None = None, assist: str = "none",
                  pitch_law: Callable | None = None, _model: mujoco.MjModel | None = None) -> None:
-        from lifelike_mj.butterfly import control3d, evolve3d
-
         self.network = None
         if isinstance(controller, (str, Path)):
-            controller = control3d.load_controller(controller)
-        if isinstance(controller, control3d.Controller3D):
+            controller = load_controller(controller)
+        if isinstance(controller, Controller3D):
             self.network, controller = controller, None
             omega_c = self.network.omega_c_rad_s if omega_c is None else omega_c
             command = command or self.network.base
@@ -122,9 +120,9 @@ class Flight3D(StepCounter):
         self.command = command or KinematicsCommand()
         if not isinstance(self.command, KinematicsCommand):
             raise UserError(f"a kinematics command is a KinematicsCommand, got {self.command!r}.")
-        self.task = task if task is not None else evolve3d.level(1.5)
-        if not isinstance(self.task, evolve3d.Task3D):
-            raise UserError(f"a task is a Task3D (evolve3d.level, turn, course), got {self.task!r}.")
+        self.task = task if task is not None else level(1.5)
+        if not isinstance(self.task, Task3D):
+            raise UserError(f"a task is a Task3D (flight3d.level, turn, course), got {self.task!r}.")
         self.params = params or ButterflyParams()
         self.dt = checks.positive("time step dt_s", dt_s, "s")
         period = 1.0 / self.command.frequency_hz
@@ -153,13 +151,6 @@ class Flight3D(StepCounter):
         n_rows = len(self.task.rows)
         self._task = self.task.as_array(n_rows)
         self._n_rows = n_rows
-        net = self.network
-        self._layers = net.layers if net else np.zeros(1, dtype=np.int64)
-        self._weights = net.weights if net else np.zeros(0)
-        self._scale = net.scale if net else np.zeros(9)
-        self._every = net.every if net else 1
-        self._air_inputs = bool(net and net.air_inputs)
-        self._base = (net.base if net else self.command).as_array()
         self.reset()
 
     # ---- the stepper shape ---------------------------------------------------------------------
@@ -181,13 +172,15 @@ class Flight3D(StepCounter):
     def reset(self, seed: int | None = None) -> None:
         """Back to the start: at rest at ``start_m``, level, heading +x, the kinematics at the start command.
         The flight has no randomness yet; ``seed`` is accepted for the common shape."""
-        from lifelike_mj.butterfly.evolve3d import new_record
-
         self._k = 0
         kin = Kinematics(self.command, self.omega_c)
         self._data = mj3d.setup_data(self._model, kin, self.params, air_m_s=self.wind_m_s, **self.options)
         self._data.qpos[self._root_q : self._root_q + 3] = self.start_m
-        self._rec = new_record(1, self._n_rows)[0]
+        net = self.network
+        self._batch = Batch(self._model, [self._data], self._task, net, dt_s=self.dt,
+                            records=new_record(1, self._n_rows), base=None if net else self.command.as_array())
+        self._task = self._batch.tasks[0]
+        self._rec = self._batch.records[0]
         self._diverged = ""
 
     @property
@@ -213,8 +206,6 @@ class Flight3D(StepCounter):
         For interactive scenes (the viewers' wind keys)."""
         from dataclasses import replace
 
-        from lifelike_mj.butterfly.control3d import T_WIND
-
         w = checks.vector("wind_m_s", wind_m_s, 3, "m/s")
         self.task = replace(self.task, wind_m_s=w)
         self.wind_m_s = np.array(w)
@@ -224,12 +215,10 @@ class Flight3D(StepCounter):
     def set_reference(self, heading_rad: float | None = None, altitude_m: float | None = None,
                       speed_m_s: float | None = None) -> None:
         """Fly level at ``heading_rad`` (from +x, left > 0), ``altitude_m`` and ``speed_m_s`` from now on: the task
-        becomes a one-row schedule (:func:`~lifelike_mj.butterfly.evolve3d.level`), its weather kept. What is
+        becomes a one-row schedule (:func:`~lifelike_mj.butterfly.flight3d.tasks.level`), its weather kept. What is
         not given stays: the schedule's current value, else the heading and altitude the butterfly has now and
         the task's speed. For interactive scenes (the viewers' course and altitude keys)."""
         from dataclasses import replace
-
-        from lifelike_mj.butterfly.control3d import T_ROW0
 
         now = self.reference
         h = float(now[0] if heading_rad is None else checks.number("heading_rad", heading_rad, unit="rad"))
@@ -250,46 +239,35 @@ class Flight3D(StepCounter):
         d, rq = self._data, self._root_q
         return float(euler_from_quat(d.qpos[rq + 3 : rq + 7])[2]), float(d.qpos[rq + 2]), float(self.task.speed_m_s)
 
-    def _fly(self, n: int) -> None:
-        from lifelike_mj.butterfly import control3d
-
-        m, d = self._model, self._data
-        control3d.fly_steps(m._address, d._address, mjabi.offsets_tuple(), m.nq, m.nv, n, self.dt, self._every,
-                            self._layers, self._weights, self._base, self._scale, self._task, self._rec, _NO_PATH, 0,
-                            math.inf, self._air_inputs)
-
     def step(self, n: int = 1) -> None:
         """Advance ``n`` time steps (a Python controller, if any, before every ``control_every``-th). An unstable
         flight raises :class:`~lifelike_mj.errors.Diverged` naming the step and the cause."""
-        from lifelike_mj.butterfly.control3d import R_DIVERGED
-
         n = checks.whole("the number of steps", n, 0)
         self._check_alive()
         d = self._data
         hold = self.options["assist"] == "hold"
-        with passive_callback(mj3d.COMPILED_PASSIVE), watching():
-            if self.controller is None and not hold:
-                self._fly(n)
+        if self.controller is None and not hold:
+            self._batch.advance(n)
+        else:
+            for _ in range(n):
+                if self.controller is not None and self._k % self.control_every == 0:
+                    command = self.controller(self)
+                    if command is not None:
+                        self.set_command(command)
+                if hold:
+                    d.qpos[self._root_q + 3 : self._root_q + 7] = quat_from_pitch(float(self.pitch_law(self)))
+                    d.qvel[self._root_d + 3 : self._root_d + 6] = 0.0
+                self._batch.advance(1)
+                self._k = int(self._rec[1])
+                if self._rec[R_DIVERGED] >= 0:
+                    break
+        self._k = int(self._rec[1])
+        if self._rec[R_DIVERGED] >= 0:
+            if d.time < 0.5 * self._k * self.dt:  # MuJoCo reset the simulation (its clock went back)
+                self._diverged = describe(d, "the 3D flight")
             else:
-                for _ in range(n):
-                    if self.controller is not None and self._k % self.control_every == 0:
-                        command = self.controller(self)
-                        if command is not None:
-                            self.set_command(command)
-                    if hold:
-                        d.qpos[self._root_q + 3 : self._root_q + 7] = quat_from_pitch(float(self.pitch_law(self)))
-                        d.qvel[self._root_d + 3 : self._root_d + 6] = 0.0
-                    self._fly(1)
-                    if self._rec[R_DIVERGED] >= 0:
-                        break
-            done = int(self._rec[1]) - self._k
-            self._k += done
-            if self._rec[R_DIVERGED] >= 0:
-                if d.time < 0.5 * self._k * self.dt:  # MuJoCo reset the simulation (its clock went back)
-                    self._diverged = describe(d, "the 3D flight")
-                else:
-                    self._diverged = f"the 3D flight diverged: its speed ran away above {RUNAWAY_M_S:g} m/s;"
-                self._diverged += f" (step {self._k}, t = {self.time:.4f} s)"
+                self._diverged = f"the 3D flight diverged: its speed ran away above {RUNAWAY_M_S:g} m/s;"
+            self._diverged += f" (step {self._k}, t = {self.time:.4f} s)"
         self._check_alive()
 
     def _check_alive(self) -> None:
@@ -299,22 +277,18 @@ class Flight3D(StepCounter):
 
     @property
     def reward(self) -> float:
-        """The task's reward summed over the steps flown (s; :func:`~lifelike_mj.butterfly.control3d.reward` per
+        """The task's reward summed over the steps flown (s; :func:`~lifelike_mj.butterfly.flight3d.loop.reward` per
         second): divided by the time flown, the mean in ``[0, 1]`` the evolution maximises."""
         return float(self._rec[0])
 
     @property
     def waypoints_passed(self) -> int:
         """How many of the task's waypoints have been passed (within its radius), in order."""
-        from lifelike_mj.butterfly.control3d import R_PASSED
-
         return int(self._rec[R_PASSED]) if self.task.kind == "waypoints" else 0
 
     @property
     def closest_approach_m(self) -> np.ndarray:
         """The closest approach (m) so far to each of the task's waypoints (inf: not yet aimed at)."""
-        from lifelike_mj.butterfly.control3d import R_WP
-
         return self._rec[R_WP : R_WP + self._n_rows].copy()
 
     def state(self) -> dict[str, np.ndarray]:

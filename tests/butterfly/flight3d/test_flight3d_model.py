@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from lifelike_mj.butterfly import aero
-from lifelike_mj.butterfly.backends import mj3d
-from lifelike_mj.butterfly.kinematics3d import Kinematics, KinematicsCommand
+from lifelike_mj.butterfly.flight3d import model as mj3d
+from lifelike_mj.butterfly.flight3d.flight import Flight3D
+from lifelike_mj.butterfly.flight3d.kinematics import Kinematics, KinematicsCommand
 from lifelike_mj.butterfly.params import ButterflyParams
-from lifelike_mj.butterfly.sim3d import Flight3D
 from lifelike_mj.errors import UserError
 from lifelike_mj.physics.callbacks import passive_callback
 
@@ -163,7 +163,7 @@ def test_with_air_the_body_feels_only_the_air_on_its_free_dofs(model):
 def test_the_3d_model_reduced_to_the_plane_flies_the_planar_mujoco_flight_for_20_s(controller, tol_m):
     """Issue 15's reduction: within 1 cm of the planar MuJoCo backend over 20 s (measured: 0.24 mm with the
     simple rule, 1.3 nm with the paper's network), never leaving the sagittal plane."""
-    from lifelike_mj.butterfly.validate3d import reduction
+    from lifelike_mj.butterfly.flight3d.validate import reduction
 
     r = reduction(controller, duration_s=20.0)
     assert r["duration_s"] == pytest.approx(20.0)

@@ -2,7 +2,7 @@
 
 :class:`Garden` is a stepper (the shape of :mod:`lifelike_mj.stepper`): ``n`` butterflies, each simulated on
 its own ``mjData`` of the one-butterfly model and flown together by the compiled threaded batch
-(:func:`~lifelike_mj.butterfly.control3d.fly_batch`). They do not touch or disturb each other (the
+(:class:`~lifelike_mj.butterfly.flight3d.loop.Batch`). They do not touch or disturb each other (the
 air's force law has no wake). Each butterfly's course visits the garden's flowers in an order drawn by
 its own seed, with its own flutter; ``model``/``data`` are a drawing scene (ground, flowers, ``n``
 butterflies) posed from the simulations by :meth:`Garden.sync`, with a fixed camera ``overview`` and
@@ -17,15 +17,13 @@ import mujoco
 import numpy as np
 
 from lifelike_mj import checks
-from lifelike_mj.butterfly import control3d as c3
-from lifelike_mj.butterfly import evolve3d as e3
-from lifelike_mj.butterfly.backends import mj3d
-from lifelike_mj.butterfly.kinematics3d import Kinematics
-from lifelike_mj.butterfly.sim3d import DT_S
+from lifelike_mj.butterfly.flight3d import model as mj3d
+from lifelike_mj.butterfly.flight3d.controllers import Controller3D, load_controller
+from lifelike_mj.butterfly.flight3d.flight import DT_S
+from lifelike_mj.butterfly.flight3d.kinematics import Kinematics
+from lifelike_mj.butterfly.flight3d.loop import Batch, attitude
+from lifelike_mj.butterfly.flight3d.tasks import R_DIVERGED, R_PASSED, Task3D, new_record
 from lifelike_mj.errors import Diverged, UserError
-from lifelike_mj.physics import mjabi
-from lifelike_mj.physics.callbacks import passive_callback
-from lifelike_mj.physics.stability import watching
 from lifelike_mj.stepper import StepCounter
 
 #: The ground lies this far below the flight altitude 0 (m).
@@ -35,6 +33,12 @@ _PETALS = ((0.92, 0.3, 0.55, 1), (0.98, 0.85, 0.2, 1), (0.55, 0.35, 0.85, 1), (0
 _WING_COLOURS = ((0.98, 0.85, 0.25, 0.95), (0.95, 0.55, 0.15, 0.95), (0.35, 0.55, 0.95, 0.95), (0.95, 0.95, 0.9, 0.95))
 #: Waypoints on each butterfly's course (the flowers visited, in its order, over and over).
 COURSE_LENGTH = 40
+#: Names of :meth:`Garden.state` and their units (one row per butterfly).
+STATE_UNITS = {
+    "position_m": "m: each thorax's origin, x and y in the garden's plane, z up",
+    "attitude_rad": "rad: each body's roll (right wing down > 0), pitch (nose up > 0), yaw (left > 0)",
+    "waypoints_passed": "flowers passed on each butterfly's course, in order",
+}
 
 
 def flowers(seed: int, n: int = 12, size_m: float = 8.0, heights_m: float = 0.5) -> np.ndarray:
@@ -100,9 +104,9 @@ def scene_model(n: int, blossoms: np.ndarray, size_m: float = 8.0) -> mujoco.MjM
 class Garden(StepCounter):
     """``n`` 3D butterflies in a garden of ``n_flowers`` flowers drawn by ``seed`` (module docstring).
 
-    ``controller``: a 3D controller (name, path or :class:`~lifelike_mj.butterfly.control3d.Controller3D`);
+    ``controller``: a 3D controller (name, path or :class:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D`);
     ``flutter``, ``gust_m_s``, ``gust_vertical_m_s``, ``wind_m_s``: each butterfly's flutter and the weather
-    (:class:`~lifelike_mj.butterfly.evolve3d.Task3D`); ``speed_m_s``: the cruise speed; ``dt_s`` the time step.
+    (:class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`); ``speed_m_s``: the cruise speed; ``dt_s`` the time step.
     """
 
     @checks.known_keywords
@@ -111,12 +115,12 @@ class Garden(StepCounter):
                  gust_vertical_m_s: float | None = None, dt_s: float = DT_S, n_strips: int = 8, n_chord: int = 2,
                  force_law: str = "exact") -> None:
         self.n = checks.whole("the number of butterflies", n, 1, 500)
-        self.controller = controller if isinstance(controller, c3.Controller3D) else c3.load_controller(controller)
+        self.controller = controller if isinstance(controller, Controller3D) else load_controller(controller)
         self.seed = checks.whole("seed", seed, 0, 2**32 - 1)
         self.size_m = checks.number("garden size", size_m, 2.0, 100.0, unit="m")
         self.blossoms = flowers(self.seed, checks.whole("the number of flowers", n_flowers, 2, 200), self.size_m)
         self.dt = checks.positive("time step dt_s", dt_s, "s")
-        self.tasks = [e3.Task3D("waypoints", tuple(tuple(float(v) for v in p)
+        self.tasks = [Task3D("waypoints", tuple(tuple(float(v) for v in p)
                                                    for p in course_among(self.blossoms, self.seed * 1000 + i)),
                                 speed_m_s=checks.positive("speed_m_s", speed_m_s, "m/s"), name=f"butterfly {i}",
                                 wind_m_s=tuple(wind_m_s), gust_m_s=gust_m_s, gust_vertical_m_s=gust_vertical_m_s,
@@ -129,7 +133,6 @@ class Garden(StepCounter):
         self._data = mujoco.MjData(self._model)
         self._blocks = [int(self._model.jnt_qposadr[self._model.joint(f"b{i}_root").id]) for i in range(self.n)]
         self._task_arr = np.array([t.as_array(COURSE_LENGTH) for t in self.tasks])
-        self._weights = np.ascontiguousarray(np.tile(self.controller.weights, (self.n, 1)))
         #: Set to a list to collect the butterflies' positions (``(n, 3)``, m) at every :meth:`sync`.
         self.track: list[np.ndarray] | None = None
         self.reset()
@@ -160,24 +163,21 @@ class Garden(StepCounter):
             d.qpos[0:3] = start
             d.qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
             self._datas.append(d)
-        self._ptrs = np.array([d._address for d in self._datas], dtype=np.int64)
-        self._recs = e3.new_record(self.n, COURSE_LENGTH)
+        self._batch = Batch(self._phys, self._datas, self._task_arr, ctl, dt_s=self.dt,
+                            records=new_record(self.n, COURSE_LENGTH))
+        self._recs = self._batch.records
 
     def step(self, n: int = 1) -> None:
         """Advance every butterfly ``n`` steps (threads over the butterflies)."""
         n = checks.whole("the number of steps", n, 0)
         if n == 0:
             return
-        m, ctl = self._phys, self.controller
-        with passive_callback(mj3d.COMPILED_PASSIVE), watching():
-            c3.fly_batch(m._address, self._ptrs, mjabi.offsets_tuple(), m.nq, m.nv, n, self.dt, ctl.every, ctl.layers,
-                         self._weights, ctl.base.as_array(), ctl.scale, self._task_arr, self._recs, math.inf,
-                         ctl.air_inputs)
+        self._batch.advance(n)
         self._k += n
-        bad = np.nonzero(self._recs[:, c3.R_DIVERGED] >= 0)[0]
+        bad = self._batch.diverged()
         if len(bad):
             i = int(bad[0])
-            raise Diverged(f"butterfly {i} of the garden diverged at step {int(self._recs[i, c3.R_DIVERGED])}: its "
+            raise Diverged(f"butterfly {i} of the garden diverged at step {int(self._recs[i, R_DIVERGED])}: its "
                            "speed ran away or MuJoCo found its state unstable; the likely cause is the time step "
                            f"({self.dt:g} s) or the wind.")
 
@@ -192,10 +192,11 @@ class Garden(StepCounter):
         mujoco.mj_camlight(self._model, self._data)  # the cameras and lights follow the bodies
 
     def state(self) -> dict[str, np.ndarray]:
-        """``position_m`` ``(n, 3)``, ``attitude_rad`` ``(n, 3)`` (roll, pitch, yaw), ``waypoints_passed`` ``(n,)``."""
+        """``position_m`` ``(n, 3)``, ``attitude_rad`` ``(n, 3)`` (roll, pitch, yaw), ``waypoints_passed`` ``(n,)``
+        (:data:`STATE_UNITS`)."""
         pos = np.array([d.qpos[0:3] for d in self._datas])
-        att = np.array([c3.attitude(d.qpos[3:7]) for d in self._datas])
-        return {"position_m": pos, "attitude_rad": att, "waypoints_passed": self._recs[:, c3.R_PASSED].copy()}
+        att = np.array([attitude(d.qpos[3:7]) for d in self._datas])
+        return {"position_m": pos, "attitude_rad": att, "waypoints_passed": self._recs[:, R_PASSED].copy()}
 
 
 def chase_camera(garden: Garden, butterfly: int = 0):

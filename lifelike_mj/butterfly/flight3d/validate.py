@@ -19,9 +19,9 @@ from lifelike_mj.errors import UserError
 
 
 def kinematics_of(controller: ButterflyController):
-    """The :class:`~lifelike_mj.butterfly.kinematics3d.KinematicsCommand` of a planar controller's flap
+    """The :class:`~lifelike_mj.butterfly.flight3d.kinematics.KinematicsCommand` of a planar controller's flap
     pattern (Oe 2010 section 4.3: ``theta_c + theta_a cos(2 pi f t)`` on both wings, no feathering)."""
-    from lifelike_mj.butterfly.kinematics3d import KinematicsCommand
+    from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
 
     fl = controller.flap
     return KinematicsCommand(frequency_hz=fl.frequency_hz, offset_left=fl.theta_c, offset_right=fl.theta_c,
@@ -34,8 +34,8 @@ def reduction(controller: ButterflyController | str = "simple_rule", duration_s:
     model reduced to it (module docstring) for ``duration_s``; return the largest differences of the
     paths (m) and the largest sideways excursion of the 3D flight (m), with both end points."""
     from lifelike_mj.butterfly import controllers as _controllers
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
     from lifelike_mj.butterfly.sim import Flight
-    from lifelike_mj.butterfly.sim3d import Flight3D
 
     ctrl = controller if isinstance(controller, ButterflyController) else _controllers.load(controller)
     planar = Flight(ctrl, backend="mujoco", config="paper", force_mode="tip", dt_s=dt_s).record(duration_s=duration_s)
@@ -95,11 +95,11 @@ def level_check(controller, speed_m_s: float = 1.5, duration_s: float = 60.0, se
     """Fly ``controller`` level at ``speed_m_s`` for ``duration_s`` and measure it: the speed over ground
     each second after ``settle_s`` (m/s), the altitude throughout (m; the reference is the start, 0 m), and
     the body's roll and pitch throughout (deg)."""
-    from lifelike_mj.butterfly import evolve3d
-    from lifelike_mj.butterfly.sim3d import Flight3D
+    from lifelike_mj.butterfly.flight3d import tasks
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
     check_window("the level check", duration_s, settle_s, 1.0, "it measures the speed each second after settling")
-    f = Flight3D(controller=controller, task=evolve3d.level(speed_m_s), **flight)
+    f = Flight3D(controller=controller, task=tasks.level(speed_m_s), **flight)
     rec = f.record(duration_s=duration_s, every=12)
     t, pos, att = rec["t_s"], rec["position_m"], rec["attitude_rad"]
     per_s = int(round(1.0 / (t[1] - t[0])))
@@ -123,12 +123,12 @@ def turn_check(controller, angle_deg: float, at_s: float = 2.0, hold_s: float = 
     ``hold_s``; measure when the course over ground (beat-averaged) first comes within 10 deg of it, the
     largest error over the last half of the hold (deg), the turn's radius (m, speed over the mean rate of
     turn while turning) and its mean bank (roll, deg)."""
-    from lifelike_mj.butterfly import evolve3d
-    from lifelike_mj.butterfly.sim3d import Flight3D
+    from lifelike_mj.butterfly.flight3d import tasks
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
     checks.number("at_s", at_s, 0.0, MAX_CHECK_S, unit="s")
     check_window("the turn check", at_s + hold_s, at_s, 1.0, "it measures the course over the hold after the command")
-    f = Flight3D(controller=controller, task=evolve3d.turn(angle_deg, at_s, speed_m_s), **flight)
+    f = Flight3D(controller=controller, task=tasks.turn(angle_deg, at_s, speed_m_s), **flight)
     period = 1.0 / f.command.frequency_hz
     rec = f.record(duration_s=at_s + hold_s, every=12)
     t, pos, att = rec["t_s"], rec["position_m"], rec["attitude_rad"]
@@ -157,16 +157,16 @@ def turn_check(controller, angle_deg: float, at_s: float = 2.0, hold_s: float = 
 def course_check(controller, seed: int, n: int = 10, max_s: float = 60.0, weather: dict | None = None,
                  **flight) -> dict:
     """Fly ``controller`` along the course of ``n`` waypoints drawn by ``seed``
-    (:func:`~lifelike_mj.butterfly.evolve3d.course`) for at most ``max_s``; report the waypoints passed (in
+    (:func:`~lifelike_mj.butterfly.flight3d.tasks.course`) for at most ``max_s``; report the waypoints passed (in
     order, within the course's 0.3 m) and the closest approach to each (m). ``weather``: the wind, gusts and
-    flutter (:meth:`~lifelike_mj.butterfly.evolve3d.Task3D.with_weather`'s arguments; the seed defaults to
+    flutter (:meth:`~lifelike_mj.butterfly.flight3d.tasks.Task3D.with_weather`'s arguments; the seed defaults to
     the course's)."""
-    from lifelike_mj.butterfly import evolve3d
-    from lifelike_mj.butterfly.sim3d import Flight3D
+    from lifelike_mj.butterfly.flight3d import tasks
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
     checks.whole("the waypoints n", n, 1, 10_000)
     check_window("the course check", max_s, 0.0, 0.1, "")
-    task = evolve3d.course(seed, n)
+    task = tasks.course(seed, n)
     if weather:
         task = task.with_weather(**weather)
     f = Flight3D(controller=controller, task=task, **flight)
@@ -187,12 +187,12 @@ def kinematics_check(controller, speed_m_s: float = 1.5, settle_s: float = 5.0, 
     beat (deg), and the bobbing within a beat (m, top to bottom of the thorax). Also the mean vertical force
     coefficient the flight needs, ``m g / (1/2 rho S (2 Phi f R)^2)`` with ``S`` both wings' area: the figure
     Sunada et al. 1993 estimate at about 4 for a cabbage white taking off."""
-    from lifelike_mj.butterfly import evolve3d
-    from lifelike_mj.butterfly.sim3d import Flight3D
+    from lifelike_mj.butterfly.flight3d import tasks
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
     check_window("the kinematics check", settle_s + window_s, settle_s, 0.5, "it measures whole wing beats in the "
                  "window after settling")
-    f = Flight3D(controller=controller, task=evolve3d.level(speed_m_s), force_law=force_law, **flight)
+    f = Flight3D(controller=controller, task=tasks.level(speed_m_s), force_law=force_law, **flight)
     f.step(int(round(settle_s / f.dt)))
     rec = f.record(duration_s=window_s, every=1)
     t, pos, att, joints = rec["t_s"], rec["position_m"], rec["attitude_rad"], rec["joints_rad"]
@@ -217,14 +217,14 @@ def kinematics_check(controller, speed_m_s: float = 1.5, settle_s: float = 5.0, 
 
 
 def target_check(controller, duration_s: float = 40.0, catch_s: float = 10.0, **target) -> dict:
-    """Follow a moving target (:func:`~lifelike_mj.butterfly.evolve3d.moving_target`) for ``duration_s``; report
+    """Follow a moving target (:func:`~lifelike_mj.butterfly.flight3d.tasks.moving_target`) for ``duration_s``; report
     when it first came within the task's 0.3 m, and the distance's median and 90th percentile after ``catch_s``."""
-    from lifelike_mj.butterfly import evolve3d
-    from lifelike_mj.butterfly.control3d import R_WP
-    from lifelike_mj.butterfly.sim3d import Flight3D
+    from lifelike_mj.butterfly.flight3d import tasks
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
+    from lifelike_mj.butterfly.flight3d.tasks import R_WP
 
     check_window("the target check", duration_s, catch_s, 0.1, "it measures the distance after the catch time")
-    task = evolve3d.moving_target(**target)
+    task = tasks.moving_target(**target)
     f = Flight3D(controller=controller, task=task)
     dist, times = [], []
     first = None

@@ -3,10 +3,9 @@
 import numpy as np
 import pytest
 
-from lifelike_mj.butterfly import control3d as c3
-from lifelike_mj.butterfly import evolve3d as e3
-from lifelike_mj.butterfly.garden import Garden, course_among, flowers
-from lifelike_mj.butterfly.sim3d import Flight3D
+from lifelike_mj.butterfly import flight3d
+from lifelike_mj.butterfly.flight3d.flight import Flight3D
+from lifelike_mj.butterfly.flight3d.garden import Garden, course_among, flowers
 from lifelike_mj.errors import UserError
 
 
@@ -22,7 +21,7 @@ def test_flowers_and_courses_are_drawn_by_seed():
 
 def test_each_garden_butterfly_flies_what_its_own_flight_flies():
     """The garden's threaded batch gives every butterfly the flight a Flight3D on the same task gives it."""
-    ctl = c3.load_controller("cruise")
+    ctl = flight3d.load_controller("cruise")
     g = Garden(3, ctl, seed=2, flutter=0.1, gust_m_s=0.3)
     starts = [d.qpos[:7].copy() for d in g._datas]
     g.step(240)
@@ -40,15 +39,15 @@ def test_each_garden_butterfly_flies_what_its_own_flight_flies():
 
 def test_bad_garden_arguments_are_one_sentence():
     with pytest.raises(UserError, match="number of butterflies"):
-        Garden(0, c3.Controller3D([10, 9], e3.pd_prior([10, 9])))
+        Garden(0, flight3d.Controller3D([10, 9], flight3d.pd_prior([10, 9])))
     with pytest.raises(UserError, match="flutter"):
-        Garden(2, c3.Controller3D([10, 9], e3.pd_prior([10, 9])), flutter=3.0)
+        Garden(2, flight3d.Controller3D([10, 9], flight3d.pd_prior([10, 9])), flutter=3.0)
 
 
 def test_the_garden_films_and_its_frames_move(tmp_path):
     from PIL import Image, ImageSequence
 
-    from lifelike_mj.butterfly.garden import film_garden
+    from lifelike_mj.butterfly.flight3d.garden import film_garden
 
     g = Garden(4, "steer", seed=1)
     info = film_garden(tmp_path / "g.gif", g, duration_s=0.3, fps=10, width=160, height=90, camera_name="chase")

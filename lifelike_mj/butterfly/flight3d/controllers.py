@@ -1,0 +1,193 @@
+"""3D controllers: what the network sees and does, and the controller file.
+
+A 3D controller sees the body's attitude and motion relative to a **reference** (a heading, an altitude
+and a forward speed) and answers with changes of the kinematics around a **base command**
+(:class:`~lifelike_mj.butterfly.flight3d.kinematics.KinematicsCommand`). The reference comes from a **task**:
+a schedule of references over time (level flight, turns) or a course of waypoints (the reference then
+points at the next waypoint). The network never sees where it is, only how far it is off.
+
+Observation (:data:`OBS_NAMES`; SI units, in the heading frame: forward, left, up):
+roll, pitch, heading error (reference less yaw, wrapped to ``(-pi, pi]``), the thorax's angular
+velocity (roll, pitch, yaw rates in its own axes), forward-speed error, sideways speed, climb rate and
+altitude error (clipped to +-1 m). A controller's ``inputs`` say what the forward and sideways speeds are
+measured against: ``"ground"`` (the shipped ``steer`` and ``cruise``) or ``"air"`` (the air around the
+butterfly, wind and gusts included, as a butterfly's antennae sense it; the speed reference is then an air
+speed). The climb rate and the altitude are always the ground's.
+
+Action (:data:`ACTION_NAMES`): nine numbers ``u`` in ``(-1, 1)`` (the network's last layer through
+``tanh``), each scaled by its entry of ``scale`` (rad; Hz for the frequency) and added to the base
+command: the wings' stroke offset and amplitude, both wings alike (``sym``) and left against right
+(``asym``), the feathering mean (``sym``, ``asym``), the feathering amplitude, the abdomen's mean angle
+and the flap frequency. The kinematics follow each
+new command smoothly (the filter of :mod:`~lifelike_mj.butterfly.flight3d.kinematics`).
+
+Networks: ``layers = [10, ..., 9]``, hidden neurons ``tanh``; ``[10, 9]`` is a linear policy.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+OBS_NAMES = ("roll_rad", "pitch_rad", "heading_error_rad", "roll_rate_rad_s", "pitch_rate_rad_s",
+             "yaw_rate_rad_s", "speed_error_m_s", "sideways_m_s", "climb_m_s", "altitude_error_m")
+ACTION_NAMES = ("offset_sym", "offset_asym", "amplitude_sym", "amplitude_asym", "feather_sym", "feather_asym",
+                "feather_amplitude", "abdomen_mean", "frequency")
+N_OBS, N_ACT = len(OBS_NAMES), len(ACTION_NAMES)
+#: Altitude errors beyond this (m) are seen as this.
+ALTITUDE_CLIP_M = 1.0
+#: What the network's inputs are divided by (the observation's units): angles by 1 rad, rates by 10 rad/s,
+#: speeds by 1 m/s, the altitude error by 0.5 m, so that every input is of order one in flight.
+INPUT_SCALE = np.array([1.0, 1.0, 1.0, 10.0, 10.0, 10.0, 1.0, 1.0, 1.0, 0.5])
+
+def n_weights(layers) -> int:
+    """How many weights a network of ``layers`` has (biases included)."""
+    return int(sum((layers[k - 1] + 1) * layers[k] for k in range(1, len(layers))))
+
+
+# ---- controller files ------------------------------------------------------------------------
+
+FORMAT = "lifelike-mj/butterfly3d-controller"
+#: Bounds of a 3D controller (files and Python alike; every one of these numbers reaches the compiled loop):
+#: at most this many layers (inputs and outputs included), neurons per hidden layer, size of a weight, steps
+#: between two runs of the network, and rate at which the kinematics follow a command (rad/s).
+MAX_LAYERS, MAX_WIDTH, MAX_WEIGHT, MAX_EVERY, MAX_OMEGA_C = 6, 256, 1.0e6, 12_000, 1.0e4
+#: What a controller's forward and sideways speeds are measured against (module docstring).
+INPUTS = ("ground", "air")
+#: Default ``scale`` of the actions (rad; Hz for the frequency).
+DEFAULT_SCALE = {"offset_sym": 0.3, "offset_asym": 0.3, "amplitude_sym": 0.3, "amplitude_asym": 0.3, "feather_sym": 0.5,
+                 "feather_asym": 0.3, "feather_amplitude": 0.3, "abdomen_mean": 0.8, "frequency": 3.0}
+
+
+def default_base():
+    """The base command of the shipped 3D controllers: the paper's 10 Hz flap over [-60, 75] deg (Oe 2010
+    section 6), feathered by 0.3 rad a quarter beat ahead (leading edge down on the downstroke)."""
+    from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+
+    return KinematicsCommand(feather_amplitude_left=0.3, feather_amplitude_right=0.3, feather_phase=-math.pi / 2)
+
+
+class Controller3D:
+    """A 3D controller: a network from the observation to the action (module docstring), the base command
+    and the actions' scales, how often it runs (``every`` steps), how fast the kinematics follow
+    (``omega_c_rad_s``) and what its speeds are measured against (``inputs``: ``"ground"`` or ``"air"``), with
+    its provenance. Plain data: :meth:`to_dict` / :func:`controller_from_dict`."""
+
+    def __init__(self, layers, weights, base=None, scale: dict | None = None, every: int = 1,
+                 omega_c_rad_s: float = 2.0 * math.pi * 10.0, provenance: dict | None = None, name: str = "",
+                 inputs: str = "ground") -> None:
+        from lifelike_mj import checks
+        from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+        from lifelike_mj.errors import UserError
+
+        self.name = name
+        where = f"3D controller {name}" if name else "3D controller"
+        try:
+            given = list(layers)
+        except TypeError:
+            given = None
+        ok = (given is not None and 2 <= len(given) <= MAX_LAYERS and all(checks.is_whole(v) for v in given)
+              and given[0] == N_OBS and given[-1] == N_ACT and all(1 <= v <= MAX_WIDTH for v in given))
+        if not ok:
+            raise UserError(f"{where}: layers must be whole numbers running from {N_OBS} inputs to {N_ACT} outputs, "
+                            f"at most {MAX_LAYERS} layers of at most {MAX_WIDTH} neurons, got {layers!r}.")
+        layers = [int(v) for v in given]
+        self.layers = np.array(layers, dtype=np.int64)
+        try:
+            self.weights = np.ascontiguousarray(weights, dtype=np.float64).reshape(-1)
+        except (TypeError, ValueError):
+            raise UserError(f"{where}: the weights must be numbers, got {weights!r}.") from None
+        if len(self.weights) != n_weights(layers) or not np.all(np.abs(self.weights) <= MAX_WEIGHT):
+            raise UserError(f"{where}: layers {layers} need {n_weights(layers)} finite weights, each within "
+                            f"+-{MAX_WEIGHT:g}, got {len(self.weights)}"
+                            + ("" if len(self.weights) != n_weights(layers) else " with one beyond") + ".")
+        self.base = base if base is not None else default_base()
+        if not isinstance(self.base, KinematicsCommand):
+            raise UserError(f"{where}: the base is a KinematicsCommand, got {self.base!r}.")
+        if scale is not None and not isinstance(scale, dict):
+            raise UserError(f"{where}: scale is a mapping of action names to numbers, got {scale!r}.")
+        scale = dict(DEFAULT_SCALE, **(scale or {}))
+        unknown = set(scale) - set(ACTION_NAMES)
+        if unknown:
+            from lifelike_mj.errors import unknown_name
+
+            raise unknown_name(f"{where}: unknown action", sorted(unknown, key=str)[0], ACTION_NAMES, "in scale")
+        self.scale = np.array([checks.number(f"scale of {a}", scale[a], 0.0, math.pi) for a in ACTION_NAMES])
+        self.every = checks.whole("every", every, 1, MAX_EVERY)
+        self.omega_c_rad_s = checks.number("omega_c_rad_s", omega_c_rad_s, 0.0, MAX_OMEGA_C, lo_open=True, unit="rad/s")
+        if inputs not in INPUTS:
+            raise UserError(f"{where}: inputs are {' or '.join(repr(v) for v in INPUTS)}, got {inputs!r}.")
+        self.inputs = inputs
+        self.provenance = dict(provenance or {})
+
+    def to_dict(self) -> dict:
+        from dataclasses import asdict
+
+        return {"format": FORMAT, "version": 1, "layers": [int(v) for v in self.layers],
+                "weights": [float(v) for v in self.weights], "base": asdict(self.base),
+                "scale": dict(zip(ACTION_NAMES, (float(v) for v in self.scale))), "every": self.every,
+                "omega_c_rad_s": self.omega_c_rad_s, "inputs": self.inputs, "provenance": self.provenance}
+
+    @property
+    def air_inputs(self) -> bool:
+        """Whether the network's speeds are through the air (the compiled loop's flag)."""
+        return self.inputs == "air"
+
+    def with_weights(self, weights, inputs: str | None = None) -> Controller3D:
+        """The same controller with other weights (and, given ``inputs``, other inputs)."""
+        return Controller3D(self.layers, weights, self.base, dict(zip(ACTION_NAMES, self.scale)), self.every,
+                            self.omega_c_rad_s, self.provenance, self.name, inputs or self.inputs)
+
+
+def json_schema() -> dict:
+    """The JSON Schema of a 3D controller file (``docs/schemas/butterfly3d-controller.schema.json``): what
+    :func:`controller_from_dict` enforces before building the controller."""
+    from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+    from lifelike_mj.schema import document_schema, number
+
+    max_weights = n_weights([N_OBS, *[MAX_WIDTH] * (MAX_LAYERS - 2), N_ACT])
+    props = {
+        "layers": {"type": "array", "minItems": 2, "maxItems": MAX_LAYERS,
+                   "items": {"type": "integer", "minimum": 1, "maximum": MAX_WIDTH},
+                   "description": f"neurons per layer, from the {N_OBS} observations to the {N_ACT} actions"},
+        "weights": {"type": "array", "maxItems": max_weights, "items": number("", -MAX_WEIGHT, MAX_WEIGHT),
+                    "description": "per layer, per neuron: its input weights, then its bias"},
+        "base": KinematicsCommand.json_schema(),
+        "scale": {"type": "object", "additionalProperties": False, "description": "each action's full scale (rad; Hz "
+                  "for the frequency); missing ones take the defaults",
+                  "properties": {a: number("rad (Hz for frequency)", 0.0, math.pi) for a in ACTION_NAMES}},
+        "every": {"type": "integer", "minimum": 1, "maximum": MAX_EVERY, "description": "time steps between two runs "
+                  "of the network"},
+        "omega_c_rad_s": number("rad/s: how fast the kinematics follow a command", maximum=MAX_OMEGA_C,
+                                exclusive_minimum=0.0),
+        "inputs": {"enum": list(INPUTS), "description": "the network's speeds over the ground or through the air"},
+        "provenance": {"type": "object"},
+    }
+    return document_schema(FORMAT, "lifelike-mj 3D butterfly controller", props, ["layers", "weights"],
+                           "A network from the 3D butterfly's attitude and motion to changes of its wing and abdomen "
+                           "kinematics, with the base command and the actions' scales.")
+
+
+def controller_from_dict(data: object, name: str = "") -> Controller3D:
+    """A :class:`Controller3D` from plain data (a parsed controller file); one sentence for anything wrong
+    (checked against :func:`json_schema` before any value is used)."""
+    from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+    from lifelike_mj.schema import check_header, validate
+
+    where = f"3D controller {name}" if name else "3D controller"
+    d = check_header(data, FORMAT, f"file {name}" if name else "the data", kind="3D controller file")
+    validate(d, json_schema(), where)
+    base = d.get("base")
+    if base is not None:
+        base = KinematicsCommand(**{k: float(v) for k, v in base.items()})
+    return Controller3D(d["layers"], d["weights"], base, d.get("scale"), d.get("every", 1),
+                        d.get("omega_c_rad_s", 2.0 * math.pi * 10.0), d.get("provenance"), name, d.get("inputs", "ground"))
+
+
+def load_controller(name_or_path) -> Controller3D:
+    """A shipped 3D controller by name (``controllers/butterfly3d/``) or any 3D controller file by path."""
+    from lifelike_mj.paths import load_named_json
+
+    data, path = load_named_json("butterfly3d", name_or_path, "3D controller")
+    return controller_from_dict(data, path.stem)

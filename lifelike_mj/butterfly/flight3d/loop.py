@@ -1,0 +1,368 @@
+"""The compiled loop that flies 3D butterflies: observation, network, guidance, gusts, reward, and the one
+owner of its state (:class:`Batch`).
+
+Each step of each butterfly: the gusts advance, the reference comes from the task
+(:mod:`~lifelike_mj.butterfly.flight3d.tasks`), the network (:mod:`~lifelike_mj.butterfly.flight3d.controllers`)
+turns the observation into a new kinematics command every ``every`` steps, one ``mj_step`` runs the MuJoCo
+model (:mod:`~lifelike_mj.butterfly.flight3d.model`), and the kinematics advance exactly in the userdata. All of
+it is compiled (numba), with no Python between the steps; a batch of butterflies runs on every core.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from lifelike_mj.butterfly.flight3d import model as mj3d
+from lifelike_mj.butterfly.flight3d.controllers import ALTITUDE_CLIP_M, INPUT_SCALE, N_ACT, N_OBS
+from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS, filter_at
+from lifelike_mj.butterfly.flight3d.tasks import (
+    R_DIVERGED,
+    R_FIT,
+    R_FLUTTER,
+    R_GUST,
+    R_PASSED,
+    R_STEPS,
+    R_TUMBLED,
+    R_WP,
+    T_FLUTTER,
+    T_FLUTTER_TAU,
+    T_GUST,
+    T_GUST_TAU,
+    T_GUST_W,
+    T_KIND,
+    T_RADIUS,
+    T_ROW0,
+    T_ROWS,
+    T_SEED,
+    T_SPEED,
+    T_WIND,
+    TASK_SCHEDULE,
+    TASK_TARGET,
+)
+from lifelike_mj.physics import mjabi
+
+#: A roll or pitch beyond this (rad) is a tumble: the flight ends there (no more reward).
+TUMBLE_RAD = math.radians(80.0)
+_O_TIME, _O_QPOS, _O_QVEL, _O_UD = mjabi.O_TIME, mjabi.O_QPOS, mjabi.O_QVEL, mjabi.O_UD
+_mj_step = mjabi.mj_step
+_vp = mjabi.voidptr_from_int
+_ptr_at = mjabi.ptr_at
+_f64 = mjabi.f64_at
+
+
+@njit(cache=True)
+def wrap(a):
+    """``a`` (rad) wrapped to ``(-pi, pi]``."""
+    return a - 2.0 * math.pi * math.floor((a + math.pi) / (2.0 * math.pi))
+
+
+@njit(cache=True)
+def attitude(q):
+    """Roll, pitch (nose up > 0), yaw of the quaternion ``q`` (w, x, y, z) (as
+    :func:`~lifelike_mj.butterfly.flight3d.flight.euler_from_quat`)."""
+    w, x, y, z = q[0], q[1], q[2], q[3]
+    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    s = 2.0 * (w * y - z * x)
+    s = max(-1.0, min(1.0, s))
+    pitch = -math.asin(s)
+    yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    return roll, pitch, yaw
+
+
+@njit(cache=True)
+def observe(qpos, qvel, heading, altitude, speed, air, obs):
+    """The observation (module docstring) of the free body whose root is at ``qpos[0:7]``, ``qvel[0:6]``,
+    against the reference ``heading`` (rad), ``altitude`` (m) and forward ``speed`` (m/s). The forward and
+    sideways speeds are taken relative to the horizontal velocity ``air[0:2]`` (m/s): zeros for speeds over
+    the ground, the wind for speeds through the air."""
+    roll, pitch, yaw = attitude(qpos[3:7])
+    c, s = math.cos(yaw), math.sin(yaw)
+    vx, vy = qvel[0] - air[0], qvel[1] - air[1]
+    obs[0] = roll
+    obs[1] = pitch
+    obs[2] = wrap(heading - yaw)
+    obs[3] = qvel[3]
+    obs[4] = -qvel[4]  # nose up positive (the body's y axis points left)
+    obs[5] = qvel[5]
+    obs[6] = c * vx + s * vy - speed
+    obs[7] = -s * vx + c * vy
+    obs[8] = qvel[2]
+    obs[9] = max(-ALTITUDE_CLIP_M, min(ALTITUDE_CLIP_M, qpos[2] - altitude))
+
+
+@njit(cache=True)
+def network(layers, weights, x, out, scratch):
+    """``out = tanh(last layer)`` of the network ``layers`` (hidden neurons ``tanh``) with ``weights``
+    (per layer, per neuron: its input weights, then its bias) on the observation ``x`` divided by
+    :data:`INPUT_SCALE`. ``scratch``: at least ``2 * max(layers)`` floats."""
+    width = 0
+    for k in range(len(layers)):
+        width = max(width, layers[k])
+    a = scratch[:width]
+    b = scratch[width : 2 * width]
+    for i in range(layers[0]):
+        a[i] = x[i] / INPUT_SCALE[i]
+    w = 0
+    for k in range(1, len(layers)):
+        n_in, n_out = layers[k - 1], layers[k]
+        for j in range(n_out):
+            s = weights[w + n_in]
+            for i in range(n_in):
+                s += weights[w + i] * a[i]
+            b[j] = math.tanh(s)
+            w += n_in + 1
+        for j in range(n_out):
+            a[j] = b[j]
+    for j in range(layers[-1]):
+        out[j] = a[j]
+
+
+@njit(cache=True)
+def command(base, scale, u, target):
+    """The kinematics parameters (``target``, :class:`KinematicsCommand`'s order) of the action ``u``
+    around ``base`` (module docstring)."""
+    for i in range(N_PARAMS):
+        target[i] = base[i]
+    d_off, a_off = scale[0] * u[0], scale[1] * u[1]
+    d_amp, a_amp = scale[2] * u[2], scale[3] * u[3]
+    d_fm, a_fm = scale[4] * u[4], scale[5] * u[5]
+    target[1] += d_off + a_off
+    target[2] += d_off - a_off
+    target[3] += d_amp + a_amp
+    target[4] += d_amp - a_amp
+    target[5] += d_fm + a_fm
+    target[6] += d_fm - a_fm
+    target[7] += scale[6] * u[6]
+    target[8] += scale[6] * u[6]
+    target[10] += scale[7] * u[7]
+    target[0] += scale[8] * u[8]
+
+
+@njit(cache=True)
+def reference(task, t, pos, rec):
+    """The reference (heading rad, altitude m, speed m/s) of ``task`` at time ``t`` and position ``pos``;
+    advances the waypoint counter ``rec[R_PASSED]`` when the current waypoint is within the pass radius,
+    keeping the closest approach to each waypoint (while it is the one aimed at) in ``rec[R_WP + i]``. A moving
+    target is aimed at where it is now, at the cruise speed or, when close, the target's speed plus the
+    distance per second (at least 1 m/s); ``rec[R_PASSED]`` then counts the steps spent within the radius and
+    ``rec[R_WP]``, ``rec[R_WP + 1]`` hold the closest and the current distance."""
+    rows = int(task[T_ROWS])
+    if int(task[T_KIND]) == TASK_TARGET:
+        # a moving target: on a circle (centre, radius; rate, phase) bobbing by the vertical amplitude
+        b = T_ROW0
+        w, ph, amp = task[b + 4], task[b + 5], task[b + 6]
+        tx = task[b] + task[b + 3] * math.cos(w * t + ph)
+        ty = task[b + 1] + task[b + 3] * math.sin(w * t + ph)
+        tz = task[b + 2] + amp * math.sin(2.0 * w * t)
+        dx, dy, dz = tx - pos[0], ty - pos[1], tz - pos[2]
+        dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+        rec[R_WP] = min(rec[R_WP], dist)
+        rec[R_WP + 1] = dist  # the distance now
+        if dist < task[T_RADIUS]:
+            rec[R_PASSED] += 1.0  # steps spent within the radius
+        v_target = abs(w) * task[b + 3]
+        return math.atan2(dy, dx), tz, min(task[T_SPEED], max(1.0, v_target + dist))
+    if int(task[T_KIND]) == TASK_SCHEDULE:
+        r = 0
+        while r + 1 < rows and task[T_ROW0 + 4 * (r + 1)] <= t:
+            r += 1
+        b = T_ROW0 + 4 * r
+        return task[b + 1], task[b + 2], task[b + 3]
+    i = int(rec[R_PASSED])
+    if i >= rows:
+        i = rows - 1
+    b = T_ROW0 + 4 * i
+    dx, dy, dz = task[b] - pos[0], task[b + 1] - pos[1], task[b + 2] - pos[2]
+    dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+    if dist < rec[R_WP + i]:
+        rec[R_WP + i] = dist
+    if dist < task[T_RADIUS] and rec[R_PASSED] < rows:
+        rec[R_PASSED] += 1.0
+    return math.atan2(dy, dx), task[b + 2], task[T_SPEED]
+
+
+@njit(cache=True)
+def _mix(z):
+    # splitmix64's finaliser: a 64-bit hash with full avalanche
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
+
+
+@njit(cache=True)
+def uniform(seed, step, channel):
+    """A number in ``(0, 1)`` that depends only on ``(seed, step, channel)`` (a counter-based generator: the
+    same flight draws the same numbers in any thread, batch or order)."""
+    z = _mix(np.uint64(seed) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(step) * np.uint64(64) + np.uint64(channel))
+    return (float(z >> np.uint64(11)) + 0.5) * (1.0 / 9007199254740992.0)
+
+
+@njit(cache=True)
+def normal(seed, step, channel):
+    """A standard normal number of ``(seed, step, channel)`` (Box-Muller on two :func:`uniform` numbers)."""
+    u1 = uniform(seed, step, 2 * channel)
+    u2 = uniform(seed, step, 2 * channel + 1)
+    return math.sqrt(-2.0 * math.log(u1)) * math.cos(2.0 * math.pi * u2)
+
+
+@njit(cache=True)
+def ou_step(x, sigma, tau, dt, n):
+    """One step of an Ornstein-Uhlenbeck process (a first-order Gauss-Markov process, the Dryden gust
+    model's simplest form): stationary standard deviation ``sigma``, correlation time ``tau`` (s), driven by
+    the standard normal ``n``."""
+    a = math.exp(-dt / tau)
+    return a * x + sigma * math.sqrt(1.0 - a * a) * n
+
+
+@njit(cache=True)
+def reward(obs):
+    """One step's reward in ``[0, 1]``: 0.1 for flying upright, and 0.3 more for each of the speed (within
+    about 0.3 m/s), the altitude (0.2 m) and the heading (0.3 rad) held."""
+    e_v, e_z, e_h = obs[6] / 0.3, obs[9] / 0.2, obs[2] / 0.3
+    return 0.1 + 0.3 * (1.0 / (1.0 + e_v * e_v) + 1.0 / (1.0 + e_z * e_z) + 1.0 / (1.0 + e_h * e_h))
+
+
+@njit(cache=True)
+def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, base, scale, task, rec, path, path_every,
+              tumble_rad, air_inputs):
+    """Fly one butterfly ``n_steps`` steps from its current state: every ``every`` steps the network turns
+    the observation into a new command; after each ``mj_step`` the kinematics advance exactly in the
+    userdata. ``rec``: the run record (``R_*``); ``path``: rows of (t, x, y, z, roll, pitch, yaw) every
+    ``path_every`` steps (none when 0). A roll or pitch beyond ``tumble_rad`` (a tumble) or a runaway
+    ends the flight (recorded in ``rec``). Without weights the command in the userdata stays. ``air_inputs``:
+    the network's speeds are through the air (the controller's ``inputs == "air"``), else over the ground."""
+    ud = _f64(_ptr_at(dptr + off[_O_UD]), mj3d.N_USERDATA)
+    qpos = _f64(_ptr_at(dptr + off[_O_QPOS]), nq)
+    qvel = _f64(_ptr_at(dptr + off[_O_QVEL]), nv)
+    time = _f64(dptr + off[_O_TIME], 1)
+    obs = np.empty(N_OBS)
+    u = np.zeros(N_ACT)
+    width = 0
+    for k in range(len(layers)):
+        width = max(width, layers[k])
+    scratch = np.empty(2 * width)
+    p = np.empty(N_PARAMS)
+    dp = np.empty(N_PARAMS)
+    ddp = np.empty(N_PARAMS)
+    w_c = ud[mj3d.U_OMEGA_C]
+    ground = np.zeros(3)
+    n_path = 0
+    for _ in range(n_steps):
+        if rec[R_DIVERGED] >= 0 or rec[R_TUMBLED] >= 0:
+            return
+        step = int(rec[R_STEPS])
+        seed = int(task[T_SEED])
+        if task[T_GUST] > 0.0 or task[T_GUST_W] > 0.0:
+            for i in range(3):
+                sigma = task[T_GUST] if i < 2 else task[T_GUST_W]
+                rec[R_GUST + i] = ou_step(rec[R_GUST + i], sigma, task[T_GUST_TAU], dt, normal(seed, step, i))
+        for i in range(3):
+            ud[mj3d.U_AIR + i] = task[T_WIND + i] + rec[R_GUST + i]
+        heading, altitude, speed = reference(task, time[0], qpos[0:3], rec)
+        observe(qpos, qvel, heading, altitude, speed, ud[mj3d.U_AIR : mj3d.U_AIR + 3] if air_inputs else ground, obs)
+        if path_every > 0 and step % path_every == 0 and n_path < path.shape[0]:
+            path[n_path, 0] = time[0]
+            for i in range(3):
+                path[n_path, 1 + i] = qpos[i]
+            r_, p_, y_ = attitude(qpos[3:7])
+            path[n_path, 4] = r_
+            path[n_path, 5] = p_
+            path[n_path, 6] = y_
+            n_path += 1
+        if abs(obs[0]) > tumble_rad or abs(obs[1]) > tumble_rad:
+            rec[R_TUMBLED] = step
+            return
+        if step % every == 0 and len(weights) > 0:
+            network(layers, weights, obs, u, scratch)
+            if task[T_FLUTTER] > 0.0:
+                for i in range(N_ACT):
+                    rec[R_FLUTTER + i] = ou_step(rec[R_FLUTTER + i], task[T_FLUTTER], task[T_FLUTTER_TAU], dt * every,
+                                                 normal(seed, step, 3 + i))
+                    u[i] = max(-1.0, min(1.0, u[i] + rec[R_FLUTTER + i]))
+            command(base, scale, u, ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS])
+        ud[mj3d.U_T0] = time[0]
+        t0 = time[0]
+        _mj_step(_vp(mptr), _vp(dptr))
+        ud[mj3d.U_PSI0] = filter_at(ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS], ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS],
+                                    ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS], ud[mj3d.U_PSI0], w_c, dt, p, dp, ddp)
+        for i in range(N_PARAMS):
+            ud[mj3d.U_P0 + i] = p[i]
+            ud[mj3d.U_DP0 + i] = dp[i]
+        rec[R_STEPS] = step + 1
+        if abs(time[0] - (t0 + dt)) > 0.5 * dt or not (abs(qvel[0]) + abs(qvel[1]) + abs(qvel[2]) < 1e3):
+            rec[R_DIVERGED] = step + 1
+            return
+        rec[R_FIT] += reward(obs) * dt
+
+
+@njit(cache=True, parallel=True)
+def fly_batch(mptr, dptrs, off, nq, nv, n_steps, dt, every, layers, weights, base, scale, tasks, recs, tumble_rad,
+              air_inputs):
+    """:func:`fly_steps` for many butterflies at once (one ``mjData`` each, ``weights[i]`` and
+    ``tasks[i]`` per copy), threads over the copies; no paths are recorded."""
+    none = np.empty((0, 7))
+    for i in prange(len(dptrs)):
+        fly_steps(mptr, dptrs[i], off, nq, nv, n_steps, dt, every, layers, weights[i], base, scale, tasks[i], recs[i],
+                  none, 0, tumble_rad, air_inputs)
+
+
+
+
+class Batch:
+    """The one owner of the compiled loop's state: one MuJoCo model and, per butterfly, its ``mjData``, its task
+    array and run record (:mod:`~lifelike_mj.butterfly.flight3d.tasks`), and its network weights; the network's
+    shape, base command and scales are shared. A flight is a batch of one, a garden a batch of ``n``, an
+    evolution's generation a batch of candidates x tasks. :meth:`advance` flies them all in one native call.
+
+    ``controller``: a :class:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D`, or ``None`` for flights
+    that keep the command in their userdata (then ``base`` is that command's array); ``weights``: one row per
+    butterfly (default: the controller's own, for each); ``tumble_rad``: a roll or pitch beyond which a flight
+    ends (``inf``: never)."""
+
+    def __init__(self, model, datas, tasks: np.ndarray, controller=None, *, weights=None, dt_s: float,
+                 records: np.ndarray, tumble_rad: float = math.inf, base: np.ndarray | None = None) -> None:
+        self.model, self.datas = model, list(datas)
+        self.n = len(self.datas)
+        self.tasks = np.ascontiguousarray(tasks, dtype=np.float64).reshape(self.n, -1)
+        self.records = records
+        self.dt, self.tumble_rad = float(dt_s), float(tumble_rad)
+        self.ptrs = np.array([d._address for d in self.datas], dtype=np.int64)
+        if controller is None:
+            self.layers, self.scale, self.every, self.air_inputs = np.zeros(1, dtype=np.int64), np.zeros(N_ACT), 1, False
+            self.weights = np.zeros((self.n, 0))
+            self.base = np.asarray(base, dtype=np.float64)
+        else:
+            self.layers, self.scale = controller.layers, controller.scale
+            self.every, self.air_inputs = controller.every, controller.air_inputs
+            self.base = controller.base.as_array() if base is None else np.asarray(base, dtype=np.float64)
+            w = controller.weights if weights is None else weights
+            self.weights = np.ascontiguousarray(np.broadcast_to(w, (self.n, len(controller.weights))), dtype=np.float64)
+
+    def advance(self, n_steps: int, path: np.ndarray | None = None, path_every: int = 0) -> None:
+        """Fly every butterfly ``n_steps`` steps (threads over the butterflies), with the model's compiled air
+        forces installed. ``path`` (a batch of one only): rows of (t, x, y, z, roll, pitch, yaw) every
+        ``path_every`` steps. A flight that has ended (diverged, tumbled) stays where it ended."""
+        from lifelike_mj.physics.callbacks import passive_callback
+        from lifelike_mj.physics.stability import watching
+
+        m = self.model
+        with passive_callback(mj3d.COMPILED_PASSIVE), watching():
+            if self.n == 1:
+                fly_steps(m._address, int(self.ptrs[0]), mjabi.offsets_tuple(), m.nq, m.nv, n_steps, self.dt,
+                          self.every, self.layers, self.weights[0], self.base, self.scale, self.tasks[0],
+                          self.records[0], _NO_PATH if path is None else path, path_every, self.tumble_rad,
+                          self.air_inputs)
+            else:
+                fly_batch(m._address, self.ptrs, mjabi.offsets_tuple(), m.nq, m.nv, n_steps, self.dt, self.every,
+                          self.layers, self.weights, self.base, self.scale, self.tasks, self.records, self.tumble_rad,
+                          self.air_inputs)
+
+    def diverged(self) -> np.ndarray:
+        """Indices of the butterflies whose flight diverged."""
+        return np.nonzero(self.records[:, R_DIVERGED] >= 0)[0]
+
+
+_NO_PATH = np.empty((0, 7))

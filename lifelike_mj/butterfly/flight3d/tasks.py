@@ -1,0 +1,171 @@
+"""What a 3D flight is asked to do: the task type, its builders (level flight, turns, courses, a moving target),
+and the two array layouts the compiled loop reads and writes.
+
+A **task** (:class:`Task3D`) is a schedule of references (heading, altitude, speed from given times: level
+flight, turns, climbs), a course of waypoints, or a moving target, in some weather (a mean wind, gusts) and
+with the butterfly's own irregularity (flutter). The compiled loop (:mod:`~lifelike_mj.butterfly.flight3d.loop`)
+reads a task as a flat array (:meth:`Task3D.as_array`, layout ``T_*``) and writes each flight's **run record**
+(:func:`new_record`, layout ``R_*``): its reward, steps flown, how it ended, and the waypoints passed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from lifelike_mj import checks
+from lifelike_mj.errors import UserError
+
+# task array: kind, then either a schedule (rows of t_start, heading, altitude, speed) or waypoints
+TASK_SCHEDULE, TASK_WAYPOINTS, TASK_TARGET = 0, 1, 2
+#: Task header: kind, rows, pass radius (m), cruise speed (m/s), mean wind (3, m/s), gusts' standard deviation
+#: (m/s, horizontal) and correlation time (s), flutter's standard deviation (action units) and correlation time
+#: (s), the seed of both, the vertical gusts' standard deviation (m/s); then 4 numbers per row.
+T_KIND, T_ROWS, T_RADIUS, T_SPEED, T_WIND = 0, 1, 2, 3, 4
+T_GUST, T_GUST_TAU, T_FLUTTER, T_FLUTTER_TAU, T_SEED, T_GUST_W, T_ROW0 = 7, 8, 9, 10, 11, 12, 13
+
+# per-copy run record (float64): fitness, steps flown, diverged step, waypoints passed, tumble step, the gust
+# (3, m/s) and the flutter (one per action) now, then the closest approach to each waypoint
+R_FIT, R_STEPS, R_DIVERGED, R_PASSED, R_TUMBLED, R_GUST, R_FLUTTER = 0, 1, 2, 3, 4, 5, 8
+R_WP = R_FLUTTER + 9
+
+#: A task's most rows, and the largest number in a row (m, s, rad, m/s): far beyond a garden, finite in the loop.
+MAX_TASK_ROWS = 10_000
+MAX_TASK_NUMBER = 1.0e6
+
+
+@dataclass(frozen=True)
+class Task3D:
+    """A task: ``kind="schedule"`` with rows ``(t_start_s, heading_rad, altitude_m, speed_m_s)`` (the
+    reference from each row's time on; the first row's time is 0), or ``kind="waypoints"`` with rows
+    ``(x, y, z)`` in m, visited in order at ``speed_m_s``, each passed when within ``radius_m``, or
+    ``kind="target"``, a moving target (:func:`moving_target`).
+
+    The weather: a mean wind ``wind_m_s`` (world frame, m/s, where it blows to) plus gusts, a first-order
+    Gauss-Markov (Ornstein-Uhlenbeck) process on each axis with standard deviation ``gust_m_s`` (the two
+    horizontal axes) and ``gust_vertical_m_s`` (the vertical; ``None``: the same as ``gust_m_s``) and
+    correlation time ``gust_tau_s``, starting from calm. Near the ground the vertical gusts are weaker:
+    :data:`DRYDEN_VERTICAL_RATIO`. ``flutter``: the butterfly's own irregularity, the
+    same process added to each of the controller's actions (standard deviation ``flutter`` in action units,
+    where 1 is the action's full scale; correlation time ``flutter_tau_s``). Both are drawn from ``seed``."""
+
+    kind: str
+    rows: tuple[tuple[float, ...], ...]
+    radius_m: float = 0.3
+    speed_m_s: float = 1.5
+    name: str = ""
+    wind_m_s: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    gust_m_s: float = 0.0
+    gust_tau_s: float = 1.0
+    flutter: float = 0.0
+    flutter_tau_s: float = 0.2
+    seed: int = 0
+    gust_vertical_m_s: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.kind not in ("schedule", "waypoints", "target"):
+            raise UserError(f"a task is a schedule, waypoints or a target, got {self.kind!r}.")
+        width = 3 if self.kind == "waypoints" else 4
+        if not self.rows or len(self.rows) > MAX_TASK_ROWS or any(len(r) != width for r in self.rows):
+            raise UserError(f"a {self.kind} task needs 1 to {MAX_TASK_ROWS:,} rows of {width} numbers.")
+        for r in self.rows:
+            for v in r:
+                checks.number("a task's number", v, -MAX_TASK_NUMBER, MAX_TASK_NUMBER)
+        if self.kind == "schedule" and self.rows[0][0] != 0.0:
+            raise UserError("a schedule's first row starts at 0 s.")
+        checks.number("radius_m", self.radius_m, 0.0, 1000.0, lo_open=True, unit="m")
+        checks.number("speed_m_s", self.speed_m_s, 0.0, 100.0, lo_open=True, unit="m/s")
+        object.__setattr__(self, "wind_m_s", checks.vector("wind_m_s", self.wind_m_s, 3, "m/s"))
+        for w in self.wind_m_s:
+            checks.number("each component of wind_m_s", w, -100.0, 100.0, unit="m/s")
+        checks.number("gust_m_s", self.gust_m_s, 0.0, 10.0, unit="m/s")
+        checks.number("gust_tau_s", self.gust_tau_s, 0.0, 1e4, lo_open=True, unit="s")
+        if self.gust_vertical_m_s is not None:
+            checks.number("gust_vertical_m_s", self.gust_vertical_m_s, 0.0, 10.0, unit="m/s")
+        checks.number("flutter", self.flutter, 0.0, 1.0)
+        checks.number("flutter_tau_s", self.flutter_tau_s, 0.0, 1e4, lo_open=True, unit="s")
+        checks.whole("seed", self.seed, 0, 2**32 - 1)
+
+    def with_weather(self, wind_m_s=(0.0, 0.0, 0.0), gust_m_s: float = 0.0, gust_tau_s: float = 1.0,
+                     flutter: float = 0.0, flutter_tau_s: float = 0.2, seed: int | None = None,
+                     gust_vertical_m_s: float | None = None) -> Task3D:
+        """The same task in other weather (and flutter); the seed defaults to the task's."""
+        from dataclasses import replace
+
+        return replace(self, wind_m_s=tuple(wind_m_s), gust_m_s=gust_m_s, gust_tau_s=gust_tau_s, flutter=flutter,
+                       flutter_tau_s=flutter_tau_s, seed=self.seed if seed is None else seed,
+                       gust_vertical_m_s=gust_vertical_m_s)
+
+    @property
+    def vertical_gust_m_s(self) -> float:
+        """The vertical gusts' standard deviation (m/s)."""
+        return self.gust_m_s if self.gust_vertical_m_s is None else self.gust_vertical_m_s
+
+    def as_array(self, max_rows: int) -> np.ndarray:
+        """The compiled loop's task array (layout ``T_*`` above), padded to
+        ``max_rows`` rows."""
+        out = np.zeros(T_ROW0 + 4 * max_rows)
+        out[T_KIND] = {"schedule": TASK_SCHEDULE, "waypoints": TASK_WAYPOINTS, "target": TASK_TARGET}[self.kind]
+        out[T_ROWS] = len(self.rows)
+        out[T_RADIUS] = self.radius_m
+        out[T_SPEED] = self.speed_m_s
+        out[T_WIND : T_WIND + 3] = self.wind_m_s
+        out[T_GUST], out[T_GUST_TAU], out[T_GUST_W] = self.gust_m_s, self.gust_tau_s, self.vertical_gust_m_s
+        out[T_FLUTTER], out[T_FLUTTER_TAU], out[T_SEED] = self.flutter, self.flutter_tau_s, self.seed
+        for i, r in enumerate(self.rows):
+            out[T_ROW0 + 4 * i : T_ROW0 + 4 * i + len(r)] = r
+        return out
+
+
+#: The vertical gusts' standard deviation over the horizontal ones near the ground: the low-altitude Dryden
+#: model (MIL-F-8785C; MIL-HDBK-1797) gives ``sigma_w / sigma_u = (0.177 + 0.000823 h)^0.4`` with ``h`` in
+#: feet, 0.50 at 1 m.
+DRYDEN_VERTICAL_RATIO = 0.5
+
+
+def level(speed_m_s: float = 1.5, heading_rad: float = 0.0, altitude_m: float = 0.0) -> Task3D:
+    """Straight level flight at ``speed_m_s`` (the start altitude 0 m)."""
+    return Task3D("schedule", ((0.0, heading_rad, altitude_m, speed_m_s),), name=f"level {speed_m_s:g} m/s")
+
+
+def turn(angle_deg: float, at_s: float = 2.0, speed_m_s: float = 1.5, climb_m: float = 0.0) -> Task3D:
+    """Level flight, then at ``at_s`` a new heading ``angle_deg`` to the left (negative: right), and a new
+    altitude ``climb_m`` above the start."""
+    return Task3D("schedule", ((0.0, 0.0, 0.0, speed_m_s), (at_s, math.radians(angle_deg), climb_m, speed_m_s)),
+                  name=f"turn {angle_deg:g} deg")
+
+
+def course(seed: int, n: int = 10, spacing_m: float = 1.5, altitude_span_m: float = 0.6, speed_m_s: float = 1.5,
+           radius_m: float = 0.3) -> Task3D:
+    """``n`` waypoints drawn by ``seed``: each ``spacing_m`` from the last in a direction at most 90 deg
+    off the previous leg's, at altitudes within ``+-altitude_span_m / 2`` of the start."""
+    rng = np.random.default_rng(seed)
+    pts, heading, p = [], 0.0, np.zeros(3)
+    for _ in range(n):
+        heading += rng.uniform(-math.pi / 2, math.pi / 2)
+        p = p + spacing_m * np.array([math.cos(heading), math.sin(heading), 0.0])
+        p[2] = rng.uniform(-0.5, 0.5) * altitude_span_m
+        pts.append(tuple(float(v) for v in p))
+    return Task3D("waypoints", tuple(pts), radius_m=radius_m, speed_m_s=speed_m_s, name=f"course seed {seed}",
+                  seed=seed)
+
+
+def moving_target(centre_m=(3.0, 0.0, 0.0), radius_m: float = 2.0, speed_m_s: float = 0.5, bob_m: float = 0.2,
+                  cruise_m_s: float = 1.5, phase_rad: float = 0.0) -> Task3D:
+    """A target moving at ``speed_m_s`` round a circle of ``radius_m`` about ``centre_m`` (counter-clockwise
+    seen from above), bobbing ``bob_m`` up and down twice a lap; the butterfly flies at ``cruise_m_s`` towards
+    where it is now (slower when close)."""
+    w = speed_m_s / checks.positive("radius_m", radius_m, "m")
+    return Task3D("target", (tuple(float(v) for v in centre_m) + (float(radius_m),), (w, phase_rad, bob_m, 0.0)),
+                  radius_m=0.3, speed_m_s=cruise_m_s, name=f"moving target {speed_m_s:g} m/s")
+
+
+def new_record(n: int, max_rows: int) -> np.ndarray:
+    """Empty run records (layout ``R_*`` above) for ``n`` flights."""
+    rec = np.zeros((n, R_WP + max_rows))  # the gusts and the flutter start from zero
+    rec[:, R_DIVERGED] = -1.0
+    rec[:, R_TUMBLED] = -1.0
+    rec[:, R_WP :] = np.inf
+    return rec
