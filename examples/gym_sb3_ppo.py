@@ -51,7 +51,7 @@ class PaperTransfer(torch.nn.Module):
         return torch.sigmoid(12.0 * (u + 0.5)) + torch.sigmoid(12.0 * (u - 0.5)) - 1.0
 
 
-def make_env(wind: bool, frame_skip: int, inputs: str = "relative") -> gym.Env:
+def make_env(wind: bool, frame_skip: int, inputs: str = "air") -> gym.Env:
     """The environment acting every ``frame_skip`` steps with the paper's pitch rate limit (3 deg per
     simulation step, so ``3 x frame_skip`` deg per decision)."""
     cls = ButterflyPitchWindEnv if wind else ButterflyPitchEnv
@@ -77,7 +77,7 @@ def export(model: PPO, provenance: dict | None = None):
     linears = [m for m in model.policy.mlp_extractor.policy_net if isinstance(m, torch.nn.Linear)]
     linears.append(model.policy.action_net)
     layers = [(m.weight.detach().double().numpy(), m.bias.detach().double().numpy()) for m in linears]
-    return network_controller(layers, "relative", provenance)
+    return network_controller(layers, "air", provenance)
 
 
 def main() -> int:

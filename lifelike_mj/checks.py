@@ -142,3 +142,39 @@ def known_keywords(func):
         return func(*args, **kwargs)
 
     return checked
+
+
+_RENAMED: set[str] = set()
+
+
+def renamed(old: str, new: str, why: str = "") -> None:
+    """A one-line note (a ``DeprecationWarning``, once per name and process) that ``old`` is now spelled ``new``
+    (``why``: what the new name says); the old spelling goes in the next release."""
+    if old in _RENAMED:
+        return
+    import warnings
+
+    _RENAMED.add(old)
+    warnings.warn(f"{old} is now {new}{f' ({why})' if why else ''}; the old name goes in the next release.",
+                  DeprecationWarning, stacklevel=3)
+
+
+def one_wind(where: str, to_m_s, from_m_s, old_m_s=None, old_means: str = "to", n: int = 3):
+    """The wind (m/s), given once: as where it blows to (``to_m_s``, the air's velocity), where it comes from
+    (``from_m_s``), or in the old spelling ``old_m_s`` (meaning ``old_means``, taken with a note). Returns the
+    air's velocity, a tuple of ``n`` floats, or ``None`` if none was given; two spellings at once, or anything
+    but ``n`` finite numbers, are a :class:`UserError` naming the argument."""
+    given = [(k, v) for k, v in (("wind_to_m_s", to_m_s), ("wind_from_m_s", from_m_s), ("wind_m_s", old_m_s))
+             if v is not None]
+    if len(given) > 1:
+        raise UserError(f"{where}: give the wind once, as wind_to_m_s or wind_from_m_s, not {given[0][0]} and "
+                        f"{given[1][0]}.")
+    if not given:
+        return None
+    name, v = given[0]
+    w = vector(name, v, n, "m/s")
+    if name == "wind_m_s":
+        renamed(f"{where}(wind_m_s=...)", f"wind_{old_means}_m_s",
+                "where the wind " + ("blows to" if old_means == "to" else "comes from"))
+        name = f"wind_{old_means}_m_s"
+    return w if name == "wind_to_m_s" else tuple(0.0 - x for x in w)

@@ -105,7 +105,8 @@ class PitchProblem:
         d = {
             "problem": "butterfly-pitch-ann",
             "backend": self.backend,
-            "conditions": [{"y0_m": c.y0_m, "wind_m_s": list(c.wind_m_s)} for c in self.conditions],
+            # the key keeps its first name so that the fingerprints of earlier problems (and checkpoints) hold
+            "conditions": [{"y0_m": c.y0_m, "wind_m_s": list(c.wind_from_m_s)} for c in self.conditions],
             "inputs": self.inputs,
             "duration_s": self.duration_s,
             "dt_s": self.dt_s,
@@ -160,7 +161,7 @@ class PitchProblem:
     def weights(self) -> np.ndarray:
         """Weights of :meth:`flights` in the fitness, summing to 1: equal, or with
         ``weighting="ground_speed"`` proportional to :func:`flight_weight`."""
-        w = np.array([flight_weight(c.wind_m_s[0]) if self.weighting == "ground_speed" else 1.0
+        w = np.array([flight_weight(c.wind_from_m_s[0]) if self.weighting == "ground_speed" else 1.0
                       for c, _ in self.flights()])
         return w / w.sum()
 
@@ -168,7 +169,7 @@ class PitchProblem:
         """The flights of one evaluation: ``(condition, air-relative inputs?)``."""
         out = []
         for c in self.conditions:
-            windy = any(w != 0.0 for w in c.wind_m_s)
+            windy = any(w != 0.0 for w in c.wind_from_m_s)
             if self.inputs == "both" and windy:
                 out += [(c, True), (c, False)]
             else:

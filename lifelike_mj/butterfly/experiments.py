@@ -520,5 +520,5 @@ def fly(controller: controllers.ButterflyController, params: ButterflyParams | N
 
     cond = condition or Condition()
     prov = provenance(controller=controller.to_dict(), params=asdict(params or ButterflyParams()), y0_m=cond.y0_m,
-                      wind_m_s=list(cond.wind_m_s), duration_s=duration_s, dt_s=dt_s, backend=backend, **opts)
+                      wind_from_m_s=list(cond.wind_from_m_s), duration_s=duration_s, dt_s=dt_s, backend=backend, **opts)
     return FlyResult(traj, summary, prov)

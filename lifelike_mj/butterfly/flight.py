@@ -36,24 +36,48 @@ MAX_ALTITUDE_M = 1000.0
 MAX_WIND_M_S = 50.0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Condition:
-    """Conditions of one flight: start altitude (m) and wind ``(a, b)`` (m/s, where it comes from)."""
+    """Conditions of one flight: the start altitude ``y0_m`` (m) and the wind ``wind_from_m_s = (a, b)`` (m/s,
+    where it comes from: ``a > 0`` from ahead, ``b > 0`` from above). ``wind_to_m_s`` gives the same wind as where
+    it blows to (the air's velocity, forward and up; also readable); ``wind_m_s`` is the older spelling of
+    ``wind_from_m_s`` (taken this release, with a note). Positionally: ``Condition(y0_m, wind_from_m_s)``."""
 
     y0_m: float = 0.0
-    wind_m_s: tuple[float, float] = (0.0, 0.0)
+    wind_from_m_s: tuple[float, float] = (0.0, 0.0)
+
+    def __init__(self, y0_m: float = 0.0, wind_from_m_s: tuple[float, float] | None = None, *,
+                 wind_to_m_s: tuple[float, float] | None = None, wind_m_s: tuple[float, float] | None = None) -> None:
+        if wind_to_m_s is None and wind_m_s is None:
+            w = (0.0, 0.0) if wind_from_m_s is None else wind_from_m_s
+        else:
+            w = tuple(0.0 - v for v in checks.one_wind("Condition", wind_to_m_s, wind_from_m_s, wind_m_s, "from", n=2))
+        object.__setattr__(self, "y0_m", y0_m)
+        object.__setattr__(self, "wind_from_m_s", w)
+        self.__post_init__()
 
     def __post_init__(self) -> None:
         checks.number("the start altitude y0", self.y0_m, -MAX_ALTITUDE_M, MAX_ALTITUDE_M, unit="m")
-        w = self.wind_m_s
+        w = self.wind_from_m_s
         if not (isinstance(w, (tuple, list)) and len(w) == 2):
             raise UserError(f"the wind must be two numbers (a, b) in m/s, got {w!r}.")
         for name, v in zip(("a", "b"), w):
             checks.number(f"the wind component {name}", v, -MAX_WIND_M_S, MAX_WIND_M_S, unit="m/s")
 
+    @property
+    def wind_to_m_s(self) -> tuple[float, float]:
+        """The wind as where it blows to (m/s, forward and up): the air's velocity."""
+        return self.air_velocity()
+
+    @property
+    def wind_m_s(self) -> tuple[float, float]:
+        """The older name of :attr:`wind_from_m_s` (with a note)."""
+        checks.renamed("Condition.wind_m_s", "Condition.wind_from_m_s", "where the wind comes from")
+        return self.wind_from_m_s
+
     def air_velocity(self) -> tuple[float, float]:
         """Air velocity (forward, up) in m/s: ``-(a, b)`` (docs/models/butterfly.md)."""
-        return (-float(self.wind_m_s[0]), -float(self.wind_m_s[1]))
+        return (-float(self.wind_from_m_s[0]), -float(self.wind_from_m_s[1]))
 
 
 def check_timing(duration_s: float, dt_s: float, record_every: int = 1) -> int:

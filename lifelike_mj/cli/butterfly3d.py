@@ -97,7 +97,7 @@ def cmd_assess3d(args) -> None:
     with stage("level flight, turns of 90 and 180 deg, courses"):
         level = level_check(ctrl, args.speed, args.duration, LEVEL_SETTLE_S)
         turns = [turn_check(ctrl, a, speed_m_s=args.speed) for a in (90.0, -90.0, 180.0)]
-        weather = {"wind_m_s": args.wind, "gust_m_s": args.gusts, "gust_vertical_m_s": args.vertical_gusts}
+        weather = {"wind_to_m_s": args.wind, "gust_m_s": args.gusts, "gust_vertical_m_s": args.vertical_gusts}
         courses = [course_check(ctrl, s, weather=weather) for s in args.courses]
     d = {"controller": ctrl.name or args.controller, "level": level, "turns": turns, "courses": courses,
          "course_weather": weather}
@@ -126,7 +126,7 @@ def cmd_garden(args) -> None:
                     checks.MAX_FRAMES, "frames", "a shorter garden or fewer frames per second")
     ctrl = load_controller(args.controller)
     check_outputs(args, files={"--out": (".mp4", ".gif"), "--paths": (".png",)})
-    garden = Garden(args.n, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_m_s=args.wind,
+    garden = Garden(args.n, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_to_m_s=args.wind,
                     gust_vertical_m_s=args.vertical_gusts)
     d: dict = {"butterflies": args.n, "seed": args.seed, "controller": ctrl.name or args.controller}
     if args.paths:
@@ -293,7 +293,7 @@ def export_window(args):
     if args.garden:
         from lifelike_mj.butterfly.flight3d.garden import Garden
 
-        sim = Garden(args.garden, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_m_s=args.wind,
+        sim = Garden(args.garden, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_to_m_s=args.wind,
                      gust_vertical_m_s=args.vertical_gusts)
     else:
         from lifelike_mj.butterfly.flight3d.flight import Flight3D

@@ -146,9 +146,11 @@ class ButterflyPitchEnv(gym.Env):
 
     ## Arguments
 
-    ``backend`` (``"paper"``: eq. 7-11 with RK4, compiled; ``"mujoco"``), ``inputs`` (``"relative"``:
-    velocities relative to the air, the paper's section 6; ``"ground"``: section 7.2), ``action_mode``,
-    ``wind_m_s`` ``(a, b)`` (where the wind comes from: front, above; m/s), ``y0_m``, ``duration_s``,
+    ``backend`` (``"paper"``: eq. 7-11 with RK4, compiled; ``"mujoco"``), ``inputs`` (``"air"``:
+    velocities through the air, the paper's section 6; ``"ground"``: over the ground, section 7.2; the older
+    word ``"relative"`` for ``"air"`` is taken this release with a note), ``action_mode``, the wind:
+    ``wind_from_m_s`` ``(a, b)`` (where it comes from: front, above; m/s) or ``wind_to_m_s`` (where it blows to:
+    forward, up; ``wind_m_s`` is the older spelling of ``wind_from_m_s``), ``y0_m``, ``duration_s``,
     ``dt_s`` (1/1200 s), ``frame_skip``, ``max_dphi_deg`` (3), ``phi_limit_deg`` (30), ``params`` (a
     :class:`~lifelike_mj.butterfly.ButterflyParams`, or a dict of overrides in the command line's units
     such as ``{"body_area_cm2": 1.53}``), ``config`` and ``force_mode`` (MuJoCo backend), ``ground_m``;
@@ -163,19 +165,23 @@ class ButterflyPitchEnv(gym.Env):
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 30}
 
     @checks.known_keywords
-    def __init__(self, backend: str = "paper", inputs: str = "relative", action_mode: str = "dphi",
-                 wind_m_s: tuple[float, float] = (0.0, 0.0), y0_m: float = 0.0, duration_s: float = 20.0,
+    def __init__(self, backend: str = "paper", inputs: str = "air", action_mode: str = "dphi",
+                 wind_from_m_s: tuple[float, float] | None = None, y0_m: float = 0.0, duration_s: float = 20.0,
                  dt_s: float = 1.0 / 1200.0, frame_skip: int = 1, max_dphi_deg: float = 3.0,
                  phi_limit_deg: float = 30.0, params: ButterflyParams | dict | None = None, config: str = "paper",
                  force_mode: str | None = None, ground_m: float | None = None, render_mode: str | None = None,
-                 width: int = 640, height: int = 480, camera: str = "follow") -> None:
+                 width: int = 640, height: int = 480, camera: str = "follow", wind_to_m_s=None,
+                 wind_m_s=None) -> None:
         from lifelike_mj.butterfly.backends import check_backend, mujoco_options
 
         check_backend(backend)
         if backend == "mujoco":
             mujoco_options(config, force_mode)  # an unknown configuration is refused here, not at reset
-        if inputs not in ("relative", "ground"):
-            raise UserError(f"inputs must be relative or ground, got {inputs!r}.")
+        if inputs == "relative":
+            checks.renamed("inputs='relative'", "inputs='air'", "the speeds through the air")
+            inputs = "air"
+        if inputs not in ("air", "ground"):
+            raise UserError(f"inputs must be air or ground, got {inputs!r}.")
         if action_mode not in ACTION_MODES:
             raise UserError(f"action_mode must be dphi or phi, got {action_mode!r}.")
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -184,7 +190,8 @@ class ButterflyPitchEnv(gym.Env):
             params = ButterflyParams().with_overrides(**params)
         self.params = params or ButterflyParams()
         self.backend, self.inputs, self.action_mode = backend, inputs, action_mode
-        self.condition = self._own_condition = as_condition((y0_m, wind_m_s))
+        wind = Condition(wind_from_m_s=wind_from_m_s, wind_to_m_s=wind_to_m_s, wind_m_s=wind_m_s).wind_from_m_s
+        self.condition = self._own_condition = as_condition((y0_m, wind))
         self.dt_s = checks.positive("dt_s", dt_s, "s")
         self.frame_skip = checks.whole("frame_skip", frame_skip, 1, 10_000)
         self.n_steps = int(round(checks.positive("duration_s", duration_s, "s") / self.dt_s))
@@ -302,7 +309,7 @@ class ButterflyPitchEnv(gym.Env):
     def _observation(self) -> np.ndarray:
         o = self.flight.observation()
         vy, vz = o.climb_m_s, o.forward_m_s
-        if self.inputs == "relative":
+        if self.inputs == "air":
             vy, vz = vy - o.air_up_m_s, vz - o.air_forward_m_s
         out = np.array([o.phi_rad, o.omega_rad_s, o.theta_rad, vy, o.altitude_m, vz], dtype=np.float64)
         return np.where(np.isfinite(out), out, 0.0)
@@ -354,5 +361,6 @@ class ButterflyPitchWindEnv(ButterflyPitchEnv):
     def _reset_info(self) -> dict[str, Any]:
         from lifelike_mj.butterfly.evolution import flight_weight
 
-        return {**super()._reset_info(), "y0_m": self.condition.y0_m, "wind_m_s": tuple(self.condition.wind_m_s),
-                "flight_weight": flight_weight(self.condition.wind_m_s[0])}
+        w = tuple(self.condition.wind_from_m_s)
+        return {**super()._reset_info(), "y0_m": self.condition.y0_m, "wind_from_m_s": w, "wind_m_s": w,
+                "flight_weight": flight_weight(w[0])}

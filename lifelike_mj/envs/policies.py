@@ -35,6 +35,12 @@ def _actions(kinds, cparams, obs, out):
         out[i, 0] = pitch_command(kinds[i], cparams[i], 0.0, o[2], o[1], o[4], 0.0, o[3], o[5], 0.0, 0.0, o[0])
 
 
+#: The environment's word for the speed inputs (``air``, ``ground``) and the planar controller file's (``relative``,
+#: ``ground``; the files keep their word).
+FILE_WORD = {"air": "relative", "ground": "ground"}
+ENV_WORD = {"relative": "air", "ground": "ground"}
+
+
 def pitch_actions(kinds: np.ndarray, cparams: np.ndarray, obs: np.ndarray) -> np.ndarray:
     """The pitch (rad) each compiled controller chooses from its copy's observation: ``kinds[i]`` and
     ``cparams[i]`` (rows of :meth:`~lifelike_mj.butterfly.ButterflyController.compiled`, padded to one
@@ -73,9 +79,10 @@ def controller_policy(controller: ButterflyController | str | Path, env) -> Call
     if single.action_mode != "phi":
         raise UserError("a controller sets the pitch itself: make the environment with action_mode='phi'.")
     wants = ctrl.parameters.get("inputs")
-    if wants is not None and wants != single.inputs:
+    if wants is not None and wants != FILE_WORD[single.inputs]:
         raise UserError(f"the controller reads {wants} velocities but the environment observes {single.inputs} ones; "
-                        f"make it with inputs={wants!r} (or use controller.with_inputs({single.inputs!r})).")
+                        f"make it with inputs={ENV_WORD[wants]!r} (or use "
+                        f"controller.with_inputs({FILE_WORD[single.inputs]!r})).")
     kind, cp = ctrl.compiled()
     kinds, cps = np.array([kind], dtype=np.int64), np.ascontiguousarray(cp, dtype=np.float64)[None, :]
 
@@ -101,7 +108,7 @@ class NetworkInputs(gym.ObservationWrapper):
     def __init__(self, env: gym.Env) -> None:
         super().__init__(env)
         u = env.unwrapped
-        cp = ann.compile_params(u.inputs, ann.default_scales(PAPER_FLAP), np.zeros(ann.N_WEIGHTS))
+        cp = ann.compile_params(FILE_WORD[u.inputs], ann.default_scales(PAPER_FLAP), np.zeros(ann.N_WEIGHTS))
         self._scale = cp[ann.A_SCALE : ann.A_W].copy()
         self._shift = np.array([0.0, 0.0, cp[ann.A_THETA_C], 0.0, 0.0, 0.0])
         box = env.observation_space
@@ -129,7 +136,7 @@ class NetworkActions(gym.ActionWrapper):
         return np.array([self._max * ann.transfer(u)])
 
 
-def network_controller(layers: list[tuple[np.ndarray, np.ndarray]], inputs: str = "relative",
+def network_controller(layers: list[tuple[np.ndarray, np.ndarray]], inputs: str = "air",
                        provenance: dict | None = None) -> ButterflyController:
     """A network controller (the controller file's ``ann`` type) from a trained network's layers
     ``[(W, b), ...]`` (``W`` of shape (outputs, inputs), as ``torch.nn.Linear`` keeps it): hidden layers
@@ -142,4 +149,4 @@ def network_controller(layers: list[tuple[np.ndarray, np.ndarray]], inputs: str 
         for j in range(w.shape[0]):  # per neuron: its input weights, then its bias
             flat.extend(w[j].tolist())
             flat.append(float(b[j]))
-    return ann_controller(np.array(flat), PAPER_FLAP, inputs, provenance=provenance, layers=sizes)
+    return ann_controller(np.array(flat), PAPER_FLAP, FILE_WORD.get(inputs, inputs), provenance=provenance, layers=sizes)

@@ -260,7 +260,7 @@ class ButterflyPitchVectorEnv(VectorEnv):
                     b.step(np.flatnonzero(live & (steps == k)), self._phis, int(k))
         obs, rewards = np.empty((n, 6)), np.empty(n)
         terminated, truncated = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
-        _finish(live, b.columns(), self._phis, self._airs, s.inputs == "relative", before, b.fitness(), b.reset,
+        _finish(live, b.columns(), self._phis, self._airs, s.inputs == "air", before, b.fitness(), b.reset,
                 b.diverged, b.ks, s.n_steps, -1.0 if s.ground_m is None else s.ground_m, obs, rewards, terminated,
                 truncated)
         self._ended = terminated | truncated
@@ -287,7 +287,7 @@ class ButterflyPitchVectorEnv(VectorEnv):
 
     def _observations(self) -> np.ndarray:
         obs = np.empty((self.num_envs, 6))
-        _observe(self._batch.columns(), self._phis, self._airs, self.single.inputs == "relative", obs)
+        _observe(self._batch.columns(), self._phis, self._airs, self.single.inputs == "air", obs)
         return obs
 
     def _reset_info(self, which: np.ndarray) -> dict:

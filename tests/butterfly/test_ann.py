@@ -171,7 +171,7 @@ def test_windmap_small_grid():
 def test_robust_task_flies_windy_conditions_with_both_input_readings():
     prob = make_problem("robust")
     flights = prob.flights()
-    windy = [c for c in prob.conditions if any(c.wind_m_s)]
+    windy = [c for c in prob.conditions if any(c.wind_from_m_s)]
     assert prob.inputs == "both" and len(flights) == len(prob.conditions) + len(windy)
     short = PitchProblem(duration_s=0.3, conditions=prob.conditions, inputs="both")
     x = _weights(7)
@@ -189,7 +189,7 @@ def test_robust_map_task_weights_flights_by_ground_speed():
     assert "weighting" not in make_problem("robust").describe()
     w = prob.weights()
     assert w.sum() == pytest.approx(1.0)
-    heads = np.array([c.wind_m_s[0] for c, _ in prob.flights()])
+    heads = np.array([c.wind_from_m_s[0] for c, _ in prob.flights()])
     expected = 3.0 / np.maximum(3.0 - heads, 0.5)
     np.testing.assert_allclose(w, expected / expected.sum())
     assert w[heads == 3.0][0] == pytest.approx(6 * w[heads == 0.0][0])

@@ -29,7 +29,7 @@ def _frozen(theta_deg: float = 0.0, phi_deg: float = 0.0) -> controllers.Butterf
     [
         ({"phi_up_deg": 12.77}, ButterflyParams(), paper.Condition()),
         ({"phi_up_deg": 14.0, "phi_down_deg": -3.0}, ButterflyParams(body_area_m2=1.53e-4),
-         paper.Condition(y0_m=2.0, wind_m_s=(2.0, -0.5))),
+         paper.Condition(y0_m=2.0, wind_from_m_s=(2.0, -0.5))),
     ],
 )
 def test_compiled_equals_naive_loop_after_2s(simple, ctrl_args, params, cond):
@@ -53,8 +53,8 @@ def test_batch_equals_each_flown_alone_bitwise(simple):
     ]
     params = [ButterflyParams(), ButterflyParams(mass_kg=0.4e-3), ButterflyParams(), ButterflyParams(body_area_m2=2e-4),
               ButterflyParams()]
-    conds = [paper.Condition(), paper.Condition(wind_m_s=(0.0, 2.0)), paper.Condition(y0_m=10.0),
-             paper.Condition(y0_m=-1.0, wind_m_s=(-2.0, 0.0)), paper.Condition(wind_m_s=(1.0, 1.0))]
+    conds = [paper.Condition(), paper.Condition(wind_from_m_s=(0.0, 2.0)), paper.Condition(y0_m=10.0),
+             paper.Condition(y0_m=-1.0, wind_from_m_s=(-2.0, 0.0)), paper.Condition(wind_from_m_s=(1.0, 1.0))]
     batch = paper.simulate(ctrls, params, conds, 1.0, DT, 3)
     assert len(batch) == 5
     for i, tr in enumerate(batch):
@@ -74,7 +74,7 @@ def test_wind_enters_as_air_relative_velocity_first_step():
     p = ButterflyParams()
     c = 0.5 * p.rho * p.cd * p.body_area_m2 / p.mass_kg  # 1/m
     for wind, sign in (((2.0, 0.0), -1.0), ((-2.0, 0.0), +1.0)):
-        (tr,) = paper.simulate(_frozen(), p, paper.Condition(wind_m_s=wind), 10 * DT, DT, 1)
+        (tr,) = paper.simulate(_frozen(), p, paper.Condition(wind_from_m_s=wind), 10 * DT, DT, 1)
         # dv/dt = -c u|u| with u = v_z + 2 (head) or v_z - 2 (tail): u(t) = u0 / (1 + c |u0| t)
         u0 = -sign * 2.0
         expected_vz = u0 / (1.0 + c * abs(u0) * tr.t) - u0
@@ -83,7 +83,7 @@ def test_wind_enters_as_air_relative_velocity_first_step():
         assert math.isclose(tr.vz[1] / DT, sign * c * 4.0, rel_tol=1e-3)  # first-step acceleration
     # wind from above (0, 2): air moving down, air-relative v_y = +2 m/s, drag pushes down beyond gravity
     (still,) = paper.simulate(_frozen(), p, paper.Condition(), 10 * DT, DT, 1)
-    (above,) = paper.simulate(_frozen(), p, paper.Condition(wind_m_s=(0.0, 2.0)), 10 * DT, DT, 1)
+    (above,) = paper.simulate(_frozen(), p, paper.Condition(wind_from_m_s=(0.0, 2.0)), 10 * DT, DT, 1)
     assert math.isclose((above.vy[1] - still.vy[1]) / DT, -c * 4.0, rel_tol=1e-2)
 
 
@@ -91,7 +91,7 @@ def test_head_wind_raises_air_relative_forward_speed_and_lift(simple):
     # On the upstroke phi_up > 0: v_w' = L omega - v_zr sin(phi) (eq. 7) is smaller with the larger
     # air-relative forward speed v_zr of a head wind, so the downward wing force of the upstroke
     # shrinks and the butterfly ends higher than in still air (paper section 7.2: holds ~0 m).
-    still, head = paper.simulate([simple, simple], None, [paper.Condition(), paper.Condition(wind_m_s=(2.0, 0.0))],
+    still, head = paper.simulate([simple, simple], None, [paper.Condition(), paper.Condition(wind_from_m_s=(2.0, 0.0))],
                                  1.0, DT, 1)
     air_rel_still = still.vz - 0.0
     air_rel_head = head.vz + 2.0  # air velocity is -(2, 0)

@@ -23,7 +23,7 @@ def test_fly_records_controller_constants_and_conditions(tmp_path):
     p = _prov(out / "summary.json")
     assert "--wind -2,0.5" in p["command"]
     q = p["parameters"]
-    assert q["wind_m_s"] == [-2.0, 0.5] and q["params"]["mass_kg"] == 0.3e-3 and q["dt_s"] == 1.0 / 1200.0
+    assert q["wind_from_m_s"] == [-2.0, 0.5] and q["params"]["mass_kg"] == 0.3e-3 and q["dt_s"] == 1.0 / 1200.0
     assert q["controller"]["parameters"] == {"phi_up_deg": 12.77, "phi_down_deg": 0.0}
     png = Image.open(out / "flight.png")
     assert png.text["Software"] == f"lifelike-mj {__version__}" and "butterfly fly" in png.text["Description"]

@@ -12,7 +12,7 @@ pytest.importorskip("gymnasium")
 
 from lifelike_mj.butterfly import controllers  # noqa: E402
 from lifelike_mj.butterfly.ann_experiments import PAPER_WINDS, assess  # noqa: E402
-from lifelike_mj.envs.policies import controller_policy  # noqa: E402
+from lifelike_mj.envs.policies import FILE_WORD, controller_policy  # noqa: E402
 from lifelike_mj.envs.vector import ButterflyPitchVectorEnv  # noqa: E402
 
 SETTLE_FROM = 12000  # steps: the last 10 s of 20 s at 1/1200 s
@@ -23,9 +23,9 @@ def _fly(ctrl, inputs, conditions):
     """Altitude (m) and ground forward speed (m/s) after every step, one column per condition."""
     n = len(conditions)
     env = ButterflyPitchVectorEnv(n, action_mode="phi", inputs=inputs, duration_s=20.0)
-    policy = controller_policy(ctrl.with_inputs(inputs), env)
+    policy = controller_policy(ctrl.with_inputs(FILE_WORD[inputs]), env)
     obs, _ = env.reset(seed=0, options={"conditions": conditions})
-    air_fwd = np.array([(-a if inputs == "relative" else 0.0) for _, (a, _b) in conditions])
+    air_fwd = np.array([(-a if inputs == "air" else 0.0) for _, (a, _b) in conditions])
     ys, vzs = [obs[:, 4].copy()], [obs[:, 5] + air_fwd]
     for _ in range(24000):
         obs, _, term, trunc, _ = env.step(policy(obs))
@@ -42,7 +42,7 @@ def test_the_shipped_network_through_the_env_scores_what_assess_reports():
     grid = np.arange(-2, 3) * STEP
     cells = [(0.0, (a, b)) for b in grid for a in grid]
     flights = [(0.0, (0.0, 0.0)), (10.0, (0.0, 0.0)), (0.0, PAPER_WINDS["behind (-2,0)"])]
-    y, vz = _fly(ctrl, "relative", flights + cells)
+    y, vz = _fly(ctrl, "air", flights + cells)
     settled = slice(SETTLE_FROM, None)
 
     def numbers(j, y0):

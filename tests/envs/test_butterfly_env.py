@@ -78,8 +78,8 @@ def test_bad_arguments_are_one_sentence():
     from lifelike_mj.errors import UserError
 
     for kw in ({"backend": "jax"}, {"backend": "mujoco", "config": "wide"},
-               {"inputs": "air"}, {"action_mode": "angle"}, {"frame_skip": 0}, {"duration_s": -1},
-               {"wind_m_s": (100.0, 0.0)}, {"render_mode": "movie"}, {"camera": "top"}, {"width": 0}):
+               {"inputs": "water"}, {"action_mode": "angle"}, {"frame_skip": 0}, {"duration_s": -1},
+               {"wind_from_m_s": (100.0, 0.0)}, {"render_mode": "movie"}, {"camera": "top"}, {"width": 0}):
         with pytest.raises(UserError):
             ButterflyPitchEnv(**kw)
 
@@ -92,14 +92,14 @@ def test_the_wind_env_draws_its_condition_from_the_seed():
     env = gym.make("lifelike_mj/ButterflyPitchWind-v0", duration_s=0.5).unwrapped
     check_env(env, skip_render_check=True)
     drawn = [env.reset(seed=s)[1] for s in range(40)]
-    conds = {(c.y0_m, tuple(c.wind_m_s)) for c in robust_map_conditions()}
-    got = {(d["y0_m"], d["wind_m_s"]) for d in drawn}
+    conds = {(c.y0_m, tuple(c.wind_from_m_s)) for c in robust_map_conditions()}
+    got = {(d["y0_m"], d["wind_from_m_s"]) for d in drawn}
     assert got <= conds and len(got) >= 10  # 40 draws over the 17 conditions
     assert env.reset(seed=7)[1] == env.reset(seed=7)[1]
     obs, info = env.reset(seed=3)
     assert obs[4] == info["y0_m"] and info["flight_weight"] > 0
     fixed = gym.make("lifelike_mj/ButterflyPitchWind-v0", conditions=[(5.0, (0.0, 1.0))]).unwrapped
-    assert fixed.reset(seed=0)[1]["wind_m_s"] == (0.0, 1.0)
+    assert fixed.reset(seed=0)[1]["wind_from_m_s"] == (0.0, 1.0)
 
 
 @pytest.mark.parametrize("backend", ["paper", "mujoco"])
@@ -184,3 +184,25 @@ def test_the_envs_inputs_are_named_as_a_pitch_laws_and_the_old_names_still_work_
         warnings.simplefilter("always")
         with pytest.warns(DeprecationWarning, match="altitude_m"):
             assert law_obs.y_m == law_obs.altitude_m
+
+
+def test_wind_and_inputs_are_named_by_their_meaning_and_the_old_words_still_work():
+    """``wind_from_m_s`` and ``wind_to_m_s`` are one wind seen from its two ends; ``wind_m_s`` (where it comes from)
+    and ``inputs="relative"`` (through the air) are taken this release, each with a note."""
+    import warnings
+
+    from lifelike_mj.butterfly import Condition
+    from lifelike_mj.errors import UserError
+
+    a = ButterflyPitchEnv(wind_from_m_s=(1.0, 0.5))
+    b = ButterflyPitchEnv(wind_to_m_s=(-1.0, -0.5))
+    assert a.condition == b.condition and a.condition.wind_to_m_s == (-1.0, -0.5)
+    with pytest.warns(DeprecationWarning):
+        old = ButterflyPitchEnv(wind_m_s=(1.0, 0.5), inputs="relative")
+    assert old.condition == a.condition and old.inputs == "air"
+    with pytest.raises(UserError, match="give the wind once"):
+        ButterflyPitchEnv(wind_from_m_s=(1.0, 0.0), wind_to_m_s=(1.0, 0.0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the new names give no note
+        assert Condition(wind_to_m_s=(2.0, 0.0)).wind_from_m_s == (-2.0, 0.0)
+        assert Condition(3.0, (2.0, 0.0)).air_velocity() == (-2.0, -0.0)

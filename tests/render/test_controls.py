@@ -51,12 +51,12 @@ def test_the_butterflys_keys_change_its_course_altitude_and_wind():
     _press(keys, "Left")
     assert f.reference == (math.pi / 4, 1.0, 1.5)
     _press(keys, "7")
-    np.testing.assert_array_equal(f.wind_m_s, [0.0, 1.0, 0.0])
+    np.testing.assert_array_equal(f.wind_to_m_s, [0.0, 1.0, 0.0])
     f.step(int(4.0 / f.dt))
     s = f.state()
     assert abs(s["position_m"][2] - 1.0) < 0.15 and abs(math.degrees(s["attitude_rad"][2]) - 45.0) < 15.0
     _press(keys, "Space")
-    np.testing.assert_array_equal(f.wind_m_s, [0.0, 0.0, 0.0])
+    np.testing.assert_array_equal(f.wind_to_m_s, [0.0, 0.0, 0.0])
 
 
 def test_the_boids_keys_switch_the_weights_live():

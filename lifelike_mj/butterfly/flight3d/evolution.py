@@ -83,7 +83,10 @@ class FlightProblem3D:
 
     def describe(self) -> dict:
         t = self.template.to_dict()
-        return {"problem": "butterfly3d-flight", "tasks": [asdict(k) for k in self.tasks], "duration_s": self.duration_s,
+        # each task's wind keeps its first key, wind_m_s (where it blows to), so that the fingerprints of earlier
+        # problems (and their checkpoints) hold
+        tasks = [{("wind_m_s" if k == "wind_to_m_s" else k): v for k, v in asdict(t).items()} for t in self.tasks]
+        return {"problem": "butterfly3d-flight", "tasks": tasks, "duration_s": self.duration_s,
                 "dt_s": self.dt_s, "gene_bound": self.gene_bound, "params": asdict(self.params),
                 "force_law": self.force_law, "n_strips": self.n_strips, "n_chord": self.n_chord, "layers": t["layers"],
                 "base": t["base"],

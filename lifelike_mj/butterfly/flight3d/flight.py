@@ -87,7 +87,8 @@ class Flight3D(StepCounter):
     or the name or path of a controller file), flown in the compiled loop towards ``task``'s references
     (:class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`; default level flight at 1.5 m/s), or any callable
     ``controller(flight) -> KinematicsCommand | None`` run from Python before every ``control_every``-th
-    step. ``wind_m_s``: the mean wind (world frame, m/s, where it blows to), replacing the task's (gusts and
+    step. ``wind_to_m_s`` (where it blows to) or ``wind_from_m_s`` (where it comes from): the mean wind (world
+    frame, m/s), replacing the task's (``wind_m_s``, the older spelling of ``wind_to_m_s``, with a note; gusts and
     flutter are the task's: :class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`); ``start_m``: the thorax's start
     position.
     Model options: ``force_law`` (``exact``: eq. 1 integrated exactly over each wing; ``strip``: eq. 1 on wing
@@ -102,7 +103,8 @@ class Flight3D(StepCounter):
 
     @checks.known_keywords
     def __init__(self, command: KinematicsCommand | None = None, params: ButterflyParams | None = None, *,
-                 controller=None, task=None, control_every: int = 1, wind_m_s=None,
+                 controller=None, task=None, control_every: int = 1, wind_to_m_s=None, wind_from_m_s=None,
+                 wind_m_s=None,
                  start_m=(0.0, 0.0, 0.0), force_law: str = "exact", drag_frame: str = "body",
                  body_areas_m2=None, masses: str = "animal", dt_s: float = DT_S, n_strips: int = 8,
                  n_chord: int = 2, drive_hz: float = 50.0, omega_c: float | None = None, assist: str = "none",
@@ -132,11 +134,12 @@ class Flight3D(StepCounter):
         if assist == "hold" and not callable(pitch_law):
             raise UserError("the attitude hold needs pitch_law, a function of the flight returning the pitch (rad).")
         self.controller, self.control_every = controller, checks.whole("control_every", control_every, 1)
-        if wind_m_s is not None:
+        wind = checks.one_wind("Flight3D", wind_to_m_s, wind_from_m_s, wind_m_s, "to")
+        if wind is not None:
             from dataclasses import replace
 
-            self.task = replace(self.task, wind_m_s=checks.vector("wind_m_s", wind_m_s, 3, "m/s"))
-        self.wind_m_s = np.array(self.task.wind_m_s)
+            self.task = replace(self.task, wind_to_m_s=wind)
+        self.wind_to_m_s = np.array(self.task.wind_to_m_s)
         self.start_m = np.array(checks.vector("start_m", start_m, 3), dtype=float)
         self.options = {"force_law": force_law, "drag_frame": drag_frame, "body_areas_m2": body_areas_m2,
                         "assist": assist, "drive_hz": checks.positive("drive_hz", drive_hz, "Hz"),
@@ -174,7 +177,7 @@ class Flight3D(StepCounter):
         The flight has no randomness yet; ``seed`` is accepted for the common shape."""
         self._k = 0
         kin = Kinematics(self.command, self.omega_c)
-        self._data = mj3d.setup_data(self._model, kin, self.params, air_m_s=self.wind_m_s, **self.options)
+        self._data = mj3d.setup_data(self._model, kin, self.params, air_m_s=self.wind_to_m_s, **self.options)
         self._data.qpos[self._root_q : self._root_q + 3] = self.start_m
         net = self.network
         self._batch = Batch(self._model, [self._data], self._task, net, dt_s=self.dt,
@@ -201,14 +204,23 @@ class Flight3D(StepCounter):
         self.command = command
         self._data.userdata[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS] = command.as_array()
 
-    def set_wind(self, wind_m_s) -> None:
-        """The mean wind from now on (world frame, m/s, where it blows to); the task's gusts and flutter go on.
-        For interactive scenes (the viewers' wind keys)."""
+    @property
+    def wind_m_s(self) -> np.ndarray:
+        """The older name of :attr:`wind_to_m_s` (with a note)."""
+        checks.renamed("Flight3D.wind_m_s", "Flight3D.wind_to_m_s", "where the wind blows to")
+        return self.wind_to_m_s
+
+    def set_wind(self, wind_to_m_s=None, *, wind_from_m_s=None, wind_m_s=None) -> None:
+        """The mean wind from now on (world frame, m/s: where it blows to, or ``wind_from_m_s``, where it comes from;
+        ``wind_m_s``: the older spelling of ``wind_to_m_s``); the task's gusts and flutter go on. For interactive
+        scenes (the viewers' wind keys)."""
         from dataclasses import replace
 
-        w = checks.vector("wind_m_s", wind_m_s, 3, "m/s")
-        self.task = replace(self.task, wind_m_s=w)
-        self.wind_m_s = np.array(w)
+        w = checks.one_wind("set_wind", wind_to_m_s, wind_from_m_s, wind_m_s, "to")
+        if w is None:
+            raise UserError("set_wind: give the wind, as wind_to_m_s or wind_from_m_s.")
+        self.task = replace(self.task, wind_to_m_s=w)
+        self.wind_to_m_s = np.array(w)
         self._task[T_WIND : T_WIND + 3] = w
         self._data.userdata[mj3d.U_AIR : mj3d.U_AIR + 3] = w  # the gusts are added at the next step
 

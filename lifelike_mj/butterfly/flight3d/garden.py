@@ -105,25 +105,27 @@ class Garden(StepCounter):
     """``n`` 3D butterflies in a garden of ``n_flowers`` flowers drawn by ``seed`` (module docstring).
 
     ``controller``: a 3D controller (name, path or :class:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D`);
-    ``flutter``, ``gust_m_s``, ``gust_vertical_m_s``, ``wind_m_s``: each butterfly's flutter and the weather
+    ``flutter``, ``gust_m_s``, ``gust_vertical_m_s``, ``wind_to_m_s`` (or ``wind_from_m_s``; ``wind_m_s``, the
+    older spelling of ``wind_to_m_s``): each butterfly's flutter and the weather
     (:class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`); ``speed_m_s``: the cruise speed; ``dt_s`` the time step.
     """
 
     @checks.known_keywords
     def __init__(self, n: int = 20, controller="steer", *, seed: int = 0, n_flowers: int = 10, size_m: float = 6.0,
-                 speed_m_s: float = 1.5, flutter: float = 0.1, gust_m_s: float = 0.0, wind_m_s=(0.0, 0.0, 0.0),
+                 speed_m_s: float = 1.5, flutter: float = 0.1, gust_m_s: float = 0.0, wind_to_m_s=None,
                  gust_vertical_m_s: float | None = None, dt_s: float = DT_S, n_strips: int = 8, n_chord: int = 2,
-                 force_law: str = "exact") -> None:
+                 force_law: str = "exact", wind_from_m_s=None, wind_m_s=None) -> None:
         self.n = checks.whole("the number of butterflies", n, 1, 500)
         self.controller = controller if isinstance(controller, Controller3D) else load_controller(controller)
         self.seed = checks.whole("seed", seed, 0, 2**32 - 1)
         self.size_m = checks.number("garden size", size_m, 2.0, 100.0, unit="m")
         self.blossoms = flowers(self.seed, checks.whole("the number of flowers", n_flowers, 2, 200), self.size_m)
         self.dt = checks.positive("time step dt_s", dt_s, "s")
+        wind = checks.one_wind("Garden", wind_to_m_s, wind_from_m_s, wind_m_s, "to") or (0.0, 0.0, 0.0)
         self.tasks = [Task3D("waypoints", tuple(tuple(float(v) for v in p)
                                                    for p in course_among(self.blossoms, self.seed * 1000 + i)),
                                 speed_m_s=checks.positive("speed_m_s", speed_m_s, "m/s"), name=f"butterfly {i}",
-                                wind_m_s=tuple(wind_m_s), gust_m_s=gust_m_s, gust_vertical_m_s=gust_vertical_m_s,
+                                wind_to_m_s=wind, gust_m_s=gust_m_s, gust_vertical_m_s=gust_vertical_m_s,
                                 flutter=flutter,
                                 seed=(self.seed * 1000 + i) % 2**32) for i in range(self.n)]
         self._phys = mj3d.build_model()

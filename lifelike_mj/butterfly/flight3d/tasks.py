@@ -36,14 +36,15 @@ MAX_TASK_ROWS = 10_000
 MAX_TASK_NUMBER = 1.0e6
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Task3D:
     """A task: ``kind="schedule"`` with rows ``(t_start_s, heading_rad, altitude_m, speed_m_s)`` (the
     reference from each row's time on; the first row's time is 0), or ``kind="waypoints"`` with rows
     ``(x, y, z)`` in m, visited in order at ``speed_m_s``, each passed when within ``radius_m``, or
     ``kind="target"``, a moving target (:func:`moving_target`).
 
-    The weather: a mean wind ``wind_m_s`` (world frame, m/s, where it blows to) plus gusts, a first-order
+    The weather: a mean wind ``wind_to_m_s`` (world frame, m/s, where it blows to: the air's velocity; or
+    ``wind_from_m_s``, where it comes from; ``wind_m_s`` is the older spelling of ``wind_to_m_s``) plus gusts, a first-order
     Gauss-Markov (Ornstein-Uhlenbeck) process on each axis with standard deviation ``gust_m_s`` (the two
     horizontal axes) and ``gust_vertical_m_s`` (the vertical; ``None``: the same as ``gust_m_s``) and
     correlation time ``gust_tau_s``, starting from calm. Near the ground the vertical gusts are weaker:
@@ -56,13 +57,37 @@ class Task3D:
     radius_m: float = 0.3
     speed_m_s: float = 1.5
     name: str = ""
-    wind_m_s: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    wind_to_m_s: tuple[float, float, float] = (0.0, 0.0, 0.0)
     gust_m_s: float = 0.0
     gust_tau_s: float = 1.0
     flutter: float = 0.0
     flutter_tau_s: float = 0.2
     seed: int = 0
     gust_vertical_m_s: float | None = None
+
+    def __init__(self, kind: str, rows, radius_m: float = 0.3, speed_m_s: float = 1.5, name: str = "",
+                 wind_to_m_s=None, gust_m_s: float = 0.0, gust_tau_s: float = 1.0, flutter: float = 0.0,
+                 flutter_tau_s: float = 0.2, seed: int = 0, gust_vertical_m_s: float | None = None, *,
+                 wind_from_m_s=None, wind_m_s=None) -> None:
+        wind = checks.one_wind("Task3D", wind_to_m_s, wind_from_m_s, wind_m_s, "to")
+        given = {"kind": kind, "rows": rows, "radius_m": radius_m, "speed_m_s": speed_m_s, "name": name,
+                 "wind_to_m_s": (0.0, 0.0, 0.0) if wind is None else wind, "gust_m_s": gust_m_s,
+                 "gust_tau_s": gust_tau_s, "flutter": flutter, "flutter_tau_s": flutter_tau_s, "seed": seed,
+                 "gust_vertical_m_s": gust_vertical_m_s}
+        for k, v in given.items():
+            object.__setattr__(self, k, v)
+        self.__post_init__()
+
+    @property
+    def wind_from_m_s(self) -> tuple[float, float, float]:
+        """The mean wind as where it comes from (m/s, world frame)."""
+        return tuple(0.0 - w for w in self.wind_to_m_s)
+
+    @property
+    def wind_m_s(self) -> tuple[float, float, float]:
+        """The older name of :attr:`wind_to_m_s` (with a note)."""
+        checks.renamed("Task3D.wind_m_s", "Task3D.wind_to_m_s", "where the wind blows to")
+        return self.wind_to_m_s
 
     def __post_init__(self) -> None:
         if self.kind not in ("schedule", "waypoints", "target"):
@@ -77,9 +102,9 @@ class Task3D:
             raise UserError("a schedule's first row starts at 0 s.")
         checks.number("radius_m", self.radius_m, 0.0, 1000.0, lo_open=True, unit="m")
         checks.number("speed_m_s", self.speed_m_s, 0.0, 100.0, lo_open=True, unit="m/s")
-        object.__setattr__(self, "wind_m_s", checks.vector("wind_m_s", self.wind_m_s, 3, "m/s"))
-        for w in self.wind_m_s:
-            checks.number("each component of wind_m_s", w, -100.0, 100.0, unit="m/s")
+        object.__setattr__(self, "wind_to_m_s", checks.vector("wind_to_m_s", self.wind_to_m_s, 3, "m/s"))
+        for w in self.wind_to_m_s:
+            checks.number("each component of the wind", w, -100.0, 100.0, unit="m/s")
         checks.number("gust_m_s", self.gust_m_s, 0.0, 10.0, unit="m/s")
         checks.number("gust_tau_s", self.gust_tau_s, 0.0, 1e4, lo_open=True, unit="s")
         if self.gust_vertical_m_s is not None:
@@ -88,15 +113,17 @@ class Task3D:
         checks.number("flutter_tau_s", self.flutter_tau_s, 0.0, 1e4, lo_open=True, unit="s")
         checks.whole("seed", self.seed, 0, 2**32 - 1)
 
-    def with_weather(self, wind_m_s=(0.0, 0.0, 0.0), gust_m_s: float = 0.0, gust_tau_s: float = 1.0,
+    def with_weather(self, wind_to_m_s=None, gust_m_s: float = 0.0, gust_tau_s: float = 1.0,
                      flutter: float = 0.0, flutter_tau_s: float = 0.2, seed: int | None = None,
-                     gust_vertical_m_s: float | None = None) -> Task3D:
-        """The same task in other weather (and flutter); the seed defaults to the task's."""
+                     gust_vertical_m_s: float | None = None, *, wind_from_m_s=None, wind_m_s=None) -> Task3D:
+        """The same task in other weather (and flutter): the mean wind as ``wind_to_m_s`` or ``wind_from_m_s``
+        (default calm; ``wind_m_s``: the older spelling of ``wind_to_m_s``); the seed defaults to the task's."""
         from dataclasses import replace
 
-        return replace(self, wind_m_s=tuple(wind_m_s), gust_m_s=gust_m_s, gust_tau_s=gust_tau_s, flutter=flutter,
-                       flutter_tau_s=flutter_tau_s, seed=self.seed if seed is None else seed,
-                       gust_vertical_m_s=gust_vertical_m_s)
+        wind = checks.one_wind("with_weather", wind_to_m_s, wind_from_m_s, wind_m_s, "to")
+        return replace(self, wind_to_m_s=(0.0, 0.0, 0.0) if wind is None else wind, gust_m_s=gust_m_s,
+                       gust_tau_s=gust_tau_s, flutter=flutter, flutter_tau_s=flutter_tau_s,
+                       seed=self.seed if seed is None else seed, gust_vertical_m_s=gust_vertical_m_s)
 
     @property
     def vertical_gust_m_s(self) -> float:
@@ -111,7 +138,7 @@ class Task3D:
         out[T_ROWS] = len(self.rows)
         out[T_RADIUS] = self.radius_m
         out[T_SPEED] = self.speed_m_s
-        out[T_WIND : T_WIND + 3] = self.wind_m_s
+        out[T_WIND : T_WIND + 3] = self.wind_to_m_s
         out[T_GUST], out[T_GUST_TAU], out[T_GUST_W] = self.gust_m_s, self.gust_tau_s, self.vertical_gust_m_s
         out[T_FLUTTER], out[T_FLUTTER_TAU], out[T_SEED] = self.flutter, self.flutter_tau_s, self.seed
         for i, r in enumerate(self.rows):

@@ -200,7 +200,7 @@ def test_vertical_gusts_have_their_own_deviation():
 
 def test_a_gusty_flight_is_the_same_for_the_same_seed_and_feels_the_gusts():
     ctl = flight3d.Controller3D([10, 9], flight3d.pd_prior([10, 9]))
-    task = flight3d.level(1.5).with_weather(wind_m_s=(1.0, 0.0, 0.0), gust_m_s=0.5, flutter=0.2, seed=4)
+    task = flight3d.level(1.5).with_weather(wind_to_m_s=(1.0, 0.0, 0.0), gust_m_s=0.5, flutter=0.2, seed=4)
     runs = []
     for seed in (4, 4, 5):
         f = Flight3D(controller=ctl, task=task.with_weather((1.0, 0.0, 0.0), 0.5, flutter=0.2, seed=seed),

@@ -39,5 +39,34 @@ def test_bad_references_are_refused():
     f = Flight3D(controller="wind")
     with pytest.raises(UserError, match="altitude_m"):
         f.set_reference(altitude_m=float("nan"))
-    with pytest.raises(UserError, match="wind_m_s"):
+    with pytest.raises(UserError, match="wind_to_m_s"):
         f.set_wind((1.0, 2.0))
+
+
+def test_the_wind_is_named_by_its_meaning_and_the_old_name_still_works():
+    """``wind_to_m_s`` (the air's velocity) and ``wind_from_m_s`` are one wind; ``wind_m_s`` (where it blows to, as
+    before) is taken this release with a note, on the flight, the garden, the task and ``set_wind``."""
+    import warnings
+
+    from lifelike_mj.butterfly import flight3d
+
+    to = Flight3D(controller="wind", wind_to_m_s=(1.0, 0.5, 0.0))
+    fro = Flight3D(controller="wind", wind_from_m_s=(-1.0, -0.5, 0.0))
+    assert to.task == fro.task and to.task.wind_from_m_s == (-1.0, -0.5, 0.0)
+    to.step(600)
+    fro.step(600)
+    np.testing.assert_array_equal(to.state()["position_m"], fro.state()["position_m"])
+    with pytest.warns(DeprecationWarning):
+        old = Flight3D(controller="wind", wind_m_s=(1.0, 0.5, 0.0))
+    assert old.task == to.task
+    with pytest.warns(DeprecationWarning):
+        assert old.wind_m_s.tolist() == [1.0, 0.5, 0.0]
+    with pytest.warns(DeprecationWarning):
+        assert flight3d.level(1.5).with_weather(wind_m_s=(0.0, 1.0, 0.0)).wind_to_m_s == (0.0, 1.0, 0.0)
+    with pytest.raises(UserError, match="give the wind once"):
+        flight3d.Garden(2, wind_to_m_s=(1.0, 0.0, 0.0), wind_from_m_s=(1.0, 0.0, 0.0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the new names give no note
+        to.set_wind(wind_from_m_s=(0.0, 2.0, 0.0))
+        assert to.wind_to_m_s.tolist() == [0.0, -2.0, 0.0]
+        assert flight3d.Garden(2, wind_from_m_s=(1.0, 0.0, 0.0)).tasks[0].wind_to_m_s == (-1.0, 0.0, 0.0)

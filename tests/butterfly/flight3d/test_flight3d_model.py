@@ -178,8 +178,8 @@ def test_bad_flight_options_are_one_sentence():
         Flight3D(force_law="vortex")
     with pytest.raises(UserError, match="pitch_law"):
         Flight3D(assist="hold")
-    with pytest.raises(UserError, match="wind_m_s must be 3 finite numbers"):
-        Flight3D(wind_m_s=(1.0, float("nan"), 0.0))
+    with pytest.raises(UserError, match="wind_to_m_s must be 3 finite numbers"):
+        Flight3D(wind_to_m_s=(1.0, float("nan"), 0.0))
     with pytest.raises(UserError, match="does not resolve"):
         Flight3D(dt_s=0.05)
     with pytest.raises(UserError, match="mass layout"):

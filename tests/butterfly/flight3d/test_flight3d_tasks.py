@@ -45,10 +45,10 @@ GUSTY = {"gust_m_s": 0.5, "gust_vertical_m_s": 0.5 * DRYDEN_VERTICAL_RATIO}
 
 @pytest.mark.parametrize("seed,wind", [(101, (1.0, 0.0, 0.0)), (105, (0.0, -1.0, 0.0))])
 def test_the_wind_controller_holds_a_course_never_trained_on_in_gusty_wind(seed, wind):
-    r = course_check("wind", seed=seed, weather={"wind_m_s": wind, **GUSTY})
+    r = course_check("wind", seed=seed, weather={"wind_to_m_s": wind, **GUSTY})
     assert r["passed"] == 10 and r["all_within_radius"], r
     # steer, which measures its speed over the ground, loses the same course
-    assert course_check("steer", seed=seed, max_s=30.0, weather={"wind_m_s": wind, **GUSTY})["passed"] < 10
+    assert course_check("steer", seed=seed, max_s=30.0, weather={"wind_to_m_s": wind, **GUSTY})["passed"] < 10
 
 
 def test_the_flight_looks_like_dudleys_butterflies():
