@@ -156,17 +156,9 @@ class PitchObservation(NamedTuple):
         return _renamed("v_z_m_s", "forward_m_s", self.forward_m_s)
 
 
-_WARNED: set[str] = set()
-
-
 def _renamed(old: str, new: str, value: float) -> float:
     """``value``, with a one-line note (once per name and process) that ``old`` is now ``new``."""
-    if old not in _WARNED:
-        import warnings
-
-        _WARNED.add(old)
-        warnings.warn(f"PitchObservation.{old} is now called {new} (the name the environment also uses); the old "
-                      "name goes in the next release.", DeprecationWarning, stacklevel=3)
+    checks.renamed(f"PitchObservation.{old}", f"PitchObservation.{new}", "the name the environment also uses")
     return value
 
 

@@ -24,13 +24,9 @@ OLD_OBSERVATION_NAMES = {"phi_prev_rad": "phi_rad", "v_y_m_s": "climb_m_s", "y_m
 def observation_index(name: str) -> int:
     """The index of the input ``name`` in an observation (:data:`OBSERVATION_NAMES`; a name of before 0.3 works
     for one more release, with a one-line note)."""
-    import warnings
-
     if name in OLD_OBSERVATION_NAMES:
-        new = OLD_OBSERVATION_NAMES[name]
-        warnings.warn(f"the observation {name!r} is now called {new!r} (the pitch law's name); the old name goes "
-                      "in the next release.", DeprecationWarning, stacklevel=2)
-        name = new
+        checks.renamed(f"the observation {name!r}", repr(OLD_OBSERVATION_NAMES[name]), "the pitch law's name")
+        name = OLD_OBSERVATION_NAMES[name]
     if name not in OBSERVATION_NAMES:
         from lifelike_mj.errors import UserError
 

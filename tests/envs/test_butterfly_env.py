@@ -163,11 +163,11 @@ def test_the_envs_inputs_are_named_as_a_pitch_laws_and_the_old_names_still_work_
     with ground inputs the values are the same; the names of before 0.3 still work, each with a note."""
     import warnings
 
-    from lifelike_mj.butterfly import flight
+    from lifelike_mj import checks
     from lifelike_mj.butterfly.flight import PitchObservation
     from lifelike_mj.envs.butterfly import OLD_OBSERVATION_NAMES, observation_index
 
-    flight._WARNED.clear()  # the note comes once per process: let this test see it
+    checks._RENAMED.clear()  # the note comes once per process: let this test see it
 
     assert set(OBSERVATION_NAMES) <= set(PitchObservation._fields)
     env = ButterflyPitchEnv(inputs="ground")
