@@ -9,7 +9,11 @@ named before the colon) ``gymnasium.make("lifelike_mj.envs:lifelike_mj/Butterfly
 * ``lifelike_mj/ButterflyPitchWind-v0``: :class:`~lifelike_mj.envs.butterfly.ButterflyPitchWindEnv`,
   the same with the start altitude and the wind drawn per episode (``butterfly evolve``'s
   ``robust_map`` task).
-* :class:`~lifelike_mj.envs.vector.ButterflyPitchVectorEnv`: N of either, on either backend, stepped in
+* ``lifelike_mj/ButterflyFlight3D-v0``: :class:`~lifelike_mj.envs.butterfly3d.ButterflyFlight3DEnv`, the
+  free-flying 3D butterfly steered by its wing and abdomen kinematics through level flight, turns, courses and
+  courses in wind; its vector form :class:`~lifelike_mj.envs.butterfly3d.ButterflyFlight3DVectorEnv` flies N
+  on one compiled MuJoCo batch.
+* :class:`~lifelike_mj.envs.vector.ButterflyPitchVectorEnv`: N of either planar one, on either backend, stepped in
   one native call
   (``gymnasium.make_vec("lifelike_mj/ButterflyPitch-v0", num_envs=N, vectorization_mode="vector_entry_point")``).
 * :mod:`lifelike_mj.envs.policies`: controller files as policies of these environments, and networks
@@ -27,12 +31,14 @@ from lifelike_mj._lazy import attach
 ENVS = {
     "lifelike_mj/ButterflyPitch-v0": "lifelike_mj.envs.butterfly:ButterflyPitchEnv",
     "lifelike_mj/ButterflyPitchWind-v0": "lifelike_mj.envs.butterfly:ButterflyPitchWindEnv",
+    "lifelike_mj/ButterflyFlight3D-v0": "lifelike_mj.envs.butterfly3d:ButterflyFlight3DEnv",
 }
 
 
 _VECTOR = {
     "lifelike_mj/ButterflyPitch-v0": "lifelike_mj.envs.vector:ButterflyPitchVectorEnv",
     "lifelike_mj/ButterflyPitchWind-v0": "lifelike_mj.envs.vector:ButterflyPitchWindVectorEnv",
+    "lifelike_mj/ButterflyFlight3D-v0": "lifelike_mj.envs.butterfly3d:ButterflyFlight3DVectorEnv",
 }
 
 
@@ -48,7 +54,8 @@ def register_envs() -> None:
 
 __getattr__, __dir__, _names = attach(__name__, {
     "ButterflyPitchEnv": "butterfly", "ButterflyPitchWindEnv": "butterfly", "ButterflyPitchVectorEnv": "vector",
-    "butterfly": ".", "vector": ".", "policies": ".",
+    "ButterflyFlight3DEnv": "butterfly3d", "ButterflyFlight3DVectorEnv": "butterfly3d",
+    "butterfly": ".", "vector": ".", "policies": ".", "butterfly3d": ".",
 }, globals())
 __all__ = ["ENVS", "register_envs", *_names]
 

@@ -95,8 +95,8 @@ def main() -> int:
 
     import importlib
 
-    for name in ("butterfly", "fish", "boids"):
-        importlib.import_module(f"lifelike_mj.{name}.render").view = watched_view
+    for name in ("butterfly.render", "butterfly.flight3d.view", "fish.render", "boids.render"):
+        importlib.import_module(f"lifelike_mj.{name}").view = watched_view
     from lifelike_mj.cli import main as cli
 
     return cli(["view", creature, *args])

@@ -36,8 +36,18 @@ from lifelike_mj import checks
 from lifelike_mj.butterfly.flight3d import model as mj3d
 from lifelike_mj.butterfly.flight3d.controllers import Controller3D, load_controller
 from lifelike_mj.butterfly.flight3d.kinematics import JOINTS, N_PARAMS, Kinematics, KinematicsCommand
-from lifelike_mj.butterfly.flight3d.loop import Batch
-from lifelike_mj.butterfly.flight3d.tasks import R_DIVERGED, R_PASSED, R_WP, T_ROW0, T_WIND, Task3D, level, new_record
+from lifelike_mj.butterfly.flight3d.loop import TUMBLE_RAD, Batch
+from lifelike_mj.butterfly.flight3d.tasks import (
+    R_DIVERGED,
+    R_PASSED,
+    R_TUMBLED,
+    R_WP,
+    T_ROW0,
+    T_WIND,
+    Task3D,
+    level,
+    new_record,
+)
 from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.errors import Diverged, UserError
 from lifelike_mj.physics.callbacks import passive_callback
@@ -97,6 +107,8 @@ class Flight3D(StepCounter):
     paper's ``A_b`` on every axis), ``masses`` (``animal`` or ``paper``), ``n_strips`` and ``n_chord`` (panels
     per wing, for the panel laws), ``drive_hz`` (the joints' tracking bandwidth), ``omega_c`` (rad/s, how
     fast the kinematics follow a command; default the controller's, else one wing beat).
+    ``end_on_tumble``: a roll or pitch beyond :data:`~lifelike_mj.butterfly.flight3d.loop.TUMBLE_RAD` ends the
+    flight there (as in an evolution; :attr:`tumbled`), else it flies on.
     ``assist="hold"`` holds the attitude at ``pitch_law(flight)`` (rad, nose up), set once per step, roll
     and yaw 0: the reduction check to the planar model, not free flight.
     """
@@ -108,7 +120,8 @@ class Flight3D(StepCounter):
                  start_m=(0.0, 0.0, 0.0), force_law: str = "exact", drag_frame: str = "body",
                  body_areas_m2=None, masses: str = "animal", dt_s: float = DT_S, n_strips: int = 8,
                  n_chord: int = 2, drive_hz: float = 50.0, omega_c: float | None = None, assist: str = "none",
-                 pitch_law: Callable | None = None, _model: mujoco.MjModel | None = None) -> None:
+                 pitch_law: Callable | None = None, end_on_tumble: bool = False,
+                 _model: mujoco.MjModel | None = None) -> None:
         self.network = None
         if isinstance(controller, (str, Path)):
             controller = load_controller(controller)
@@ -145,6 +158,7 @@ class Flight3D(StepCounter):
                         "assist": assist, "drive_hz": checks.positive("drive_hz", drive_hz, "Hz"),
                         "n_strips": n_strips, "n_chord": n_chord}
         self.masses, self.omega_c, self.pitch_law = masses, omega_c, pitch_law
+        self.end_on_tumble = bool(end_on_tumble)
         self._model = _model if _model is not None else mj3d.build_model(self.params, masses)
         self._model.opt.timestep = self.dt
         self._model.opt.gravity[:] = (0.0, 0.0, -self.params.gravity)
@@ -181,7 +195,8 @@ class Flight3D(StepCounter):
         self._data.qpos[self._root_q : self._root_q + 3] = self.start_m
         net = self.network
         self._batch = Batch(self._model, [self._data], self._task, net, dt_s=self.dt,
-                            records=new_record(1, self._n_rows), base=None if net else self.command.as_array())
+                            records=new_record(1, self._n_rows), base=None if net else self.command.as_array(),
+                            tumble_rad=TUMBLE_RAD if self.end_on_tumble else math.inf)
         self._task = self._batch.tasks[0]
         self._rec = self._batch.records[0]
         self._diverged = ""
@@ -281,6 +296,41 @@ class Flight3D(StepCounter):
                 self._diverged = f"the 3D flight diverged: its speed ran away above {RUNAWAY_M_S:g} m/s;"
             self._diverged += f" (step {self._k}, t = {self.time:.4f} s)"
         self._check_alive()
+
+    def decide(self, action=None, *, max_steps: int | None = None) -> np.ndarray:
+        """Fly on to the controller's next decision with ``action`` taken now: the nine actions
+        (:data:`~lifelike_mj.butterfly.flight3d.controllers.ACTION_NAMES`, each in ``[-1, 1]``) of a policy of your
+        own in place of the network's (the task's flutter is added to them as to the network's). The flight then
+        goes on, as the compiled loop flies it, to the next step at which the network would run (every
+        ``every`` steps of the controller), or until it ends (a tumble: :attr:`tumbled`) or has flown
+        ``max_steps`` steps. ``action=None``: take no action, only observe (at the start). Returns the
+        observation there (:data:`~lifelike_mj.butterfly.flight3d.controllers.OBS_NAMES`, SI units). A runaway
+        raises :class:`~lifelike_mj.errors.Diverged`. This is the step of the Gymnasium environment
+        ``lifelike_mj/ButterflyFlight3D-v0``; :attr:`reward` sums the same rewards as the evolution's."""
+        if self.network is None:
+            raise UserError("decide needs a 3D controller (its base command, scales and rate); give one to Flight3D.")
+        self._check_alive()
+        if action is not None:
+            from lifelike_mj.butterfly.flight3d.controllers import N_ACT
+
+            a = np.asarray(action, dtype=np.float64).reshape(-1)
+            if a.shape != (N_ACT,) or not np.isfinite(a).all():
+                raise UserError(f"an action is {N_ACT} finite numbers in [-1, 1], got {action!r}.")
+            action = np.clip(a, -1.0, 1.0)[None, :]
+        limit = np.iinfo(np.int64).max if max_steps is None else checks.whole("max_steps", max_steps, 0)
+        self._batch.decide(action, limit)
+        self._k = int(self._rec[1])
+        if self._rec[R_DIVERGED] >= 0:
+            self._diverged = (f"the 3D flight diverged: its speed ran away above {RUNAWAY_M_S:g} m/s or MuJoCo found "
+                              f"its state unstable; (step {self._k}, t = {self.time:.4f} s)")
+        self._check_alive()
+        return self._batch.observations[0].copy()
+
+    @property
+    def tumbled(self) -> bool:
+        """Whether the flight ended in a tumble (a roll or pitch beyond
+        :data:`~lifelike_mj.butterfly.flight3d.loop.TUMBLE_RAD`, in flights that stop there)."""
+        return bool(self._rec[R_TUMBLED] >= 0)
 
     def _check_alive(self) -> None:
         if self._diverged:

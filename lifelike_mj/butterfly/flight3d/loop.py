@@ -226,6 +226,71 @@ def reward(obs):
 
 
 @njit(cache=True)
+def _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, path, path_every, n_path, tumble_rad):
+    """The first half of a step: the gusts advance, the air is set, the reference is taken and the observation made
+    (into ``obs``), the path sampled. Returns ``(tumbled, n_path)``: a roll or pitch beyond ``tumble_rad`` ends the
+    flight here (recorded in ``rec``)."""
+    step = int(rec[R_STEPS])
+    seed = int(task[T_SEED])
+    if task[T_GUST] > 0.0 or task[T_GUST_W] > 0.0:
+        for i in range(3):
+            sigma = task[T_GUST] if i < 2 else task[T_GUST_W]
+            rec[R_GUST + i] = ou_step(rec[R_GUST + i], sigma, task[T_GUST_TAU], dt, normal(seed, step, i))
+    for i in range(3):
+        ud[mj3d.U_AIR + i] = task[T_WIND + i] + rec[R_GUST + i]
+    heading, altitude, speed = reference(task, time[0], qpos[0:3], rec)
+    observe(qpos, qvel, heading, altitude, speed, ud[mj3d.U_AIR : mj3d.U_AIR + 3] if air_inputs else ground, obs)
+    if path_every > 0 and step % path_every == 0 and n_path < path.shape[0]:
+        path[n_path, 0] = time[0]
+        for i in range(3):
+            path[n_path, 1 + i] = qpos[i]
+        r_, p_, y_ = attitude(qpos[3:7])
+        path[n_path, 4] = r_
+        path[n_path, 5] = p_
+        path[n_path, 6] = y_
+        n_path += 1
+    if abs(obs[0]) > tumble_rad or abs(obs[1]) > tumble_rad:
+        rec[R_TUMBLED] = step
+        return True, n_path
+    return False, n_path
+
+
+@njit(cache=True)
+def _act(u, dt, every, base, scale, task, rec, ud):
+    """The action ``u`` (changed in place by the flutter, if the task has any) becomes the kinematics' new target."""
+    step = int(rec[R_STEPS])
+    if task[T_FLUTTER] > 0.0:
+        seed = int(task[T_SEED])
+        for i in range(N_ACT):
+            rec[R_FLUTTER + i] = ou_step(rec[R_FLUTTER + i], task[T_FLUTTER], task[T_FLUTTER_TAU], dt * every,
+                                         normal(seed, step, 3 + i))
+            u[i] = max(-1.0, min(1.0, u[i] + rec[R_FLUTTER + i]))
+    command(base, scale, u, ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS])
+
+
+@njit(cache=True)
+def _after(mptr, dptr, ud, qvel, time, dt, rec, obs, p, dp, ddp):
+    """The second half of a step: one ``mj_step``, the kinematics advanced exactly, the reward of the observation
+    ``obs`` added. Returns ``False`` if the flight diverged (recorded in ``rec``)."""
+    step = int(rec[R_STEPS])
+    ud[mj3d.U_T0] = time[0]
+    t0 = time[0]
+    _mj_step(_vp(mptr), _vp(dptr))
+    ud[mj3d.U_PSI0] = filter_at(ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS], ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS],
+                                ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS], ud[mj3d.U_PSI0], ud[mj3d.U_OMEGA_C], dt,
+                                p, dp, ddp)
+    for i in range(N_PARAMS):
+        ud[mj3d.U_P0 + i] = p[i]
+        ud[mj3d.U_DP0 + i] = dp[i]
+    rec[R_STEPS] = step + 1
+    if abs(time[0] - (t0 + dt)) > 0.5 * dt or not (abs(qvel[0]) + abs(qvel[1]) + abs(qvel[2]) < 1e3):
+        rec[R_DIVERGED] = step + 1
+        return False
+    rec[R_FIT] += reward(obs) * dt
+    return True
+
+
+@njit(cache=True)
 def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, base, scale, task, rec, path, path_every,
               tumble_rad, air_inputs):
     """Fly one butterfly ``n_steps`` steps from its current state: every ``every`` steps the network turns
@@ -247,55 +312,66 @@ def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, base
     p = np.empty(N_PARAMS)
     dp = np.empty(N_PARAMS)
     ddp = np.empty(N_PARAMS)
-    w_c = ud[mj3d.U_OMEGA_C]
     ground = np.zeros(3)
     n_path = 0
     for _ in range(n_steps):
         if rec[R_DIVERGED] >= 0 or rec[R_TUMBLED] >= 0:
             return
-        step = int(rec[R_STEPS])
-        seed = int(task[T_SEED])
-        if task[T_GUST] > 0.0 or task[T_GUST_W] > 0.0:
-            for i in range(3):
-                sigma = task[T_GUST] if i < 2 else task[T_GUST_W]
-                rec[R_GUST + i] = ou_step(rec[R_GUST + i], sigma, task[T_GUST_TAU], dt, normal(seed, step, i))
-        for i in range(3):
-            ud[mj3d.U_AIR + i] = task[T_WIND + i] + rec[R_GUST + i]
-        heading, altitude, speed = reference(task, time[0], qpos[0:3], rec)
-        observe(qpos, qvel, heading, altitude, speed, ud[mj3d.U_AIR : mj3d.U_AIR + 3] if air_inputs else ground, obs)
-        if path_every > 0 and step % path_every == 0 and n_path < path.shape[0]:
-            path[n_path, 0] = time[0]
-            for i in range(3):
-                path[n_path, 1 + i] = qpos[i]
-            r_, p_, y_ = attitude(qpos[3:7])
-            path[n_path, 4] = r_
-            path[n_path, 5] = p_
-            path[n_path, 6] = y_
-            n_path += 1
-        if abs(obs[0]) > tumble_rad or abs(obs[1]) > tumble_rad:
-            rec[R_TUMBLED] = step
+        tumbled, n_path = _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, path, path_every,
+                                  n_path, tumble_rad)
+        if tumbled:
             return
-        if step % every == 0 and len(weights) > 0:
+        if int(rec[R_STEPS]) % every == 0 and len(weights) > 0:
             network(layers, weights, obs, u, scratch)
-            if task[T_FLUTTER] > 0.0:
-                for i in range(N_ACT):
-                    rec[R_FLUTTER + i] = ou_step(rec[R_FLUTTER + i], task[T_FLUTTER], task[T_FLUTTER_TAU], dt * every,
-                                                 normal(seed, step, 3 + i))
-                    u[i] = max(-1.0, min(1.0, u[i] + rec[R_FLUTTER + i]))
-            command(base, scale, u, ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS])
-        ud[mj3d.U_T0] = time[0]
-        t0 = time[0]
-        _mj_step(_vp(mptr), _vp(dptr))
-        ud[mj3d.U_PSI0] = filter_at(ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS], ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS],
-                                    ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS], ud[mj3d.U_PSI0], w_c, dt, p, dp, ddp)
-        for i in range(N_PARAMS):
-            ud[mj3d.U_P0 + i] = p[i]
-            ud[mj3d.U_DP0 + i] = dp[i]
-        rec[R_STEPS] = step + 1
-        if abs(time[0] - (t0 + dt)) > 0.5 * dt or not (abs(qvel[0]) + abs(qvel[1]) + abs(qvel[2]) < 1e3):
-            rec[R_DIVERGED] = step + 1
+            _act(u, dt, every, base, scale, task, rec, ud)
+        if not _after(mptr, dptr, ud, qvel, time, dt, rec, obs, p, dp, ddp):
             return
-        rec[R_FIT] += reward(obs) * dt
+
+
+@njit(cache=True)
+def to_decision(mptr, dptr, off, nq, nv, n_max, dt, every, action, act, base, scale, task, rec, obs, tumble_rad,
+                air_inputs):
+    """Fly one butterfly to its next decision with an action from outside (a policy, not the network): with
+    ``act``, the action ``action`` (``(N_ACT,)``, in ``[-1, 1]``, the flutter added as for a network's) is taken at
+    the current step, whose observation is ``obs``; then the steps go on, as :func:`fly_steps` flies them, until the
+    next step at which the network would run (``every``), the flight ends (a tumble, a runaway) or ``n_max`` steps
+    have been flown. ``obs`` then holds that step's observation. Without ``act``: the current step's observation
+    only (at the start). Returns whether the flight goes on."""
+    ud = _f64(_ptr_at(dptr + off[_O_UD]), mj3d.N_USERDATA)
+    qpos = _f64(_ptr_at(dptr + off[_O_QPOS]), nq)
+    qvel = _f64(_ptr_at(dptr + off[_O_QVEL]), nv)
+    time = _f64(dptr + off[_O_TIME], 1)
+    p = np.empty(N_PARAMS)
+    dp = np.empty(N_PARAMS)
+    ddp = np.empty(N_PARAMS)
+    ground = np.zeros(3)
+    none = np.empty((0, 7))
+    if rec[R_DIVERGED] >= 0 or rec[R_TUMBLED] >= 0:
+        return False
+    if act:
+        u = action.copy()
+        _act(u, dt, every, base, scale, task, rec, ud)
+        if not _after(mptr, dptr, ud, qvel, time, dt, rec, obs, p, dp, ddp):
+            return False
+    while True:
+        tumbled, _ = _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, none, 0, 0, tumble_rad)
+        if tumbled:
+            return False
+        step = int(rec[R_STEPS])
+        if step >= n_max or step % every == 0:
+            return True
+        if not _after(mptr, dptr, ud, qvel, time, dt, rec, obs, p, dp, ddp):
+            return False
+
+
+@njit(cache=True, parallel=True)
+def to_decisions(mptr, dptrs, off, nq, nv, n_max, dt, every, actions, act, base, scale, tasks, recs, obs, tumble_rad,
+                 air_inputs, going):
+    """:func:`to_decision` for many butterflies at once, one action row each (threads over the copies); copies with
+    ``act[i]`` false only observe. ``going[i]``: whether copy ``i`` goes on."""
+    for i in prange(len(dptrs)):
+        going[i] = to_decision(mptr, dptrs[i], off, nq, nv, n_max, dt, every, actions[i], act[i], base, scale,
+                               tasks[i], recs[i], obs[i], tumble_rad, air_inputs)
 
 
 @njit(cache=True, parallel=True)
@@ -330,6 +406,8 @@ class Batch:
         self.records = records
         self.dt, self.tumble_rad = float(dt_s), float(tumble_rad)
         self.ptrs = np.array([d._address for d in self.datas], dtype=np.int64)
+        #: Each butterfly's observation at its last decision (:meth:`decide`; ``OBS_NAMES``, SI units).
+        self.observations = np.zeros((self.n, N_OBS))
         if controller is None:
             self.layers, self.scale, self.every, self.air_inputs = np.zeros(1, dtype=np.int64), np.zeros(N_ACT), 1, False
             self.weights = np.zeros((self.n, 0))
@@ -359,6 +437,30 @@ class Batch:
                 fly_batch(m._address, self.ptrs, mjabi.offsets_tuple(), m.nq, m.nv, n_steps, self.dt, self.every,
                           self.layers, self.weights, self.base, self.scale, self.tasks, self.records, self.tumble_rad,
                           self.air_inputs)
+
+    def decide(self, actions: np.ndarray | None, n_max: int, act: np.ndarray | None = None) -> np.ndarray:
+        """Fly every butterfly to its next decision (:func:`to_decision`) with ``actions`` (one row of ``N_ACT``
+        numbers in ``[-1, 1]`` per butterfly, from outside, taken now) or, with ``None``, only observe the current
+        step; ``act`` (a mask): which butterflies act (the others only observe). The observations are then in
+        :attr:`observations`; returns whether each flight goes on."""
+        from lifelike_mj.physics.callbacks import passive_callback
+        from lifelike_mj.physics.stability import watching
+
+        m = self.model
+        act = np.full(self.n, actions is not None) if act is None else np.asarray(act, dtype=np.bool_) & (
+            actions is not None)
+        a = np.zeros((self.n, N_ACT)) if actions is None else np.ascontiguousarray(actions, dtype=np.float64)
+        going = np.zeros(self.n, dtype=np.bool_)
+        with passive_callback(mj3d.COMPILED_PASSIVE), watching():
+            if self.n == 1:
+                going[0] = to_decision(m._address, int(self.ptrs[0]), mjabi.offsets_tuple(), m.nq, m.nv, int(n_max),
+                                       self.dt, self.every, a[0], bool(act[0]), self.base, self.scale, self.tasks[0],
+                                       self.records[0], self.observations[0], self.tumble_rad, self.air_inputs)
+            else:
+                to_decisions(m._address, self.ptrs, mjabi.offsets_tuple(), m.nq, m.nv, int(n_max), self.dt, self.every,
+                             a, act, self.base, self.scale, self.tasks, self.records, self.observations,
+                             self.tumble_rad, self.air_inputs, going)
+        return going
 
     def diverged(self) -> np.ndarray:
         """Indices of the butterflies whose flight diverged."""

@@ -1,0 +1,141 @@
+"""ButterflyFlight3D-v0: Gymnasium's checker, the return against the evolution's fitness, the vector form against
+single environments, rendering, and bad input."""
+
+import numpy as np
+import pytest
+
+gym = pytest.importorskip("gymnasium")
+
+import lifelike_mj.envs  # noqa: E402,F401  (registers the environments)
+from lifelike_mj.butterfly import flight3d  # noqa: E402
+from lifelike_mj.butterfly.flight3d.loop import network  # noqa: E402
+from lifelike_mj.envs.butterfly3d import (  # noqa: E402
+    TASKS,
+    ButterflyFlight3DEnv,
+    ButterflyFlight3DVectorEnv,
+    NetworkActions3D,
+    NetworkInputs3D,
+    network_controller3d,
+)
+from lifelike_mj.errors import UserError  # noqa: E402
+
+
+@pytest.mark.parametrize("task", TASKS)
+def test_gymnasiums_checker_passes(task):
+    from gymnasium.utils.env_checker import check_env
+
+    env = gym.make("lifelike_mj/ButterflyFlight3D-v0", task=task, duration_s=0.1, every=12, flutter=0.1).unwrapped
+    check_env(env, skip_render_check=True)
+    obs, info = env.reset(seed=0)
+    assert info["observation_names"] == flight3d.OBS_NAMES and env.observation_space.contains(obs)
+
+
+def _network_policy(ctl):
+    u, scratch = np.zeros(flight3d.N_ACT), np.zeros(2 * int(max(ctl.layers)))
+
+    def policy(obs):
+        network(ctl.layers, ctl.weights, obs, u, scratch)
+        return u.copy()
+
+    return policy
+
+
+@pytest.mark.parametrize("name", ["steer", "wind"])
+def test_a_shipped_controllers_return_is_its_evolution_fitness(name):
+    """Flown through the env by its own network, a shipped controller's mean return over its task set is the fitness
+    ``evolve3d`` computes for it (the wind set has gusts and wind: the env draws them as the evolution does)."""
+    ctl = flight3d.load_controller(name)
+    tasks = flight3d.TASK_SETS[name]()
+    problem = flight3d.FlightProblem3D(tuple(tasks), ctl, duration_s=4.0)
+    fitness = float(problem.evaluate(np.zeros((1, problem.dim)))[0])
+    env = gym.make("lifelike_mj/ButterflyFlight3D-v0", controller=ctl, duration_s=4.0)
+    policy = _network_policy(ctl)
+    returns = []
+    for task in tasks:
+        obs, _ = env.reset(options={"task": task})
+        total, done = 0.0, False
+        while not done:
+            obs, r, term, trunc, _ = env.step(policy(obs))
+            total, done = total + r, term or trunc
+        returns.append(total)
+    assert np.mean(returns) == pytest.approx(fitness, rel=1e-9, abs=1e-12)
+    assert fitness > 0.7  # the shipped controllers fly their tasks well: a return of 0 would not pass
+
+
+def test_the_vector_env_is_single_envs_in_one_call_bit_for_bit():
+    """Copy i of the vector env seeded s flies as a single env seeded s + i, through autoresets (NEXT_STEP)."""
+    n, kw = 3, {"task": "wind", "duration_s": 0.2, "every": 12, "flutter": 0.1}
+    env = gym.make_vec("lifelike_mj/ButterflyFlight3D-v0", num_envs=n, vectorization_mode="vector_entry_point", **kw)
+    assert isinstance(env.unwrapped, ButterflyFlight3DVectorEnv)
+    singles = [ButterflyFlight3DEnv(**kw) for _ in range(n)]
+    obs, _ = env.reset(seed=5)
+    assert np.array_equal(obs, [s.reset(seed=5 + i)[0] for i, s in enumerate(singles)])
+    actions = np.random.default_rng(0).uniform(-1.0, 1.0, (45, n, flight3d.N_ACT))
+    ended, resets = [False] * n, 0
+    for a in actions:
+        obs, rewards, term, trunc, _ = env.step(a)
+        for i, s in enumerate(singles):
+            if ended[i]:
+                (o, _), r, t, tr = s.reset(), 0.0, False, False
+                resets += 1
+            else:
+                o, r, t, tr, _ = s.step(a[i])
+            ended[i] = t or tr
+            assert np.array_equal(obs[i], o) and rewards[i] == r and (term[i], trunc[i]) == (t, tr)
+    assert resets >= n  # every copy went through an autoreset
+
+
+def test_a_trained_network_leaves_the_env_as_a_controller_file_fly3d_flies(tmp_path):
+    """A policy of NetworkInputs3D -> tanh layers -> NetworkActions3D is written out by network_controller3d; the
+    controller flies the same flight (same rewards) as the policy in the env."""
+    rng = np.random.default_rng(3)
+    shapes = [(16, 10), (9, 16)]
+    layers = [(0.3 * rng.standard_normal(s), 0.1 * rng.standard_normal(s[0])) for s in shapes]
+
+    def policy(x):  # numpy stand-in for a trained torch actor: tanh hidden layer, linear mean
+        h = np.tanh(layers[0][0] @ x + layers[0][1])
+        return layers[1][0] @ h + layers[1][1]
+
+    env = NetworkActions3D(NetworkInputs3D(ButterflyFlight3DEnv(task="turn", duration_s=1.0, every=12)))
+    obs, _ = env.reset(seed=2)
+    total, done = 0.0, False
+    while not done:
+        obs, r, term, trunc, _ = env.step(policy(obs))
+        total, done = total + r, term or trunc
+    ctl = network_controller3d(layers, env.unwrapped.controller)
+    path = tmp_path / "rl.json"
+    from lifelike_mj.io import write_json
+
+    write_json(path, ctl.to_dict())
+    flight = flight3d.Flight3D(controller=str(path), task=env.unwrapped.episode_task, end_on_tumble=True)
+    flight.step(1200)
+    assert flight.reward == pytest.approx(total * 1.0, rel=1e-12)
+
+
+def test_rgb_array_draws_the_butterfly():
+    env = gym.make("lifelike_mj/ButterflyFlight3D-v0", render_mode="rgb_array", width=160, height=120)
+    env.reset(seed=0)
+    env.step(np.zeros(flight3d.N_ACT))
+    img = env.render()
+    assert img.shape == (120, 160, 3) and img.dtype == np.uint8
+    centre = img[40:80, 50:110].reshape(-1, 3).astype(int)
+    assert (np.abs(centre - np.median(centre, axis=0)).sum(axis=1) > 60).mean() > 0.01  # the wings stand out
+    env.close()
+
+
+@pytest.mark.parametrize("kw", [{"task": "swim"}, {"speed_m_s": 0}, {"duration_s": -1}, {"render_mode": "movie"},
+                                {"controller": "no_such"}, {"every": 0}, {"inputs": "water"}, {"flutter": 2},
+                                {"task": [flight3d.course(1, 11)]}])
+def test_bad_arguments_are_one_sentence(kw):
+    with pytest.raises(UserError):
+        ButterflyFlight3DEnv(**kw)
+
+
+def test_bad_actions_are_one_sentence():
+    env = ButterflyFlight3DEnv(duration_s=0.1)
+    env.reset(seed=0)
+    for bad in (np.zeros(8), np.full(9, np.nan), np.array(["a"] * 9)):
+        with pytest.raises(UserError, match="an action is 9 finite numbers"):
+            env.step(bad)
+    with pytest.raises(UserError, match="unknown reset option"):
+        env.reset(options={"tasks": "level"})
