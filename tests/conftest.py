@@ -231,3 +231,13 @@ def other_process():
     o = _OtherProcess()
     yield o
     o.close()
+
+
+@pytest.fixture(scope="session")
+def local_ray():
+    """A local Ray cluster of 2 CPUs for the whole session (starting one takes about 20 s), shut down at its end."""
+    ray = pytest.importorskip("ray")
+    if not ray.is_initialized():
+        ray.init(num_cpus=2, include_dashboard=False)
+    yield ray
+    ray.shutdown()

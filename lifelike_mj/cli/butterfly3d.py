@@ -5,7 +5,19 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from lifelike_mj.cli.common import add_json, add_overwrite, add_run_files, add_seed, add_wind, check_outputs, count, emit, num
+from lifelike_mj.cli.common import (
+    add_executor,
+    add_json,
+    add_overwrite,
+    add_run_files,
+    add_seed,
+    add_wind,
+    check_executor,
+    check_outputs,
+    count,
+    emit,
+    num,
+)
 from lifelike_mj.errors import UserError
 from lifelike_mj.progress import stage
 
@@ -66,6 +78,7 @@ def cmd_evolve3d(args) -> None:
     from lifelike_mj.butterfly.flight3d.controllers import load_controller
     from lifelike_mj.butterfly.flight3d.evolution import TASK_SETS, evolve
 
+    check_executor(args)
     layers = [10, *args.hidden, 9]
     start = load_controller(args.start) if args.start else None
     if start is not None and args.hidden:
@@ -75,7 +88,7 @@ def cmd_evolve3d(args) -> None:
                        population=args.population, generations=args.generations, duration_s=args.duration,
                        checkpoint=args.checkpoint, resume=args.resume, progress=not args.quiet,
                        overwrite=args.overwrite, task_set=args.tasks, start=start, gene_bound=args.gene_bound,
-                       inputs=args.inputs)
+                       inputs=args.inputs, executor=args.executor, workers=args.workers, ray_address=args.ray_address)
     if ctrl is None:
         raise KeyboardInterrupt("stopped before the first generation was evaluated; nothing was written")
     state = "stopped early (Ctrl-C); best so far" if res.interrupted else "done"
@@ -221,6 +234,7 @@ def add_commands(bf) -> None:
     p.add_argument("--generations", type=count(1, 1_000_000), default=300, help="generations")
     p.add_argument("--duration", type=num(0, 60, lo_open=True, unit="s"), default=4.0,
                    help="seconds of each training flight")
+    add_executor(p, "serial", "this process, which flies a generation on every core")
     add_seed(p)
     add_run_files(p, "controller file to write (.json)")
     add_json(p)

@@ -151,10 +151,11 @@ def seeds(text: str, what: str = "--seeds", limit: int | None = None) -> list[in
     return list(range(ends[0], ends[1] + 1)) if "-" in text else ends
 
 
-def add_executor(p: argparse.ArgumentParser) -> None:
-    """``--executor``, ``--workers``, ``--ray-address`` (checked together by :func:`check_executor`)."""
-    p.add_argument("--executor", default="process", choices=("serial", "process", "ray"),
-                   help="where candidates are evaluated: serial (this process), process (a pool on this machine) or ray")
+def add_executor(p: argparse.ArgumentParser, default: str = "process", serial: str = "this process") -> None:
+    """``--executor``, ``--workers``, ``--ray-address`` (checked together by :func:`check_executor`); ``serial``: what
+    the serial executor is, in the help."""
+    p.add_argument("--executor", default=default, choices=("serial", "process", "ray"),
+                   help=f"where candidates are evaluated: serial ({serial}), process (a pool on this machine) or ray")
     p.add_argument("--workers", type=count(1, 1024), default=None,
                    help="worker processes (process) or chunks per batch (ray), 1 to 1024 (default: all cores)")
     p.add_argument("--ray-address", default=None,

@@ -373,19 +373,14 @@ def test_process_evaluator_matches_serial():
             _same(_run(p, name, evaluator=q), _run(p, name, evaluator=s))
 
 
-def test_ray_evaluator_matches_serial():
-    ray = pytest.importorskip("ray")
+def test_ray_evaluator_matches_serial(local_ray):
     p = Rastrigin(dim=3)
-    ray.init(num_cpus=2, include_dashboard=False)
-    try:
-        with make_evaluator(p, "ray", workers=2) as r:
-            X = np.random.default_rng(1).uniform(-2, 2, (5, 3))
-            assert r(X).tobytes() == p.evaluate(X).tobytes()
-            for name in ("rcga", "cmaes"):
-                _same(_run(p, name, evaluator=r), _run(p, name))
-        assert ray.is_initialized()  # the evaluator leaves a cluster it did not start
-    finally:
-        ray.shutdown()
+    with make_evaluator(p, "ray", workers=2) as r:
+        X = np.random.default_rng(1).uniform(-2, 2, (5, 3))
+        assert r(X).tobytes() == p.evaluate(X).tobytes()
+        for name in ("rcga", "cmaes"):
+            _same(_run(p, name, evaluator=r), _run(p, name))
+    assert local_ray.is_initialized()  # the evaluator leaves a cluster it did not start
 
 
 def test_ray_missing_is_a_user_error(monkeypatch):

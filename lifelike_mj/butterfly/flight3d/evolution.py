@@ -166,15 +166,21 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
            layers=(10, 9), population: int | None = 16, generations: int = 300, duration_s: float = 4.0,
            gene_bound: float = 0.4, checkpoint: str | Path | None = None, resume: bool = False, progress: bool = True,
            overwrite: bool = False, task_set: str = "custom", on_generation=None, start: c3.Controller3D | None = None,
-           inputs: str | None = None):
+           inputs: str | None = None, executor: str = "serial", workers: int | None = None,
+           ray_address: str | None = None):
     """Evolve a 3D controller on ``tasks`` (default: the ``steer`` set) with ``optimizer`` and write it to
     ``out`` with its provenance (the problem, the optimiser, the budget, the time it took, the fitness
     history). Returns ``(result, controller)``; nothing is overwritten unasked (the checks and locks of the
     planar ``butterfly evolve``). ``start``: a controller to start from (its network, base and scales; the genes
     are then changes of its weights and ``layers`` is ignored), recorded in the provenance. ``inputs``: what the
-    network's speeds are measured against (``"ground"`` or ``"air"``; default: the start's, else the ground)."""
+    network's speeds are measured against (``"ground"`` or ``"air"``; default: the start's, else the ground).
+    ``executor``: where a generation's flights run, as for the planar evolution
+    (:func:`~lifelike_mj.evolve.make_evaluator`): ``"serial"`` (this process, which flies the whole generation on
+    every core: the fastest on one machine), ``"process"`` (a pool of ``workers`` processes, one thread each) or
+    ``"ray"`` (a Ray cluster, ``ray_address`` to join one). Every executor gives the same result for the same
+    seed, bit for bit: each flight is independent of how the generation is split."""
     from lifelike_mj import provenance as _prov
-    from lifelike_mj.evolve import optimize
+    from lifelike_mj.evolve import make_evaluator, optimize
     from lifelike_mj.evolve.checkpoint import guarded_run_files
     from lifelike_mj.io import write_json
     from lifelike_mj.machine import machine_info
@@ -194,9 +200,10 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     problem = FlightProblem3D(tuple(tasks), template, duration_s=duration_s, gene_bound=gene_bound)
     out = Path(out)
     with guarded_run_files(out, checkpoint, resume=resume, overwrite=overwrite) as ckpt:
-        res = optimize(problem, optimizer, seed=seed, population=population, generations=generations,
-                       checkpoint=ckpt, resume=resume, progress=progress, overwrite=overwrite,
-                       on_generation=on_generation)
+        with make_evaluator(problem, executor=executor, workers=workers, ray_address=ray_address) as ev:
+            res = optimize(problem, optimizer, seed=seed, population=population, generations=generations,
+                           evaluator=ev, checkpoint=ckpt, resume=resume, progress=progress, overwrite=overwrite,
+                           on_generation=on_generation)
         if not np.all(np.isfinite(res.best_x)):
             return res, None
         prov = _prov.provenance(task_set=task_set, optimizer=res.optimizer, seed=res.seed, population=res.population,
@@ -205,7 +212,7 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
                      "problem_fingerprint": problem.fingerprint(), "generations_done": res.generations,
                      "evaluations_done": res.evaluations, "best_fitness": float(res.best_f),
                      "interrupted": bool(res.interrupted), "resumed": bool(res.resumed),
-                     "evolution_wall_time_s": float(res.wall_time_s),
+                     "evolution_wall_time_s": float(res.wall_time_s), "executor": executor,
                      "machine": machine_info(),
                      "started_from": None if start is None else {
                          "name": start.name, **{k: v for k, v in start.provenance.items() if k != "fitness_history"}},
