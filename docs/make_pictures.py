@@ -1,4 +1,5 @@
-"""Make the pictures at the top of the README (docs/figures/readme_*.{gif,png}) through the public API.
+"""Make the pictures at the top of the README (docs/figures/readme_*.{gif,png}) and of the environments' pages
+(docs/figures/env_*.png) through the public API.
 
     python docs/make_pictures.py
 """
@@ -21,7 +22,37 @@ def main() -> None:
     flock = boids.Flock(boids.load_preset("4c"), n=300, seed=0)
     flock.step(3000)
     boids.render.frame_png(OUT / "readme_boids.png", flock, width=320, height=240)
-    print("wrote", ", ".join(p.name for p in sorted(OUT.glob("readme_*"))))
+    envs()
+    print("wrote", ", ".join(p.name for p in sorted([*OUT.glob("readme_*"), *OUT.glob("env_*")])))
+
+
+def envs() -> None:
+    """A frame of each environment's ``rgb_array`` rendering, flown by a shipped controller as a policy."""
+    import gymnasium as gym
+    import numpy as np
+
+    import lifelike_mj.envs  # noqa: F401  (registers the environments)
+    from lifelike_mj.butterfly import flight3d
+    from lifelike_mj.butterfly.flight3d.loop import network
+    from lifelike_mj.envs.policies import controller_policy
+    from lifelike_mj.render.video import write_png
+
+    env = gym.make("lifelike_mj/ButterflyPitch-v0", backend="mujoco", action_mode="phi", render_mode="rgb_array",
+                   width=480, height=320)
+    policy = controller_policy("ann_paper", env.unwrapped)
+    obs, _ = env.reset(seed=0)
+    for _ in range(6000):  # 5 s: settled flight
+        obs, *_ = env.step(policy(obs))
+    write_png(OUT / "env_butterfly_pitch.png", env.render())
+    ctl = flight3d.load_controller("steer")
+    env = gym.make("lifelike_mj/ButterflyFlight3D-v0", controller=ctl, task="turn", duration_s=10.0,
+                   render_mode="rgb_array", width=480, height=320)
+    obs, _ = env.reset(seed=0)
+    u, scratch = np.zeros(flight3d.N_ACT), np.zeros(64)
+    for _ in range(int(round(2.6 / flight3d.DT_S))):  # in the turn
+        network(ctl.layers, ctl.weights, obs, u, scratch)
+        obs, *_ = env.step(u.copy())
+    write_png(OUT / "env_butterfly_flight3d.png", env.render())
 
 
 if __name__ == "__main__":

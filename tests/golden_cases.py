@@ -6,7 +6,8 @@ factors, dates), plus a SHA-256 of every array in every ``.npz`` it writes and o
 every controller file it writes. ``tests/data/golden_cli.json`` holds the records made by
 ``python tests/golden_cases.py record`` on version 0.1.0 before the library reorganisation (issue
 12), and the 3D butterfly's cases (``fly3d_*``, ``evolve3d_*``, ``assess3d_*``) on commit 0e7f3e6, before the 3D
-flight became a slice of its own (issue 26); ``tests/cli/test_unchanged.py`` recomputes them and compares.
+flight became a slice of its own (issue 26); they pin ``--dt 1/1200``, the default then.
+``tests/cli/test_unchanged.py`` recomputes them and compares.
 
 Run as a script::
 
@@ -63,15 +64,16 @@ CASES: dict[str, tuple[list[str], list[str]]] = {
     "evolve_mujoco": (["butterfly", "evolve", "--optimizer", "rcga", "--backend", "mujoco", "--population", "4",
                        "--generations", "2", "--executor", "serial", "--quiet", "--out", "{out}/mj.json"], ["mj.json"]),
     "fly3d_steer_turn": (["butterfly", "fly3d", "--controller", "steer", "--task", "turn", "--angle", "-90",
-                          "--duration", "4", "--out", "{out}"], ["path.npz"]),
+                          "--duration", "4", "--dt", "1/1200", "--out", "{out}"], ["path.npz"]),
     "fly3d_wind_course": (["butterfly", "fly3d", "--controller", "wind", "--task", "course", "--seed", "3",
-                           "--wind-to", "1,0.5,0", "--gusts", "0.5", "--flutter", "0.1", "--duration", "4", "--out",
-                           "{out}"], ["path.npz"]),
-    "fly3d_cruise_level": (["butterfly", "fly3d", "--controller", "cruise", "--speed", "2", "--duration", "3"], []),
+                           "--wind-to", "1,0.5,0", "--gusts", "0.5", "--flutter", "0.1", "--duration", "4", "--dt",
+                           "1/1200", "--out", "{out}"], ["path.npz"]),
+    "fly3d_cruise_level": (["butterfly", "fly3d", "--controller", "cruise", "--speed", "2", "--duration", "3", "--dt",
+                            "1/1200"], []),
     "evolve3d_cmaes": (["butterfly", "evolve3d", "--population", "4", "--generations", "2", "--duration", "0.5",
-                        "--quiet", "--out", "{out}/c3.json"], ["c3.json"]),
+                        "--dt", "1/1200", "--quiet", "--out", "{out}/c3.json"], ["c3.json"]),
     "assess3d_wind": (["butterfly", "assess3d", "--controller", "wind", "--duration", "6", "--courses", "100",
-                       "--gusts", "0.3"], []),
+                       "--gusts", "0.3", "--dt", "1/1200"], []),
     "fish_swim": (["fish", "swim", "--fish", "5", "--duration", "4", "--out", "{out}"], ["tracks.npz"]),
     "fish_swim_nbnd": (["fish", "swim", "--preset", "NB-ND", "--fish", "3", "--duration", "3", "--seed", "2",
                         "--tank-scale", "0.5"], []),

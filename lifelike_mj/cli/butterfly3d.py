@@ -50,9 +50,9 @@ def cmd_fly3d(args) -> None:
 
     ctrl = load_controller(args.controller)
     check_outputs(args, folders={"--out": FLY3D_FILES})
-    flight = Flight3D(controller=ctrl, task=_task(args))
+    flight = Flight3D(controller=ctrl, task=_task(args), dt_s=args.dt)
     with stage(f"3D flight, {args.duration:g} s"):
-        rec = flight.record(duration_s=args.duration, every=12)
+        rec = flight.record(duration_s=args.duration, every=max(1, round(0.01 / args.dt)))  # every 10 ms
     pos, att = rec["position_m"], rec["attitude_rad"]
     s = {"controller": ctrl.name or args.controller, "task": flight.task.name, "duration_s": float(rec["t_s"][-1]),
          "end_m": [float(v) for v in pos[-1]], "distance_m": float(np.linalg.norm(pos[-1, :2] - pos[0, :2])),
@@ -88,7 +88,8 @@ def cmd_evolve3d(args) -> None:
                        population=args.population, generations=args.generations, duration_s=args.duration,
                        checkpoint=args.checkpoint, resume=args.resume, progress=not args.quiet,
                        overwrite=args.overwrite, task_set=args.tasks, start=start, gene_bound=args.gene_bound,
-                       inputs=args.inputs, executor=args.executor, workers=args.workers, ray_address=args.ray_address)
+                       inputs=args.inputs, executor=args.executor, workers=args.workers, ray_address=args.ray_address,
+                       dt_s=args.dt)
     if ctrl is None:
         raise KeyboardInterrupt("stopped before the first generation was evaluated; nothing was written")
     state = "stopped early (Ctrl-C); best so far" if res.interrupted else "done"
@@ -108,10 +109,10 @@ def cmd_assess3d(args) -> None:
                  "it measures the speed each second after settling")
     ctrl = load_controller(args.controller)
     with stage("level flight, turns of 90 and 180 deg, courses"):
-        level = level_check(ctrl, args.speed, args.duration, LEVEL_SETTLE_S)
-        turns = [turn_check(ctrl, a, speed_m_s=args.speed) for a in (90.0, -90.0, 180.0)]
+        level = level_check(ctrl, args.speed, args.duration, LEVEL_SETTLE_S, dt_s=args.dt)
+        turns = [turn_check(ctrl, a, speed_m_s=args.speed, dt_s=args.dt) for a in (90.0, -90.0, 180.0)]
         weather = {"wind_to_m_s": args.wind, "gust_m_s": args.gusts, "gust_vertical_m_s": args.vertical_gusts}
-        courses = [course_check(ctrl, s, weather=weather) for s in args.courses]
+        courses = [course_check(ctrl, s, weather=weather, dt_s=args.dt) for s in args.courses]
     d = {"controller": ctrl.name or args.controller, "level": level, "turns": turns, "courses": courses,
          "course_weather": weather}
     human = (f"level {level['duration_s']:.0f} s at {args.speed:g} m/s: speed [{level['speed_min_m_s']:.2f}, "
@@ -129,18 +130,17 @@ def cmd_garden(args) -> None:
 
     from lifelike_mj import checks
     from lifelike_mj.butterfly.flight3d.controllers import load_controller
-    from lifelike_mj.butterfly.flight3d.flight import DT_S
     from lifelike_mj.butterfly.flight3d.garden import Garden, film_garden
 
     checks.work(f"a garden of {args.n} butterflies for {args.duration:g} s",
-                args.n * checks.steps_of(args.duration, DT_S), checks.MAX_BODY_STEPS, "butterfly-steps")
+                args.n * checks.steps_of(args.duration, args.dt), checks.MAX_BODY_STEPS, "butterfly-steps")
     if args.out:
         checks.work(f"a video of {args.duration:g} s at {args.fps} frames/s", checks.steps_of(args.duration, 1 / args.fps),
                     checks.MAX_FRAMES, "frames", "a shorter garden or fewer frames per second")
     ctrl = load_controller(args.controller)
     check_outputs(args, files={"--out": (".mp4", ".gif"), "--paths": (".png",)})
     garden = Garden(args.n, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_to_m_s=args.wind,
-                    gust_vertical_m_s=args.vertical_gusts)
+                    gust_vertical_m_s=args.vertical_gusts, dt_s=args.dt)
     d: dict = {"butterflies": args.n, "seed": args.seed, "controller": ctrl.name or args.controller}
     if args.paths:
         garden.track = []  # the positions at every frame, or every 0.02 s without a video
@@ -178,6 +178,17 @@ def _add_weather(p, what: str, seed: str) -> None:
                         "Dryden model gives half)")
 
 
+def _add_dt(p, fine: bool = False) -> None:
+    """``--dt``: the 3D flight's time step (``fine``: default 1/1200 s, for exports, whose keys sample every step and
+    whose loops end on a step)."""
+    from lifelike_mj.butterfly.flight3d.flight import DT_FINE_S, DT_S
+
+    p.add_argument("--dt", type=num(1e-5, 1.0 / 80.0, unit="s"), default=DT_FINE_S if fine else DT_S,
+                   help="time step, s (1/1200 is the step the shipped controllers were evolved at; at most 1/8 of a "
+                        "wing beat)" + ("; an export keeps 1/1200 by default, so that its keys and a loop's seam "
+                                        "follow the wings closely" if fine else ""))
+
+
 def _seeds(text: str) -> list[int]:
     from lifelike_mj.cli.common import seeds
 
@@ -212,6 +223,7 @@ def add_commands(bf) -> None:
     p.add_argument("--flutter", type=num(0, 1), default=0.0, help="the butterfly's flutter, 0 to 1 (drawn from --seed)")
     p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=20.0,
                    help=f"seconds of flight, at most {MAX_DURATION_S:g}")
+    _add_dt(p)
     p.add_argument("--out", help="folder for path.npz/.csv, paths.png (top and side views), summary.json")
     add_overwrite(p)
     add_json(p)
@@ -234,6 +246,7 @@ def add_commands(bf) -> None:
     p.add_argument("--generations", type=count(1, 1_000_000), default=300, help="generations")
     p.add_argument("--duration", type=num(0, 60, lo_open=True, unit="s"), default=4.0,
                    help="seconds of each training flight")
+    _add_dt(p)
     add_executor(p, "serial", "this process, which flies a generation on every core")
     add_seed(p)
     add_run_files(p, "controller file to write (.json)")
@@ -246,6 +259,7 @@ def add_commands(bf) -> None:
     p.add_argument("--flutter", type=num(0, 1), default=0.1, help="each butterfly's flutter, 0 to 1")
     _add_weather(p, "", "each butterfly's seed")
     p.add_argument("--duration", type=num(0, 600, lo_open=True, unit="s"), default=10.0, help="seconds of flight")
+    _add_dt(p)
     p.add_argument("--out", default=None, help="video file (.mp4 or .gif)")
     p.add_argument("--camera", default="overview", choices=("overview", "chase"), help="overview (fixed) or chase")
     p.add_argument("--fps", type=count(1, 240), default=30, help="frames per second")
@@ -262,6 +276,7 @@ def add_commands(bf) -> None:
                    help="seconds of level flight")
     p.add_argument("--courses", type=_seeds, default=[100, 101, 102], help="course seeds, e.g. 100-104")
     _add_weather(p, "the courses' ", "each course's seed")
+    _add_dt(p)
     add_json(p)
     p.set_defaults(func=cmd_assess3d)
 
@@ -292,6 +307,7 @@ def add_export_args(p: argparse.ArgumentParser) -> None:
     add_seed(p)
     _add_weather(p, "", "--seed")
     p.add_argument("--flutter", type=num(0, 1), default=0.0, help="the butterfly's flutter, 0 to 1 (drawn from --seed)")
+    _add_dt(p, fine=True)
     add_window(p, MAX_DURATION_S, 5.0)
 
 
@@ -299,20 +315,19 @@ def export_window(args):
     """The run to export, built and checked, not yet simulated (:class:`~lifelike_mj.cli.export.Window`), and the
     parameters that make it."""
     from lifelike_mj.butterfly.flight3d.controllers import load_controller
-    from lifelike_mj.butterfly.flight3d.flight import DT_S
     from lifelike_mj.cli.export import Window, check_window, parameters_of
 
-    check_window(args.start, args.duration, args.fps, DT_S, bodies=args.garden or 1)
+    check_window(args.start, args.duration, args.fps, args.dt, bodies=args.garden or 1)
     ctrl = load_controller(args.controller)
     if args.garden:
         from lifelike_mj.butterfly.flight3d.garden import Garden
 
         sim = Garden(args.garden, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_to_m_s=args.wind,
-                     gust_vertical_m_s=args.vertical_gusts)
+                     gust_vertical_m_s=args.vertical_gusts, dt_s=args.dt)
     else:
         from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
-        sim = Flight3D(controller=ctrl, task=_task(args))
+        sim = Flight3D(controller=ctrl, task=_task(args), dt_s=args.dt)
     return Window(sim, args.start, args.duration, args.fps), parameters_of(args)
 
 

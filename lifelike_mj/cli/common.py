@@ -51,13 +51,18 @@ class Parser(argparse.ArgumentParser):
 
 def num(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False, unit: str = ""):
     """An argparse ``type``: a finite number in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``); the range
-    is in the error sentence. Numbers like ``1e3`` and negative values (``-2``) are accepted."""
+    is in the error sentence. Numbers like ``1e3``, negative values (``-2``) and fractions (``1/1200``, as
+    ``1.0 / 1200``) are accepted."""
     from lifelike_mj import checks
 
     def parse(text: str) -> float:
         try:
-            v = float(text)
-        except ValueError:
+            if "/" in text:
+                a, b = text.split("/")
+                v = float(a) / float(b)
+            else:
+                v = float(text)
+        except (ValueError, ZeroDivisionError):
             raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
         try:
             return checks.number("the value", v, lo, hi, lo_open=lo_open, unit=unit)

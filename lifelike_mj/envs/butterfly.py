@@ -67,6 +67,15 @@ def check_options(options: Any, known) -> None:
     check_names(options, known, "unknown reset option")
 
 
+def copy_rngs(seed: int | list[int], n: int) -> list[np.random.Generator]:
+    """The random generators of a vector environment's ``n`` copies from ``reset(seed=...)``: copy ``i`` seeded
+    ``seed + i`` (as a single environment reset with that seed), or one seed per copy from a list."""
+    seeds = list(seed) if isinstance(seed, (list, tuple)) else [int(seed) + i for i in range(n)]
+    if len(seeds) != n:
+        raise UserError(f"give one seed or {n} seeds, got {len(seeds)}.")
+    return [gym.utils.seeding.np_random(sd)[0] for sd in seeds]
+
+
 def check_actions(actions: Any, n: int) -> np.ndarray:
     """``n`` actions as a float64 array of shape ``(n,)``: accepted as shape ``(n,)`` or ``(n, 1)`` (one per copy),
     or, for ``n = 1``, a scalar; real numbers only (no bools, strings or objects), finite. Anything else is a

@@ -15,7 +15,7 @@ from gymnasium.vector.utils import batch_space
 from lifelike_mj import checks
 from lifelike_mj.butterfly import flight3d
 from lifelike_mj.butterfly.params import ButterflyParams
-from lifelike_mj.envs.butterfly import check_options
+from lifelike_mj.envs.butterfly import check_options, copy_rngs
 from lifelike_mj.errors import Diverged, UserError
 
 #: The tasks an episode can fly (``task=``), besides a :class:`~lifelike_mj.butterfly.flight3d.Task3D` of your own.
@@ -225,7 +225,7 @@ class ButterflyFlight3DEnv(gym.Env):
 
         if self._renderer is None:
             self._renderer = Offscreen(f.model, self.width, self.height)
-        self._renderer.update(f.model, f.data, camera.tracking(int(f.model.body("butterfly").id), 0.5, 150.0, -20.0))
+        self._renderer.update(f.model, f.data, camera.tracking(int(f.model.body("butterfly").id), 0.3, 150.0, -20.0))
         return self._renderer.draw()
 
     def close(self) -> None:
@@ -317,10 +317,7 @@ class ButterflyFlight3DVectorEnv(VectorEnv):
     def reset(self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None):
         check_options(options, RESET_OPTIONS)
         if seed is not None:
-            seeds = list(seed) if isinstance(seed, (list, tuple)) else [int(seed) + i for i in range(self.num_envs)]
-            if len(seeds) != self.num_envs:
-                raise UserError(f"give one seed or {self.num_envs} seeds, got {len(seeds)}.")
-            self._rngs = [gym.utils.seeding.np_random(sd)[0] for sd in seeds]
+            self._rngs = copy_rngs(seed, self.num_envs)
         chosen = (options or {}).get("task")
         task = self.single.task if chosen is None else self.single._check_task(chosen)
         s = self.single

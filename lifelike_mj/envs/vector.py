@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import gymnasium as gym
 import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
@@ -21,6 +20,7 @@ from lifelike_mj.envs.butterfly import (
     as_condition,
     check_actions,
     check_options,
+    copy_rngs,
 )
 from lifelike_mj.errors import UserError
 
@@ -226,10 +226,7 @@ class ButterflyPitchVectorEnv(VectorEnv):
     def reset(self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None):
         check_options(options, RESET_OPTIONS)
         if seed is not None:
-            seeds = list(seed) if isinstance(seed, (list, tuple)) else [int(seed) + i for i in range(self.num_envs)]
-            if len(seeds) != self.num_envs:
-                raise UserError(f"give one seed or {self.num_envs} seeds, got {len(seeds)}.")
-            self._rngs = [gym.utils.seeding.np_random(sd)[0] for sd in seeds]
+            self._rngs = copy_rngs(seed, self.num_envs)
         chosen = (options or {}).get("conditions")
         if chosen is not None:
             chosen = [as_condition(c) for c in chosen]

@@ -129,7 +129,7 @@ CASES = [
     (["butterfly", "trim", "--dt", "1.6e-6"], "asks for 1,037,500,000 time steps; at most 1,000,000,000", {}),
     (["butterfly", "evolve", "--optimizer", "rcga", "--population", "100", "--generations", "416667", "--executor",
       "serial"], "asks for 1,000,000,800,000 steps; at most 1,000,000,000,000", {}),
-    (["butterfly", "evolve3d", "--population", "100", "--generations", "520834"],
+    (["butterfly", "evolve3d", "--population", "100", "--generations", "781251"],
      "asks for 1,000,001,280,000 steps; at most 1,000,000,000,000", {}),
     (["butterfly", "garden", "--duration", "600", "--fps", "61", "--out", "g.mp4"], "asks for 36,600 frames", {}),
     (["butterfly", "windmap", "--controller", "ann_paper", "--step", "0.01", "--max", "1.0"], "40,401 wind cells", {}),

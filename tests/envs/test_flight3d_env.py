@@ -108,7 +108,7 @@ def test_a_trained_network_leaves_the_env_as_a_controller_file_fly3d_flies(tmp_p
 
     write_json(path, ctl.to_dict())
     flight = flight3d.Flight3D(controller=str(path), task=env.unwrapped.episode_task, end_on_tumble=True)
-    flight.step(1200)
+    flight.step(round(1.0 / flight.dt))
     assert flight.reward == pytest.approx(total * 1.0, rel=1e-12)
 
 

@@ -9,6 +9,7 @@ import pytest
 from test_gltf import _blob, _khronos, _turn
 from test_rigs import world_poses
 
+from lifelike_mj.butterfly.flight3d import DT_S
 from lifelike_mj.cli import main
 
 
@@ -32,7 +33,7 @@ def test_a_level_flight_loops_at_whole_wing_beats_in_place(tmp_path, capsys):
     out, gl, info = _export(tmp_path, capsys, "butterfly3d", "--task", "level", "--start", "5", "--duration", "2")
     loop = info["loop"]
     assert loop["mode"] == "cut" and loop["beats"] >= 15
-    assert loop["span_s"] == pytest.approx(loop["beats"] * loop["period_s"], abs=1.5 / 1200)  # whole beats
+    assert loop["span_s"] == pytest.approx(loop["beats"] * loop["period_s"], abs=1.5 * DT_S)  # whole beats
     assert 1.0 / loop["period_s"] == pytest.approx(10.7, abs=1.0)  # the flap frequency
     assert np.linalg.norm(loop["root_motion_m"]) / loop["span_s"] == pytest.approx(1.5, rel=0.2)  # its speed
     m, deg = _seam_in_file(gl, info)

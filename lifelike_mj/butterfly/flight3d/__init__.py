@@ -6,13 +6,13 @@ Fly one::
     from lifelike_mj.butterfly import flight3d
 
     flight = flight3d.Flight3D(controller="steer", task=flight3d.turn(90.0))
-    flight.step(6000)                                # 5 s at the default time step
+    flight.step(4000)                                # 5 s at the default time step, 1/800 s
     print(flight.state()["position_m"])              # x forward at the start, y left, z up (m)
 
 A garden of butterflies visiting flowers::
 
     garden = flight3d.Garden(20, "steer", seed=1)
-    garden.step(1200)
+    garden.step(800)                                 # one second
 
 Evolve a controller of your own (``lifelike-mj butterfly evolve3d`` does the same)::
 
@@ -47,7 +47,7 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "OBS_NAMES": "controllers", "ACTION_NAMES": "controllers", "N_OBS": "controllers", "N_ACT": "controllers",
     "n_weights": "controllers",
     "Batch": "loop", "TUMBLE_RAD": "loop",
-    "Flight3D": "flight", "DT_S": "flight", "STATE_UNITS": "flight", "euler_from_quat": "flight",
+    "Flight3D": "flight", "DT_S": "flight", "DT_FINE_S": "flight", "STATE_UNITS": "flight", "euler_from_quat": "flight",
     "Garden": "garden",
     "FlightProblem3D": "evolution", "TASK_SETS": "evolution", "evolve": "evolution", "pd_prior": "evolution",
     "kinematics": ".", "model": ".", "tasks": ".", "controllers": ".", "loop": ".", "flight": ".", "garden": ".",

@@ -18,6 +18,7 @@ import numpy as np
 
 from lifelike_mj import checks
 from lifelike_mj.butterfly.flight3d import controllers as c3
+from lifelike_mj.butterfly.flight3d.flight import DT_S
 from lifelike_mj.butterfly.flight3d.loop import TUMBLE_RAD, Batch
 from lifelike_mj.butterfly.flight3d.tasks import DRYDEN_VERTICAL_RATIO, R_FIT, Task3D, course, level, new_record, turn
 from lifelike_mj.butterfly.params import ButterflyParams
@@ -32,7 +33,7 @@ class FlightProblem3D:
     tasks: tuple[Task3D, ...]
     template: c3.Controller3D
     duration_s: float = 4.0
-    dt_s: float = 1.0 / 1200.0
+    dt_s: float = DT_S
     gene_bound: float = 3.0
     params: ButterflyParams = field(default_factory=ButterflyParams)
     n_strips: int = 8
@@ -167,7 +168,7 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
            gene_bound: float = 0.4, checkpoint: str | Path | None = None, resume: bool = False, progress: bool = True,
            overwrite: bool = False, task_set: str = "custom", on_generation=None, start: c3.Controller3D | None = None,
            inputs: str | None = None, executor: str = "serial", workers: int | None = None,
-           ray_address: str | None = None):
+           ray_address: str | None = None, dt_s: float = DT_S):
     """Evolve a 3D controller on ``tasks`` (default: the ``steer`` set) with ``optimizer`` and write it to
     ``out`` with its provenance (the problem, the optimiser, the budget, the time it took, the fitness
     history). Returns ``(result, controller)``; nothing is overwritten unasked (the checks and locks of the
@@ -178,7 +179,8 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     (:func:`~lifelike_mj.evolve.make_evaluator`): ``"serial"`` (this process, which flies the whole generation on
     every core: the fastest on one machine), ``"process"`` (a pool of ``workers`` processes, one thread each) or
     ``"ray"`` (a Ray cluster, ``ray_address`` to join one). Every executor gives the same result for the same
-    seed, bit for bit: each flight is independent of how the generation is split."""
+    seed, bit for bit: each flight is independent of how the generation is split. ``dt_s``: the time step of the
+    training flights (default :data:`~lifelike_mj.butterfly.flight3d.flight.DT_S`)."""
     from lifelike_mj import provenance as _prov
     from lifelike_mj.evolve import make_evaluator, optimize
     from lifelike_mj.evolve.checkpoint import guarded_run_files
@@ -197,7 +199,7 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
         layers = [int(v) for v in layers]
         template = c3.Controller3D(layers, pd_prior(layers) if len(layers) >= 2 and layers[0] == c3.N_OBS else [],
                                    inputs=inputs or "ground")
-    problem = FlightProblem3D(tuple(tasks), template, duration_s=duration_s, gene_bound=gene_bound)
+    problem = FlightProblem3D(tuple(tasks), template, duration_s=duration_s, gene_bound=gene_bound, dt_s=dt_s)
     out = Path(out)
     with guarded_run_files(out, checkpoint, resume=resume, overwrite=overwrite) as ckpt:
         with make_evaluator(problem, executor=executor, workers=workers, ray_address=ray_address) as ev:

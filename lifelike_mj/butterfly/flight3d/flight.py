@@ -8,7 +8,7 @@ amplitude and offset, feathering, the abdomen), which change smoothly whenever a
     from lifelike_mj.butterfly.flight3d import Flight3D, KinematicsCommand
 
     flight = Flight3D(KinematicsCommand(frequency_hz=10.0))
-    flight.step(1200)                       # one second
+    flight.step(800)                        # one second (the time step is 1/800 s)
     print(flight.state()["position_m"])     # x forward, y to the left, z up (m)
 
 A controller is a 3D controller file (:mod:`~lifelike_mj.butterfly.flight3d.controllers`: a network from the body's
@@ -64,8 +64,13 @@ STATE_UNITS = {
     "joint_rates_rad_s": "rad/s: the same joints' rates",
 }
 
-#: The 3D flight's time step (s): 120 steps per 10 Hz wing beat.
-DT_S = 1.0 / 1200.0
+#: The 3D flight's time step (s): 80 steps per 10 Hz wing beat, the largest that keeps an open-loop flight within
+#: 1 mm per second of its converged path (RK4) and the shipped controllers' scores within the spread of their own
+#: flutter (``benchmarks/timestep_3d.py``; ``docs/performance.md``).
+DT_S = 1.0 / 800.0
+#: The step the shipped controllers were evolved at (1/1200 s), and the 3D flight's default before 0.3: still
+#: selectable (``dt_s``, ``--dt 1/1200``).
+DT_FINE_S = 1.0 / 1200.0
 #: The fewest time steps per wing beat a 3D flight accepts.
 MIN_STEPS_PER_BEAT = 8
 #: A speed above this (m/s) is a runaway: the flight has diverged.
@@ -369,12 +374,13 @@ class Flight3D(StepCounter):
             mujoco.mj_forward(self._model, self._data)
         return mj3d.forces(self._data)
 
-    def record(self, n_steps: int | None = None, *, duration_s: float | None = None, every: int = 12) -> dict:
+    def record(self, n_steps: int | None = None, *, duration_s: float | None = None, every: int | None = None) -> dict:
         """Fly on ``n_steps`` steps (or ``duration_s`` seconds) and return the path sampled every ``every``
-        steps, the current state first: ``t_s``, and :meth:`state`'s arrays stacked (one row per sample)."""
+        steps (default: every 10 ms), the current state first: ``t_s``, and :meth:`state`'s arrays stacked (one row
+        per sample)."""
         if (n_steps is None) == (duration_s is None):
             raise UserError("give either n_steps or duration_s.")
-        every = checks.whole("every", every, 1)
+        every = max(1, round(0.01 / self.dt)) if every is None else checks.whole("every", every, 1)
         n = (checks.whole("the number of steps", n_steps, 1) if n_steps is not None
              else checks.steps_of(checks.positive("duration", duration_s, "s"), self.dt))
         checks.work(f"a 3D flight of {n:,} steps", n, checks.MAX_BODY_STEPS, "time steps",

@@ -81,6 +81,11 @@ def _beat_means(t: np.ndarray, x: np.ndarray, period_s: float) -> tuple[np.ndarr
 MAX_CHECK_S = 3600.0
 
 
+def _every_10_ms(flight) -> int:
+    """Steps between two samples 10 ms apart (12 at 1/1200 s), as :meth:`Flight3D.record` samples by default."""
+    return max(1, round(0.01 / flight.dt))
+
+
 def check_window(what: str, duration_s: float, settle_s: float, least_s: float, why: str) -> None:
     """Before a check flies: :class:`UserError` unless its ``duration_s`` is finite, at most :data:`MAX_CHECK_S`,
     and leaves at least ``least_s`` after its own settling time ``settle_s`` (``why``: what it measures then)."""
@@ -100,7 +105,7 @@ def level_check(controller, speed_m_s: float = 1.5, duration_s: float = 60.0, se
 
     check_window("the level check", duration_s, settle_s, 1.0, "it measures the speed each second after settling")
     f = Flight3D(controller=controller, task=tasks.level(speed_m_s), **flight)
-    rec = f.record(duration_s=duration_s, every=12)
+    rec = f.record(duration_s=duration_s, every=_every_10_ms(f))
     t, pos, att = rec["t_s"], rec["position_m"], rec["attitude_rad"]
     per_s = int(round(1.0 / (t[1] - t[0])))
     after = t >= settle_s - 1e-9
@@ -130,7 +135,7 @@ def turn_check(controller, angle_deg: float, at_s: float = 2.0, hold_s: float = 
     check_window("the turn check", at_s + hold_s, at_s, 1.0, "it measures the course over the hold after the command")
     f = Flight3D(controller=controller, task=tasks.turn(angle_deg, at_s, speed_m_s), **flight)
     period = 1.0 / f.command.frequency_hz
-    rec = f.record(duration_s=at_s + hold_s, every=12)
+    rec = f.record(duration_s=at_s + hold_s, every=_every_10_ms(f))
     t, pos, att = rec["t_s"], rec["position_m"], rec["attitude_rad"]
     ts, ps = _beat_means(t, pos, period)
     _, rolls = _beat_means(t, att[:, 0], period)
@@ -229,7 +234,7 @@ def target_check(controller, duration_s: float = 40.0, catch_s: float = 10.0, **
     dist, times = [], []
     first = None
     while f.time < duration_s - 1e-9:
-        f.step(12)
+        f.step(_every_10_ms(f))
         d = float(f._rec[R_WP + 1])
         dist.append(d)
         times.append(f.time)

@@ -151,7 +151,7 @@ def test_the_evolution_scores_what_the_stepper_flies():
     fit = prob.evaluate(np.stack([w, w * 0.5]))
     for task, rec in zip(tasks, prob.fly(w[None, :])[0]):
         f = Flight3D(controller=tmpl.with_weights(w), task=task, n_strips=8, n_chord=2)
-        f.step(360)
+        f.step(round(0.3 / f.dt))
         assert f.reward == rec[flight3d.tasks.R_FIT]
     assert fit[0] == pytest.approx(np.mean(prob.fly(w[None, :])[0][:, flight3d.tasks.R_FIT]) / 0.3, rel=1e-15)
     assert prob.evaluate(w[None, :])[0] == fit[0]  # the same row scores the same in another batch
