@@ -293,10 +293,14 @@ class Flight3D(StepCounter):
                 self._k = int(self._rec[1])
                 if self._rec[R_DIVERGED] >= 0:
                     break
+        self._settle()
+
+    def _settle(self) -> None:
+        """After the compiled loop: the step count from the run record, and a divergence named and raised."""
         self._k = int(self._rec[1])
         if self._rec[R_DIVERGED] >= 0:
-            if d.time < 0.5 * self._k * self.dt:  # MuJoCo reset the simulation (its clock went back)
-                self._diverged = describe(d, "the 3D flight")
+            if self._data.time < 0.5 * self._k * self.dt:  # MuJoCo reset the simulation (its clock went back)
+                self._diverged = describe(self._data, "the 3D flight")
             else:
                 self._diverged = f"the 3D flight diverged: its speed ran away above {RUNAWAY_M_S:g} m/s;"
             self._diverged += f" (step {self._k}, t = {self.time:.4f} s)"
@@ -318,17 +322,13 @@ class Flight3D(StepCounter):
         if action is not None:
             from lifelike_mj.butterfly.flight3d.controllers import N_ACT
 
-            a = np.asarray(action, dtype=np.float64).reshape(-1)
-            if a.shape != (N_ACT,) or not np.isfinite(a).all():
+            a = np.asarray(action)
+            if a.dtype.kind not in "fiu" or a.size != N_ACT or not np.isfinite(a).all():
                 raise UserError(f"an action is {N_ACT} finite numbers in [-1, 1], got {action!r}.")
-            action = np.clip(a, -1.0, 1.0)[None, :]
+            action = np.clip(a.astype(np.float64).reshape(1, N_ACT), -1.0, 1.0)
         limit = np.iinfo(np.int64).max if max_steps is None else checks.whole("max_steps", max_steps, 0)
         self._batch.decide(action, limit)
-        self._k = int(self._rec[1])
-        if self._rec[R_DIVERGED] >= 0:
-            self._diverged = (f"the 3D flight diverged: its speed ran away above {RUNAWAY_M_S:g} m/s or MuJoCo found "
-                              f"its state unstable; (step {self._k}, t = {self.time:.4f} s)")
-        self._check_alive()
+        self._settle()
         return self._batch.observations[0].copy()
 
     @property
