@@ -26,6 +26,7 @@ import mujoco
 import numpy as np
 
 from lifelike_mj.butterfly import flight3d
+from lifelike_mj.errors import Diverged
 from lifelike_mj.io import write_json
 from lifelike_mj.machine import machine_info
 from lifelike_mj.provenance import provenance
@@ -71,17 +72,20 @@ def fitness(name: str, dt: Fraction, integrator: str, flutter: float = 0.0, seed
     return float(p.evaluate(np.zeros((1, p.dim)))[0])
 
 
-def cost(dt: Fraction, integrator: str, n: int = 20, seconds: float = 2.0) -> float:
+def cost(dt: Fraction, integrator: str, n: int = 20, seconds: float = 2.0) -> float | None:
     """Seconds of wall time per second of flight of a garden of ``n`` (median of 3), this machine."""
     g = flight3d.Garden(n, "steer", seed=1, dt_s=float(dt))
     g._phys.opt.integrator = INTEGRATORS[integrator]
     steps = int(round(seconds / float(dt)))
-    g.step(10)
     walls = []
-    for _ in range(3):
-        t = time.perf_counter()
-        g.step(steps)
-        walls.append(time.perf_counter() - t)
+    try:
+        g.step(10)
+        for _ in range(3):
+            t = time.perf_counter()
+            g.step(steps)
+            walls.append(time.perf_counter() - t)
+    except Diverged:
+        return None
     return float(np.median(walls)) / seconds
 
 

@@ -179,9 +179,9 @@ class Garden(StepCounter):
         bad = self._batch.diverged()
         if len(bad):
             i = int(bad[0])
-            raise Diverged(f"butterfly {i} of the garden diverged at step {int(self._recs[i, R_DIVERGED])}: its "
-                           "speed ran away or MuJoCo found its state unstable; the likely cause is the time step "
-                           f"({self.dt:g} s) or the wind.")
+            step = int(self._recs[i, R_DIVERGED])
+            raise Diverged(f"butterfly {i} of the garden diverged at step {step}: its speed ran away or MuJoCo found "
+                           f"its state unstable; the likely cause is the time step ({self.dt:g} s) or the wind.", step)
 
     def sync(self) -> None:
         """Pose the drawing scene at the butterflies' current states (and add them to :attr:`track`)."""

@@ -56,3 +56,16 @@ def test_the_garden_films_and_its_frames_move(tmp_path):
     assert len(frames) == 3 and np.abs(frames[0] - frames[-1]).mean() > 0.5  # the scene changes as it flies
     with pytest.raises(UserError, match="overview or chase"):
         film_garden(tmp_path / "h.gif", g, camera_name="top")
+
+
+def test_a_garden_that_diverges_says_so_in_one_sentence():
+    """Euler at 1/200 s cannot fly the butterflies: the garden names the butterfly, the step and the likely cause."""
+    import mujoco
+
+    from lifelike_mj.errors import Diverged
+
+    g = Garden(2, "steer", seed=1, dt_s=1.0 / 200.0)
+    g._phys.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    with pytest.raises(Diverged, match=r"butterfly \d of the garden diverged at step \d+: .* time step \(0.005 s\)") as e:
+        g.step(2000)
+    assert 0 < e.value.step <= 2000
