@@ -12,7 +12,7 @@ import pytest
 EXAMPLES = sorted((Path(__file__).resolve().parent.parent / "examples").glob("*.py"))
 NEEDS_GL = {"render_your_run.py"}
 #: Examples of an optional extra: run where it is installed, skipped (with the reason) elsewhere.
-NEEDS_MODULE = {"gym_sb3_ppo.py": "stable_baselines3"}
+NEEDS_MODULE = {"gym_sb3_ppo.py": "stable_baselines3", "gym_sb3_flight3d.py": "stable_baselines3"}
 
 
 def test_there_are_examples():

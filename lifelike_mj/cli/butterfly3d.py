@@ -181,7 +181,7 @@ def _add_weather(p, what: str, seed: str) -> None:
 def _add_dt(p, fine: bool = False) -> None:
     """``--dt``: the 3D flight's time step (``fine``: default 1/1200 s, for exports, whose keys sample every step and
     whose loops end on a step)."""
-    from lifelike_mj.butterfly.flight3d.flight import DT_FINE_S, DT_S
+    from lifelike_mj.butterfly.flight3d.timing import DT_FINE_S, DT_S
 
     p.add_argument("--dt", type=num(1e-5, 1.0 / 80.0, unit="s"), default=DT_FINE_S if fine else DT_S,
                    help="time step, s (1/1200 is the step the shipped controllers were evolved at; at most 1/8 of a "

@@ -47,9 +47,9 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "OBS_NAMES": "controllers", "ACTION_NAMES": "controllers", "N_OBS": "controllers", "N_ACT": "controllers",
     "n_weights": "controllers",
     "Batch": "loop", "TUMBLE_RAD": "loop",
-    "Flight3D": "flight", "DT_S": "flight", "DT_FINE_S": "flight", "STATE_UNITS": "flight", "euler_from_quat": "flight",
+    "Flight3D": "flight", "DT_S": "timing", "DT_FINE_S": "timing", "STATE_UNITS": "flight", "euler_from_quat": "flight",
     "Garden": "garden",
     "FlightProblem3D": "evolution", "TASK_SETS": "evolution", "evolve": "evolution", "pd_prior": "evolution",
     "kinematics": ".", "model": ".", "tasks": ".", "controllers": ".", "loop": ".", "flight": ".", "garden": ".",
-    "evolution": ".", "validate": ".", "figures": ".", "view": ".", "view_flight3d": "view",
+    "evolution": ".", "validate": ".", "figures": ".", "timing": ".", "view": ".", "view_flight3d": "view",
 }, globals())

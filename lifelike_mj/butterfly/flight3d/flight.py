@@ -48,6 +48,7 @@ from lifelike_mj.butterfly.flight3d.tasks import (
     level,
     new_record,
 )
+from lifelike_mj.butterfly.flight3d.timing import DT_FINE_S, DT_S  # noqa: F401  (DT_FINE_S: here too)
 from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.errors import Diverged, UserError
 from lifelike_mj.physics.callbacks import passive_callback
@@ -64,13 +65,6 @@ STATE_UNITS = {
     "joint_rates_rad_s": "rad/s: the same joints' rates",
 }
 
-#: The 3D flight's time step (s): 80 steps per 10 Hz wing beat, the largest that keeps an open-loop flight within
-#: 1 mm per second of its converged path (RK4) and the shipped controllers' scores within the spread of their own
-#: flutter (``benchmarks/timestep_3d.py``; ``docs/performance.md``).
-DT_S = 1.0 / 800.0
-#: The step the shipped controllers were evolved at (1/1200 s), and the 3D flight's default before 0.3: still
-#: selectable (``dt_s``, ``--dt 1/1200``).
-DT_FINE_S = 1.0 / 1200.0
 #: The fewest time steps per wing beat a 3D flight accepts.
 MIN_STEPS_PER_BEAT = 8
 #: A speed above this (m/s) is a runaway: the flight has diverged.
