@@ -93,7 +93,32 @@ def check_actions(actions: Any, n: int) -> np.ndarray:
     return a
 
 
-class ButterflyPitchEnv(gym.Env):
+class Drawn:
+    """What an environment that renders keeps: an offscreen renderer (``rgb_array``) and a viewer window
+    (``human``), closed together by :meth:`close`."""
+
+    _renderer = None
+    _viewer = None
+
+    def _show_in_viewer(self, model, data, creature: str) -> None:
+        """``human``: the MuJoCo viewer on ``model`` and ``data`` (opened at the first call; needs a display)."""
+        from lifelike_mj.render.viewer import launch_viewer, require_display
+
+        if self._viewer is None:
+            require_display(creature)
+            self._viewer = launch_viewer(model, data)
+        self._viewer.sync()
+
+    def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+        if self._viewer is not None:
+            self._viewer.close()
+            self._viewer = None
+
+
+class ButterflyPitchEnv(Drawn, gym.Env):
     """``lifelike_mj/ButterflyPitch-v0``: choose the butterfly's pitch once per step so that it flies
     level and fast (Oe 2010 section 6).
 
@@ -266,12 +291,7 @@ class ButterflyPitchEnv(gym.Env):
             return None
         self.flight.sync()
         if self.render_mode == "human":
-            from lifelike_mj.render.viewer import launch_viewer, require_display
-
-            if self._viewer is None:
-                require_display("butterfly")
-                self._viewer = launch_viewer(self.flight.model, self.flight.data)
-            self._viewer.sync()
+            self._show_in_viewer(self.flight.model, self.flight.data, "butterfly")
             return None
         from lifelike_mj.butterfly.render import dress, flight_camera
         from lifelike_mj.render.offscreen import Offscreen
@@ -282,14 +302,6 @@ class ButterflyPitchEnv(gym.Env):
             self._renderer_model = self.flight.model
         self._renderer.update(self.flight.model, self.flight.data, flight_camera(self.flight, self.camera))
         return self._renderer.draw()
-
-    def close(self) -> None:
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
-        if self._viewer is not None:
-            self._viewer.close()
-            self._viewer = None
 
     # ---- internals ------------------------------------------------------------------------------
 

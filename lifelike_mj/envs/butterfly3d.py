@@ -15,7 +15,7 @@ from gymnasium.vector.utils import batch_space
 from lifelike_mj import checks
 from lifelike_mj.butterfly import flight3d
 from lifelike_mj.butterfly.params import ButterflyParams
-from lifelike_mj.envs.butterfly import check_options, copy_rngs
+from lifelike_mj.envs.butterfly import Drawn, check_options, copy_rngs
 from lifelike_mj.errors import Diverged, UserError
 
 #: The tasks an episode can fly (``task=``), besides a :class:`~lifelike_mj.butterfly.flight3d.Task3D` of your own.
@@ -45,7 +45,7 @@ def _observation_space() -> spaces.Box:
     return spaces.Box(lo, -lo, (flight3d.N_OBS,), dtype=np.float64)
 
 
-class ButterflyFlight3DEnv(gym.Env):
+class ButterflyFlight3DEnv(Drawn, gym.Env):
     """``lifelike_mj/ButterflyFlight3D-v0``: fly the free 3D butterfly through a task by changing its wing and
     abdomen kinematics, as a 3D controller's network does.
 
@@ -213,12 +213,7 @@ class ButterflyFlight3DEnv(gym.Env):
         f = self.flight
         f.sync()
         if self.render_mode == "human":
-            from lifelike_mj.render.viewer import launch_viewer, require_display
-
-            if self._viewer is None:
-                require_display("butterfly3d")
-                self._viewer = launch_viewer(f.model, f.data)
-            self._viewer.sync()
+            self._show_in_viewer(f.model, f.data, "butterfly3d")
             return None
         from lifelike_mj.render import camera
         from lifelike_mj.render.offscreen import Offscreen
@@ -227,14 +222,6 @@ class ButterflyFlight3DEnv(gym.Env):
             self._renderer = Offscreen(f.model, self.width, self.height)
         self._renderer.update(f.model, f.data, camera.tracking(int(f.model.body("butterfly").id), 0.3, 150.0, -20.0))
         return self._renderer.draw()
-
-    def close(self) -> None:
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
-        if self._viewer is not None:
-            self._viewer.close()
-            self._viewer = None
 
     def _shown(self, obs: np.ndarray) -> np.ndarray:
         """The observation within the space's bounds (only a flight about to diverge reaches them)."""
