@@ -51,8 +51,8 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
 
     The butterfly is a free body that only the air (the normal-pressure force integrated over each wing), gravity
     and its own joints move. The agent acts where a 3D controller's network acts: every ``every`` time steps
-    (the controller's; 1/1200 s each) it sets nine numbers that shift the kinematics around a base command, which
-    the kinematics then follow smoothly. An episode's return is the fitness ``lifelike-mj butterfly evolve3d``
+    (the controller's; 1/800 s each by default) it sets nine numbers that shift the kinematics around a base
+    command, which the kinematics then follow smoothly. An episode's return is the fitness ``lifelike-mj butterfly evolve3d``
     gives the same flight (the mean reward per second), so RL and the evolutions are scored alike.
 
     ## Action space
@@ -123,7 +123,8 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
     :class:`~lifelike_mj.butterfly.flight3d.Task3D` of your own, or a list of these, one drawn per episode (the
     evolution's task sets: ``task=flight3d.TASK_SETS["steer"]()``); ``reset(options={"task": ...})`` changes it
     for one episode. ``speed_m_s`` (1.5), ``angle_deg`` (90), ``flutter`` (0), ``duration_s`` (4, the evolution's
-    training flights), ``dt_s`` (1/1200 s). ``controller``: a 3D controller (name, path or object) whose base
+    training flights), ``dt_s`` (1/800 s; 1/1200 s is the step the shipped controllers were evolved at).
+    ``controller``: a 3D controller (name, path or object) whose base
     command, action scales, rate ``every``, kinematics bandwidth and ``inputs`` the environment takes (default:
     a new controller's: the paper's 10 Hz flap, ``every=1``, speeds over the ground); ``every`` and ``inputs``
     override it. Rendering: ``render_mode`` ``"rgb_array"`` (offscreen frames of ``width`` x ``height``, EGL or
