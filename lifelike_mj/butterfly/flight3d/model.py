@@ -108,10 +108,15 @@ U_REF = U_TAU + 8  # 15: the joints' references (5 x 3)
 U_KIN = U_REF + 15  # 3 * N_PARAMS: the parameters at the stage (p, dp, ddp)
 U_WL = U_KIN + 3 * N_PARAMS  # W / L: the chord per span of the planform-2 triangle
 U_NPANEL = U_WL + 1
-U_PANEL = U_NPANEL + 1  # per panel: chord position (m, + forward), span position (m, > 0), area (m^2)
+U_PANEL = U_NPANEL + 1  # per panel: chord position (m, + forward), span position (m, > 0), area (m^2), local chord (m)
 MAX_PANELS = 240
-U_DSCR = U_PANEL + 3 * MAX_PANELS  # 48: the drive's scratch (the free block's Cholesky factor and two vectors)
-N_USERDATA = U_DSCR + 48
+N_PANEL = 4  # numbers per panel
+U_DSCR = U_PANEL + N_PANEL * MAX_PANELS  # 48: the drive's scratch (the free block's Cholesky factor and two vectors)
+U_NTRI = U_DSCR + 48  # triangles of the wing's outline (exact law)
+U_RC = U_NTRI + 1  # span of the wing's area centroid (m): where the exact law splits its force into parts
+U_TRI = U_RC + 1  # per triangle: three vertices (chord, span) of the left wing (m)
+MAX_TRIS = 64
+N_USERDATA = U_TRI + 6 * MAX_TRIS
 
 _O_TIME, _O_QPOS, _O_QVEL, _O_QFRC, _O_UD = mjabi.O_TIME, mjabi.O_QPOS, mjabi.O_QVEL, mjabi.O_QFRC, mjabi.O_UD
 _O_XPOS, _O_XMAT, _O_XIPOS = mjabi.O_XPOS, mjabi.O_XMAT, mjabi.O_XIPOS
@@ -126,7 +131,7 @@ _f64 = mjabi.f64_at
 
 
 @njit(cache=True)
-def wing_panels(mode, pan, npan, side, R, lin, omega, rho, cd, wl, out):
+def wing_panels(mode, pan, npan, side, R, lin, omega, rho, cd, out):
     """The air's force on one wing from its panels (``pan``: chord position, span position, area): ``out`` =
     force (3, N), moment about the hinge (3, N m), and the force split into translational lift (3), drag (3)
     and rotational force (3), world frame. ``R``: the wing's axes as columns (chord, span, normal); ``lin``,
@@ -136,7 +141,7 @@ def wing_panels(mode, pan, npan, side, R, lin, omega, rho, cd, wl, out):
     blade elements: with ``U`` the panel's air speed across the span and ``alpha`` its angle to the wing
     plane, lift ``1/2 rho C_L(alpha) U^2 dA`` across the flow, drag ``1/2 rho C_D(alpha) U^2 dA`` along it
     (:data:`QS_CL`, :data:`QS_CD`), and the rotational force ``C_rot rho U omega_p c dA`` along the normal
-    (:data:`QS_CROT`; ``omega_p`` the pitching rate that raises ``alpha``, ``c = W r / L`` the local chord).
+    (:data:`QS_CROT`; ``omega_p`` the pitching rate that raises ``alpha``, ``c`` the panel's local chord).
     Either law's force is also split into its part along the flow (drag) and across it (lift)."""
     for k in range(15):
         out[k] = 0.0
@@ -146,9 +151,9 @@ def wing_panels(mode, pan, npan, side, R, lin, omega, rho, cd, wl, out):
     wx, wy, wz = omega[0], omega[1], omega[2]
     w_span = wx * sx + wy * sy + wz * sz
     for j in range(npan):
-        xc = pan[3 * j]
-        r = side * pan[3 * j + 1]
-        area = pan[3 * j + 2]
+        xc = pan[N_PANEL * j]
+        r = side * pan[N_PANEL * j + 1]
+        area = pan[N_PANEL * j + 2]
         rx = cx * xc + sx * r
         ry = cy * xc + sy * r
         rz = cz * xc + sz * r
@@ -184,7 +189,7 @@ def wing_panels(mode, pan, npan, side, R, lin, omega, rho, cd, wl, out):
             fy = q * (c_l * ly - c_d * ey / u)
             fz = q * (c_l * lz - c_d * ez / u)
             # rotational force: the leading edge turning towards the pushed side raises alpha
-            rot = QS_CROT * rho * u * (w_span * sgn) * (wl * abs(r)) * area
+            rot = QS_CROT * rho * u * (w_span * sgn) * pan[N_PANEL * j + 3] * area
             rox, roy, roz = -sgn * rot * nx, -sgn * rot * ny, -sgn * rot * nz
             out[12] += rox
             out[13] += roy
@@ -209,13 +214,13 @@ def wing_panels(mode, pan, npan, side, R, lin, omega, rho, cd, wl, out):
 
 
 @njit(cache=True)
-def wing_exact(side, R, lin, omega, rho, cd, span, wl, out):
-    """Eq. 1 (Oe 2010) integrated exactly over one wing, the planform-2 triangle (hinge at the origin, the
-    tip chord ``W = wl * span`` at ``span``): the same ``out`` as :func:`wing_panels` (force, moment about the
-    hinge, parts; N, N m, world frame). The wing is rigid, so its normal speed is affine over it and the
-    integral of ``v_n |v_n|`` has a closed form (:func:`~lifelike_mj.physics.fluid.triangle_sq_abs`): the
-    limit of :func:`wing_panels` with ever more panels. The parts are split along and across the flow at the
-    wing's centroid (2/3 of the span)."""
+def wing_exact(side, R, lin, omega, rho, cd, tri, ntri, rc, out):
+    """Eq. 1 (Oe 2010) integrated exactly over one wing's outline, cut into ``ntri`` triangles (``tri``: per
+    triangle three vertices (chord, span) of the left wing, m; the right wing, ``side = -1``, is their mirror):
+    the same ``out`` as :func:`wing_panels` (force, moment about the hinge, parts; N, N m, world frame). The wing
+    is rigid, so its normal speed is affine over it and the integral of ``v_n |v_n|`` over each triangle has a
+    closed form (:func:`~lifelike_mj.physics.fluid.triangle_sq_abs`): the limit of :func:`wing_panels` with ever
+    more panels. The parts are split along and across the flow at the span ``rc`` of the wing's area centroid."""
     cx, cy, cz = R[0, 0], R[1, 0], R[2, 0]
     sx, sy, sz = R[0, 1], R[1, 1], R[2, 1]
     nx, ny, nz = R[0, 2], R[1, 2], R[2, 2]
@@ -225,14 +230,21 @@ def wing_exact(side, R, lin, omega, rho, cd, span, wl, out):
     gx, gy, gz = ny * wz - nz * wy, nz * wx - nx * wz, nx * wy - ny * wx
     g_c = gx * cx + gy * cy + gz * cz
     g_s = gx * sx + gy * sy + gz * sz
-    r_tip = side * span
-    half = 0.5 * wl * span
     integ = out[12:15]  # scratch, cleared below
-    triangle_sq_abs(0.0, 0.0, -half, r_tip, half, r_tip, s0, s0 - half * g_c + r_tip * g_s,
-                    s0 + half * g_c + r_tip * g_s, integ)
+    i0, i1, i2 = 0.0, 0.0, 0.0
+    for k in range(ntri):
+        b = 6 * k
+        x0, r0 = tri[b], side * tri[b + 1]
+        x1, r1 = tri[b + 2], side * tri[b + 3]
+        x2, r2 = tri[b + 4], side * tri[b + 5]
+        triangle_sq_abs(x0, r0, x1, r1, x2, r2, s0 + x0 * g_c + r0 * g_s, s0 + x1 * g_c + r1 * g_s,
+                        s0 + x2 * g_c + r2 * g_s, integ)
+        i0 += integ[0]
+        i1 += integ[1]
+        i2 += integ[2]
     k = -0.5 * rho * cd
-    fn = k * integ[0]
-    mc, ms = k * integ[1], k * integ[2]  # the moment arm's chord and span parts (times the force density)
+    fn = k * i0
+    mc, ms = k * i1, k * i2  # the moment arm's chord and span parts (times the force density)
     ax, ay, az = mc * cx + ms * sx, mc * cy + ms * sy, mc * cz + ms * sz
     fx, fy, fz = fn * nx, fn * ny, fn * nz
     for j in range(6, 15):
@@ -242,8 +254,8 @@ def wing_exact(side, R, lin, omega, rho, cd, span, wl, out):
     out[4] = az * nx - ax * nz
     out[5] = ax * ny - ay * nx
     # the parts, by the flow across the span at the centroid
-    rc = 2.0 * r_tip / 3.0
-    px, py, pz = sx * rc, sy * rc, sz * rc
+    r_c = side * rc
+    px, py, pz = sx * r_c, sy * r_c, sz * r_c
     vx = lin[0] + wy * pz - wz * py
     vy = lin[1] + wz * px - wx * pz
     vz = lin[2] + wx * py - wy * px
@@ -330,7 +342,9 @@ def _passive_kernel(m, d, off):
         lin = wscr[0:3]
         omega = wscr[3:6]
         npan = int(ud[U_NPANEL])
-        pan = _f64(uda + 8 * U_PANEL, 3 * MAX_PANELS)
+        pan = _f64(uda + 8 * U_PANEL, N_PANEL * MAX_PANELS)
+        tri = _f64(uda + 8 * U_TRI, 6 * MAX_TRIS)
+        ntri = int(ud[U_NTRI])
         for i in range(2):
             wing = int(ud[U_WING + i])
             side = 1.0 if i == 0 else -1.0
@@ -363,10 +377,9 @@ def _passive_kernel(m, d, off):
                     omega[k] = v6[k]
                 wout = wscr[6:21]
                 if mode == 4:
-                    wing_exact(side, xmat[mw : mw + 9].reshape((3, 3)), lin, omega, rho, cd, ud[U_L], ud[U_WL], wout)
+                    wing_exact(side, xmat[mw : mw + 9].reshape((3, 3)), lin, omega, rho, cd, tri, ntri, ud[U_RC], wout)
                 else:
-                    wing_panels(mode, pan, npan, side, xmat[mw : mw + 9].reshape((3, 3)), lin, omega, rho, cd,
-                                ud[U_WL], wout)
+                    wing_panels(mode, pan, npan, side, xmat[mw : mw + 9].reshape((3, 3)), lin, omega, rho, cd, wout)
                 for k in range(3):
                     f[k] = wout[k]
                     tq[k] = wout[3 + k]
@@ -496,20 +509,22 @@ def _python_wing(mode: int, ud: np.ndarray, side: float, Rw: np.ndarray, lin: np
     rho, cd = ud[U_RHO], ud[U_CD]
     if mode == 4:
         chord, span, n = Rw[:, 0], Rw[:, 1], Rw[:, 2]
-        r_tip, half = side * ud[U_L], 0.5 * ud[U_WL] * ud[U_L]
-        verts = np.array([[0.0, 0.0], [-half, r_tip], [half, r_tip]])
-        pts = verts[:, :1] * chord[None, :] + verts[:, 1:] * span[None, :]
-        s = (lin[None, :] + np.cross(omega[None, :], pts)) @ n
-        integ = np.zeros(3)
-        triangle_sq_abs(*verts.ravel(), *s, integ)
-        fw = -0.5 * rho * cd * integ[0] * n
-        arm = -0.5 * rho * cd * (integ[1] * chord + integ[2] * span)
-        v = lin + np.cross(omega, 2.0 * r_tip / 3.0 * span)
+        tris = ud[U_TRI : U_TRI + 6 * int(ud[U_NTRI])].reshape(-1, 3, 2) * np.array([1.0, side])
+        total = np.zeros(3)
+        for verts in tris:
+            pts = verts[:, :1] * chord[None, :] + verts[:, 1:] * span[None, :]
+            s = (lin[None, :] + np.cross(omega[None, :], pts)) @ n
+            integ = np.zeros(3)
+            triangle_sq_abs(*verts.ravel(), *s, integ)
+            total += integ
+        fw = -0.5 * rho * cd * total[0] * n
+        arm = -0.5 * rho * cd * (total[1] * chord + total[2] * span)
+        v = lin + np.cross(omega, side * ud[U_RC] * span)
         e = v - (v @ span) * span
         drag = (fw @ e) / (e @ e) * e if e @ e > 0 else np.zeros(3)
         return fw, np.cross(arm, n), np.concatenate([fw - drag, drag, np.zeros(3)])
     npan = int(ud[U_NPANEL])
-    panels = ud[U_PANEL : U_PANEL + 3 * npan].reshape(npan, 3)
+    panels = ud[U_PANEL : U_PANEL + N_PANEL * npan].reshape(npan, N_PANEL)
     chord, span, n = Rw[:, 0], Rw[:, 1], Rw[:, 2]
     r = panels[:, :1] * chord[None, :] + side * panels[:, 1:2] * span[None, :]
     v = lin[None, :] + np.cross(omega[None, :], r)
@@ -531,7 +546,7 @@ def _python_wing(mode: int, ud: np.ndarray, side: float, Rw: np.ndarray, lin: np
         lift_dir /= np.linalg.norm(lift_dir, axis=1)[:, None]
         dF = (q * c_l)[:, None] * lift_dir - (q * c_d / u)[:, None] * e
         w_span = float(omega @ span)
-        mag = QS_CROT * rho * u * (w_span * sgn) * (ud[U_WL] * np.abs(side * panels[:, 1])) * panels[:, 2]
+        mag = QS_CROT * rho * u * (w_span * sgn) * panels[:, 3] * panels[:, 2]
         rot = mag[:, None] * side_n
     drag = (np.sum(dF * e, axis=1) / u2)[:, None] * e
     total = dF + rot
@@ -556,14 +571,28 @@ def model_path():
     return paths.model_path("butterfly", "butterfly3d.xml")
 
 
-def build_model(params: ButterflyParams | None = None, masses: str = "animal") -> mujoco.MjModel:
-    """Compile the 3D model with the constants of ``params`` applied through ``MjSpec``: the wing meshes
-    and tip sites scaled to ``L`` and ``W``; the parts' masses scaled to add up to ``m`` in the model
-    file's proportions (``masses="animal"``), or all of ``m`` in the thorax (``"paper"``)."""
+def build_model(params: ButterflyParams | None = None, masses: str = "animal", animal: str = "swallowtail"
+                ) -> mujoco.MjModel:
+    """Compile the 3D model of ``animal`` (one of :data:`~lifelike_mj.butterfly.flight3d.animals.ANIMALS`).
+
+    The swallowtail: the model file with the constants of ``params`` applied through ``MjSpec``: the wing meshes
+    and tip sites scaled to ``L`` and ``W``; the parts' masses scaled to add up to ``m`` in the model file's
+    proportions (``masses="animal"``), or all of ``m`` in the thorax (``"paper"``). A measured species
+    (the monarch): its own body, masses, hinges, stroke plane and wing outline (:func:`_apply_animal`);
+    ``params`` then only give the air and gravity."""
+    from lifelike_mj.butterfly.flight3d.animals import animal as _animal
+
     p = params or ButterflyParams()
     if masses not in MASS_LAYOUTS:
         raise UserError(f"unknown mass layout {masses!r}; choose one of: {', '.join(MASS_LAYOUTS)}.")
+    a = _animal(animal)
     spec = mujoco.MjSpec.from_file(str(model_path()))
+    spec.nuserdata = N_USERDATA
+    if a.measured:
+        if masses != "animal":
+            raise UserError(f"the {masses!r} mass layout is the paper's swallowtail's; the {a.name} has its own masses.")
+        _apply_animal(spec, a)
+        return spec.compile()
     geoms = {name: spec.geom(name) for name in _MASS_GEOMS}
     if masses == "animal":
         scale = p.mass_kg / sum(g.mass for g in geoms.values())
@@ -580,23 +609,145 @@ def build_model(params: ButterflyParams | None = None, masses: str = "animal") -
     return spec.compile()
 
 
+#: Half the thickness (m) of the drawn wing: a flat slab, so that it has a volume and both faces.
+WING_HALF_THICKNESS_M = 0.0002
+
+
+def slab_mesh(polygon: np.ndarray, sign: float = 1.0, half_thickness: float = WING_HALF_THICKNESS_M):
+    """Vertices ``(2n, 3)`` and faces ``(m, 3)`` of a flat slab of the polygon ``(n, 2)`` (chord, span; the span
+    times ``sign``, -1 for the right wing): the polygon's triangles on top and below, and its rim."""
+    from lifelike_mj.physics.planform import signed_area, triangulate
+
+    poly = np.asarray(polygon, dtype=float) * np.array([1.0, sign])
+    if signed_area(poly) < 0.0:
+        poly = poly[::-1]
+    n = len(poly)
+    verts = np.concatenate([np.c_[poly, np.full(n, half_thickness)], np.c_[poly, np.full(n, -half_thickness)]])
+    tris = triangulate(poly)
+    index = {tuple(v): k for k, v in enumerate(poly)}
+    top = np.array([[index[tuple(v)] for v in t] for t in tris])
+    faces = [top, top[:, ::-1] + n]
+    rim = np.array([[k, (k + 1) % n + n, (k + 1) % n] for k in range(n)]
+                   + [[k, k + n, (k + 1) % n + n] for k in range(n)])
+    return verts, np.concatenate(faces + [rim])
+
+
+def _apply_animal(spec: mujoco.MjSpec, a) -> None:
+    """Reshape the model file's swallowtail into the measured species ``a``
+    (:class:`~lifelike_mj.butterfly.flight3d.animals.Animal`): the thorax and abdomen as ellipsoids of its sizes
+    and masses (the head within the thorax's), the abdomen hinged at the thorax's rear end, the wing hinges
+    half the thorax's width out, tilted by the stroke plane (the flap axis turned about the body's y axis, the
+    top of the stroke rearward), and each wing's surfaces as drawn slabs, its mass a plate over the outline."""
+    from lifelike_mj.physics.planform import lamina_inertia
+
+    (lt, wt), (la, wa) = a.thorax_m, a.abdomen_m
+    for name in ("thorax", "thorax_mass"):
+        g = spec.geom(name)
+        g.type = mujoco.mjtGeom.mjGEOM_ELLIPSOID
+        g.size = [lt / 2.0, wt / 2.0, wt / 2.0]
+        g.fromto = [np.nan] * 6
+        g.pos = [0.0, 0.0, 0.0]
+    spec.geom("thorax_mass").mass = a.mass_body_kg
+    head = spec.geom("head")
+    head.size = [0.42 * wt, 0.0, 0.0]
+    head.pos = [lt / 2.0 + 0.25 * wt, 0.0, 0.0]
+    spec.geom("head_mass").mass = 0.0
+    spec.body("abdomen").pos = [-lt / 2.0, 0.0, 0.0]
+    for name in ("abdomen", "abdomen_mass"):
+        g = spec.geom(name)
+        g.type = mujoco.mjtGeom.mjGEOM_ELLIPSOID
+        g.size = [la / 2.0, wa / 2.0, wa / 2.0]
+        g.fromto = [np.nan] * 6
+        g.pos = [-la / 2.0, 0.0, 0.0]
+    spec.geom("abdomen_mass").mass = a.mass_abdomen_kg
+    beta = math.radians(a.stroke_plane_deg)
+    tris = a.triangles
+    for k, rgba in enumerate(a.colours):
+        spec.add_material(name=f"{a.name}_{k}", rgba=list(rgba))
+    tip = max((v for s in a.surfaces for v in s), key=lambda v: v[1])
+    for side, sign in (("left", 1.0), ("right", -1.0)):
+        body = spec.body(f"wing_{side}")
+        body.pos = [0.0, sign * wt / 2.0, 0.0]
+        body.quat = [math.cos(beta / 2.0), 0.0, -math.sin(beta / 2.0), 0.0]  # about y by -beta: top rearward
+        spec.delete(spec.geom(f"wing_{side}_mass"))
+        spec.delete(spec.geom(f"wing_{side}"))
+        spec.delete(spec.mesh(f"wing_{side}"))
+        for k, surface in enumerate(a.surfaces):
+            verts, faces = slab_mesh(surface, sign)
+            mesh = spec.add_mesh(name=f"wing_{side}_{k}", uservert=verts.ravel().tolist(),
+                                 userface=faces.ravel().tolist())
+            body.add_geom(name=f"wing_{side}" if k == 0 else f"wing_{side}_{k}", type=mujoco.mjtGeom.mjGEOM_MESH,
+                          meshname=mesh.name, material=f"{a.name}_{k}", group=0, mass=0.0, contype=0, conaffinity=0)
+        com, inertia = lamina_inertia(tris * np.array([1.0, sign]), a.mass_wing_kg)
+        vals, vecs = np.linalg.eigh(inertia)
+        if np.linalg.det(vecs) < 0:
+            vecs[:, 0] = -vecs[:, 0]
+        q = np.empty(4)
+        mujoco.mju_mat2Quat(q, vecs.ravel())
+        body.explicitinertial = True
+        body.mass, body.ipos, body.inertia, body.iquat = a.mass_wing_kg, com, vals, q
+        spec.site(f"wing_{side}_tip").pos = [float(tip[0]), sign * float(tip[1]), 0.0]
+
 
 def panels(params: ButterflyParams, n_strips: int = 8, n_chord: int = 2) -> np.ndarray:
-    """``(n, 3)``: chord position (m, + towards the leading edge), span position (m) and area (m^2) of
-    each panel of one wing: the planform-2 triangle (Oe 2010 eq. 3, chord ``W r / L`` at span ``r``)
+    """``(n, 4)``: chord position (m, + towards the leading edge), span position (m), area (m^2) and local chord
+    (m) of each panel of one wing: the planform-2 triangle (Oe 2010 eq. 3, chord ``W r / L`` at span ``r``)
     cut into ``n_strips`` strips (three Gauss points each) and each strip into ``n_chord`` Gauss-Legendre
     panels. The areas add up to the wing's ``W L / 2``."""
-    checks.whole("n_strips (strips per wing)", n_strips, 1, MAX_PANELS // 3)
-    checks.whole("n_chord (chordwise panels per strip)", n_chord, 1, MAX_PANELS // 3)
-    if 3 * n_strips * n_chord > MAX_PANELS:
-        raise UserError(f"a wing has at most {MAX_PANELS} panels (3 per strip and chordwise panel); "
-                        f"{n_strips} strips of {n_chord} panels make {3 * n_strips * n_chord}.")
+    _check_panels(n_strips, n_chord)
     r, dr = strip_nodes(params.span_m, n_strips, "gauss3")
     g, w = np.polynomial.legendre.leggauss(n_chord)
     chord = params.width_m * r / params.span_m
     xc = 0.5 * chord[:, None] * g[None, :]
     area = (chord * dr)[:, None] * (0.5 * w)[None, :]
-    return np.stack([xc.ravel(), np.repeat(r, n_chord), area.ravel()], axis=1)
+    local = np.repeat((params.width_m / params.span_m) * r, n_chord)
+    return np.stack([xc.ravel(), np.repeat(r, n_chord), area.ravel(), local], axis=1)
+
+
+def outline_panels(animal, n_strips: int = 8, n_chord: int = 2) -> np.ndarray:
+    """:func:`panels` of a measured wing outline (:class:`~lifelike_mj.butterfly.flight3d.animals.Animal`): at each
+    strip's Gauss points the chord runs from the outline's rearmost to its foremost point at that span (the
+    outlines here cross each span line once), cut into ``n_chord`` Gauss-Legendre panels."""
+    _check_panels(n_strips, n_chord)
+    r, dr = strip_nodes(animal.span_m, n_strips, "gauss3")
+    g, w = np.polynomial.legendre.leggauss(n_chord)
+    lo, hi = np.full(len(r), np.inf), np.full(len(r), -np.inf)
+    for poly in animal.surfaces:
+        a, b = poly, np.roll(poly, -1, axis=0)
+        for (xa, ya), (xb, yb) in zip(a, b):
+            if ya == yb:
+                hit = (r == ya)
+                xs = [np.where(hit, xa, np.nan), np.where(hit, xb, np.nan)]
+            else:
+                t = (r - ya) / (yb - ya)
+                xs = [np.where((t >= 0.0) & (t <= 1.0), xa + t * (xb - xa), np.nan)]
+            for x in xs:
+                lo, hi = np.fmin(lo, x), np.fmax(hi, x)
+    chord = hi - lo
+    xc = 0.5 * (lo + hi)[:, None] + 0.5 * chord[:, None] * g[None, :]
+    area = (chord * dr)[:, None] * (0.5 * w)[None, :]
+    return np.stack([xc.ravel(), np.repeat(r, n_chord), area.ravel(), np.repeat(chord, n_chord)], axis=1)
+
+
+def _check_panels(n_strips: int, n_chord: int) -> None:
+    checks.whole("n_strips (strips per wing)", n_strips, 1, MAX_PANELS // 3)
+    checks.whole("n_chord (chordwise panels per strip)", n_chord, 1, MAX_PANELS // 3)
+    if 3 * n_strips * n_chord > MAX_PANELS:
+        raise UserError(f"a wing has at most {MAX_PANELS} panels (3 per strip and chordwise panel); "
+                        f"{n_strips} strips of {n_chord} panels make {3 * n_strips * n_chord}.")
+
+
+def wing_triangles(params: ButterflyParams, animal: str = "swallowtail") -> tuple[np.ndarray, float]:
+    """The left wing's outline as triangles ``(n, 3, 2)`` (chord, span; m) and its area centroid's span (m):
+    the planform-2 triangle of ``params`` (hinge, then the tip chord's ends), or the species' outline."""
+    from lifelike_mj.butterfly.flight3d.animals import animal as _animal
+
+    a = _animal(animal)
+    if a.measured:
+        return a.triangles, float(a.moments["centroid_m"][1])
+    half = 0.5 * (params.width_m / params.span_m) * params.span_m
+    L = params.span_m
+    return np.array([[[0.0, 0.0], [-half, L], [half, L]]]), 2.0 * L / 3.0
 
 
 def driven_dofs(m: mujoco.MjModel, assist: str = "none") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -613,12 +764,20 @@ def driven_dofs(m: mujoco.MjModel, assist: str = "none") -> tuple[np.ndarray, np
 
 def setup_data(m: mujoco.MjModel, kinematics: Kinematics, params: ButterflyParams | None = None, *,
                force_law: str = "exact", air_m_s=(0.0, 0.0, 0.0), body_areas_m2=None, drag_frame: str = "body",
-               assist: str = "none", drive_hz: float = 50.0, n_strips: int = 8, n_chord: int = 2) -> mujoco.MjData:
-    """A fresh ``MjData`` of the 3D model, its userdata filled for the callback; the wings and abdomen at
-    the kinematics' angles and rates, the body at rest at the origin, level."""
+               assist: str = "none", drive_hz: float = 50.0, n_strips: int = 8, n_chord: int = 2,
+               animal: str = "swallowtail") -> mujoco.MjData:
+    """A fresh ``MjData`` of the 3D model of ``animal`` (built by :func:`build_model` for the same species), its
+    userdata filled for the callback; the wings and abdomen at the kinematics' angles and rates, the body at
+    rest at the origin, level. The paper's tip-speed law needs the swallowtail's triangle."""
+    from lifelike_mj.butterfly.flight3d.animals import animal as _animal
+
     p = params or ButterflyParams()
+    a = _animal(animal)
     if force_law not in FORCE_LAWS:
         raise UserError(f"unknown wing-force law {force_law!r}; choose one of: {', '.join(FORCE_LAWS)}.")
+    if force_law == "tip" and a.measured:
+        raise UserError(f"the paper's tip-speed law is for its triangular wing; the {a.name}'s measured wing takes "
+                        "'exact', 'strip' or 'quasi_steady'.")
     if drag_frame not in DRAG_FRAMES:
         raise UserError(f"unknown body-drag frame {drag_frame!r}; choose one of: {', '.join(DRAG_FRAMES)}.")
     if assist not in ASSISTS:
@@ -652,10 +811,17 @@ def setup_data(m: mujoco.MjModel, kinematics: Kinematics, params: ButterflyParam
     ud[U_DRIVEN_D : U_DRIVEN_D + len(driven)] = driven
     ud[U_FREE_D : U_FREE_D + len(free)] = free
     ud[U_ASSIST] = ASSISTS[assist]
-    pan = panels(p, n_strips, n_chord)
+    pan = outline_panels(a, n_strips, n_chord) if a.measured else panels(p, n_strips, n_chord)
     ud[U_WL] = p.width_m / p.span_m
     ud[U_NPANEL] = len(pan)
     ud[U_PANEL : U_PANEL + pan.size] = pan.ravel()
+    tris, rc = wing_triangles(p, a.name)
+    if len(tris) > MAX_TRIS:
+        raise UserError(f"a wing outline has at most {MAX_TRIS} triangles, the {a.name}'s has {len(tris)}.")
+    ud[U_NTRI], ud[U_RC] = len(tris), rc
+    ud[U_TRI : U_TRI + tris.size] = tris.ravel()
+    if a.measured:
+        ud[U_L] = a.span_m
     d.qpos[m.jnt_qposadr[m.joint("root").id] + 3] = 1.0
     ref = kinematics.joint_references()
     d.qpos[q] = ref[:, 0]

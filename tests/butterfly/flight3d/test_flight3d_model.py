@@ -202,7 +202,7 @@ def test_the_quasi_steady_law_gives_dickinsons_lift_and_drag_on_a_translating_wi
     U, a = 2.0, math.radians(alpha_deg)
     v = np.array([U * math.cos(a), 0.0, -U * math.sin(a)])  # forward and down: the air pushes it up
     out = np.empty(15)
-    mj3d.wing_panels(3, pan.ravel(), len(pan), 1.0, np.eye(3), v, np.zeros(3), p.rho, p.cd, p.width_m / p.span_m, out)
+    mj3d.wing_panels(3, pan.ravel(), len(pan), 1.0, np.eye(3), v, np.zeros(3), p.rho, p.cd, out)
     c_l, c_d = _fruitfly(alpha_deg)
     q = 0.5 * p.rho * U * U * 0.5 * p.width_m * p.span_m
     lift, drag, rot = out[6:9], out[9:12], out[12:15]
@@ -223,8 +223,7 @@ def test_the_rotational_force_of_a_pitching_wing_is_sane_and_dickinsons():
     v = np.array([U * math.cos(a), 0.0, -U * math.sin(a)])
     out = np.empty(15)
     # leading edge (+x) up, towards the pushed side +z: rotation about -y (the span axis is +y)
-    mj3d.wing_panels(3, pan.ravel(), len(pan), 1.0, np.eye(3), v, np.array([0.0, -w, 0.0]), p.rho, p.cd,
-                     p.width_m / p.span_m, out)
+    mj3d.wing_panels(3, pan.ravel(), len(pan), 1.0, np.eye(3), v, np.array([0.0, -w, 0.0]), p.rho, p.cd, out)
     # the flow across the span is the same at every panel (no rotation about other axes moves the span)
     integral = (p.width_m / p.span_m) ** 2 * p.span_m ** 3 / 3.0
     want = math.pi * 0.25 * p.rho * U * w * integral
@@ -232,13 +231,13 @@ def test_the_rotational_force_of_a_pitching_wing_is_sane_and_dickinsons():
 
 
 def _midpoint_panels(p, n):
-    """``n x n`` midpoint panels of the wing (chord position, span position, area), as :func:`mj3d.panels`."""
+    """``n x n`` midpoint panels of the wing (chord position, span position, area, chord), as :func:`mj3d.panels`."""
     r = (np.arange(n) + 0.5) / n * p.span_m
     g = (np.arange(n) + 0.5) / n * 2.0 - 1.0
     chord = p.width_m * r / p.span_m
     xc = 0.5 * chord[:, None] * g[None, :]
     area = np.repeat(chord * p.span_m / n / n, n)
-    return np.stack([xc.ravel(), np.repeat(r, n), area], axis=1)
+    return np.stack([xc.ravel(), np.repeat(r, n), area, np.repeat(chord, n)], axis=1)
 
 
 def test_the_exact_integral_of_eq_1_is_the_limit_of_ever_more_panels(model):
@@ -269,11 +268,12 @@ def test_the_exact_integral_of_eq_1_is_the_limit_of_ever_more_panels(model):
         lin = R @ np.array([rng.normal(), rng.normal(), s0])
         side = 1.0 if trial % 2 == 0 else -1.0
         exact = np.zeros(15)
-        mj3d.wing_exact(side, R, lin, omega, p.rho, p.cd, p.span_m, p.width_m / p.span_m, exact)
+        tris, rc = mj3d.wing_triangles(p)
+        mj3d.wing_exact(side, R, lin, omega, p.rho, p.cd, tris.ravel(), len(tris), rc, exact)
         for n in (10, 40, 160):
             got = np.zeros(15)
             pan = _midpoint_panels(p, n).ravel()
-            mj3d.wing_panels(2, pan, len(pan) // 3, side, R, lin, omega, p.rho, p.cd, p.width_m / p.span_m, got)
+            mj3d.wing_panels(2, pan, len(pan) // 4, side, R, lin, omega, p.rho, p.cd, got)
             err = max(np.abs(got[:3] - exact[:3]).max() / np.abs(exact[:3]).max(),
                       np.abs(got[3:6] - exact[3:6]).max() / np.abs(exact[3:6]).max())
             errors.setdefault(n, []).append(err)
