@@ -1,4 +1,4 @@
-"""``lifelike-mj butterfly fly3d | evolve3d | assess3d``: the butterfly in three dimensions."""
+"""``lifelike-mj butterfly fly3d | evolve3d | assess3d | measure3d``: the butterfly in three dimensions."""
 
 from __future__ import annotations
 
@@ -89,7 +89,7 @@ def cmd_evolve3d(args) -> None:
                        checkpoint=args.checkpoint, resume=args.resume, progress=not args.quiet,
                        overwrite=args.overwrite, task_set=args.tasks, start=start, gene_bound=args.gene_bound,
                        inputs=args.inputs, executor=args.executor, workers=args.workers, ray_address=args.ray_address,
-                       dt_s=args.dt)
+                       dt_s=args.dt, animal=args.animal)
     if ctrl is None:
         raise KeyboardInterrupt("stopped before the first generation was evaluated; nothing was written")
     state = "stopped early (Ctrl-C); best so far" if res.interrupted else "done"
@@ -122,6 +122,25 @@ def cmd_assess3d(args) -> None:
              + "; ".join(f"turn {t['angle_deg']:+.0f} deg in {t['turn_time_s']:.1f} s, held within "
                          f"{t['held_error_max_deg']:.1f} deg" for t in turns)
              + "; courses: " + ", ".join(f"seed {c['seed']} {c['passed']}/{c['waypoints']}" for c in courses))
+    emit(args, d, human)
+
+
+def cmd_measure3d(args) -> None:
+    from lifelike_mj.butterfly.flight3d.controllers import load_controller
+    from lifelike_mj.butterfly.flight3d.measures import check_window, level_measures
+
+    check_window("the measures", args.settle + args.window, args.settle, 0.5, "they measure whole wing beats")
+    ctrl = load_controller(args.controller)
+    with stage(f"level flight at {args.speed:g} m/s, {args.settle + args.window:g} s"):
+        m = level_measures(ctrl, args.speed, args.settle, args.window, dt_s=args.dt)
+    d = {"controller": ctrl.name or args.controller, **m}
+    human = (f"{d['controller']} ({m['animal']}) level at {args.speed:g} m/s over {m['beats']} beats: "
+             f"{m['flap_frequency_hz']:.2f} Hz, strokes left {m['stroke_left_deg']:.0f} / right "
+             f"{m['stroke_right_deg']:.0f} deg, dorsal gap {m['dorsal_gap_deg']:.0f} deg, mean roll "
+             f"{m['roll_mean_deg']:+.1f} deg, body angle {m['body_angle_deg']:.1f} deg, bobbing {m['bobbing_mm']:.1f} mm, "
+             f"abdomen {m['abdomen_mean_deg']:+.0f} +- {m['abdomen_swing_deg']:.0f} deg, power "
+             f"{m['power_W_kg']:.1f} W/kg ({m['power_net_W_kg']:.1f} net), J {m['advance_ratio']:.2f} at "
+             f"{m['air_speed_m_s']:.2f} m/s through the air")
     emit(args, d, human)
 
 
@@ -239,6 +258,9 @@ def add_commands(bf) -> None:
     p.add_argument("--inputs", default=None, choices=("ground", "air"),
                    help="the network's speeds over the ground or through the air (default: the start's, else ground)")
     p.add_argument("--start", default=None, help="a 3D controller to start from (its network; genes are its changes)")
+    p.add_argument("--animal", default=None, choices=("swallowtail", "monarch"),
+                   help="the butterfly: swallowtail (the paper's triangular wings) or monarch (measured wings, masses "
+                        "and stroke plane); default: the start's, else swallowtail")
     p.add_argument("--gene-bound", type=num(0, 10, lo_open=True), default=0.4,
                    help="bound of each gene (a weight's change from the start)")
     p.add_argument("--hidden", type=_hidden, default=[], help="hidden layer sizes, e.g. 16 (default: none, a linear network)")
@@ -279,6 +301,16 @@ def add_commands(bf) -> None:
     _add_dt(p)
     add_json(p)
     p.set_defaults(func=cmd_assess3d)
+    p = bf.add_parser("measure3d", help="how natural a 3D controller's level flight is: roll, strokes, dorsal gap, "
+                                        "body angle, bobbing, abdomen, power, advance ratio")
+    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name or a file")
+    p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s")
+    p.add_argument("--settle", type=num(0, MAX_DURATION_S, unit="s"), default=5.0, help="seconds of settling first")
+    p.add_argument("--window", type=num(0, 600, lo_open=True, unit="s"), default=5.0,
+                   help="seconds measured after settling (whole wing beats)")
+    _add_dt(p)
+    add_json(p)
+    p.set_defaults(func=cmd_measure3d)
 
 
 HELP = "the butterfly in three dimensions: one on a task, or a garden of them"

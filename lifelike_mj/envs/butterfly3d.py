@@ -127,7 +127,8 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
     ``controller``: a 3D controller (name, path or object) whose base
     command, action scales, rate ``every``, kinematics bandwidth and ``inputs`` the environment takes (default:
     a new controller's: the paper's 10 Hz flap, ``every=1``, speeds over the ground); ``every`` and ``inputs``
-    override it. Rendering: ``render_mode`` ``"rgb_array"`` (offscreen frames of ``width`` x ``height``, EGL or
+    override it; ``animal`` the butterfly flown (``"swallowtail"`` or ``"monarch"``; default the controller's).
+    Rendering: ``render_mode`` ``"rgb_array"`` (offscreen frames of ``width`` x ``height``, EGL or
     OSMesa, no display needed; a camera following the butterfly) or ``"human"`` (the MuJoCo viewer).
 
     ## Version history
@@ -141,7 +142,7 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
     def __init__(self, task: str | flight3d.Task3D = "level", speed_m_s: float = 1.5, angle_deg: float = 90.0,
                  flutter: float = 0.0, duration_s: float = 4.0, dt_s: float = flight3d.DT_S, controller=None,
                  every: int | None = None, inputs: str | None = None, render_mode: str | None = None,
-                 width: int = 640, height: int = 480) -> None:
+                 width: int = 640, height: int = 480, animal: str | None = None) -> None:
         self.task = self._check_task(task)
         self.speed_m_s = checks.number("speed_m_s", speed_m_s, 0.0, 10.0, lo_open=True, unit="m/s")
         self.angle_deg = checks.number("angle_deg", angle_deg, -360.0, 360.0, unit="deg")
@@ -153,10 +154,10 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
         ctl = controller if isinstance(controller, flight3d.Controller3D) else (
             flight3d.load_controller(controller) if controller is not None else
             flight3d.Controller3D([flight3d.N_OBS, flight3d.N_ACT], np.zeros(flight3d.n_weights([10, 9]))))
-        if every is not None or inputs is not None:
+        if every is not None or inputs is not None or animal is not None:
             ctl = flight3d.Controller3D(ctl.layers, ctl.weights, ctl.base, dict(zip(flight3d.ACTION_NAMES, ctl.scale)),
                                         ctl.every if every is None else every, ctl.omega_c_rad_s, ctl.provenance,
-                                        ctl.name, inputs or ctl.inputs)
+                                        ctl.name, inputs or ctl.inputs, animal or ctl.animal)
         self.controller = ctl
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise UserError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}.")
@@ -180,7 +181,7 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
         chosen = (options or {}).get("task")
         self.episode_task = self.draw_task(self.np_random, self.task if chosen is None else self._check_task(chosen))
         if self._model is None:
-            self._model = flight3d.build_model()
+            self._model = flight3d.build_model(animal=self.controller.animal)
         self.flight = flight3d.Flight3D(controller=self.controller, task=self.episode_task, dt_s=self.dt_s,
                                         end_on_tumble=True, _model=self._model)
         obs = self.flight.decide(max_steps=self.n_steps)
@@ -293,7 +294,7 @@ class ButterflyFlight3DVectorEnv(VectorEnv):
         self.observation_space = batch_space(self.single_observation_space, num_envs)
         self.action_space = batch_space(self.single_action_space, num_envs)
         s = self.single
-        self._model = flight3d.build_model()
+        self._model = flight3d.build_model(animal=s.controller.animal)
         self._model.opt.timestep = s.dt_s
         self._model.opt.gravity[:] = (0.0, 0.0, -ButterflyParams().gravity)
         self._rows = COURSE_WAYPOINTS
@@ -350,7 +351,7 @@ class ButterflyFlight3DVectorEnv(VectorEnv):
         from lifelike_mj.butterfly.flight3d import model as mj3d
 
         c = self.single.controller
-        return mj3d.setup_data(self._model, flight3d.Kinematics(c.base, c.omega_c_rad_s))
+        return mj3d.setup_data(self._model, flight3d.Kinematics(c.base, c.omega_c_rad_s), animal=c.animal)
 
     def _reset_one(self, i: int) -> None:
         b, s = self._batch, self.single

@@ -148,6 +148,10 @@ CASES = [
     (["butterfly", "garden", "--flutter", "2"], "--flutter", {}),
     (["butterfly", "garden", "--paths", "p.png"], "already exists", {"p.png": "x"}),
     (["butterfly", "assess3d", "--courses", "x"], "--courses", {}),
+    (["butterfly", "evolve3d", "--animal", "moth"], "invalid choice", {}),
+    (["butterfly", "measure3d", "--window", "0"], "--window", {}),
+    (["butterfly", "measure3d", "--settle", "1", "--window", "0.2"], "needs a duration of at least 1.5 s", {}),
+    (["butterfly", "measure3d", "--controller", "nope"], "nope", {}),
     # --- fish
     (SWIM + ["--fish", "0"], "--fish", {}),
     (SWIM + ["--fish", "10000000"], "from 1 to 5,000", {}),

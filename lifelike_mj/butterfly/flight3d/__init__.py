@@ -20,6 +20,8 @@ Evolve a controller of your own (``lifelike-mj butterfly evolve3d`` does the sam
 
 What is here, one layer on the next:
 
+* :mod:`~lifelike_mj.butterfly.flight3d.animals`: the butterflies, the paper's swallowtail and the monarch with
+  its measured wings (:data:`ANIMALS`, :func:`animal`);
 * :mod:`~lifelike_mj.butterfly.flight3d.kinematics`: the flap, feathering and abdomen kinematics
   (:class:`KinematicsCommand`, :class:`Kinematics`);
 * :mod:`~lifelike_mj.butterfly.flight3d.model`: the MuJoCo model and its compiled air-force callback;
@@ -30,6 +32,7 @@ What is here, one layer on the next:
 * :mod:`~lifelike_mj.butterfly.flight3d.loop`: the compiled loop and the one owner of its state,
   :class:`Batch` (a flight is a batch of one, a garden a batch of n, an evolution candidates x tasks);
 * :mod:`~lifelike_mj.butterfly.flight3d.flight`: the stepper :class:`Flight3D`;
+* :mod:`~lifelike_mj.butterfly.flight3d.measures`: how natural a flight is (:func:`level_measures`);
 * :mod:`~lifelike_mj.butterfly.flight3d.garden`: :class:`Garden`, many butterflies among flowers;
 * :mod:`~lifelike_mj.butterfly.flight3d.evolution`: :class:`FlightProblem3D`, :data:`TASK_SETS`, :func:`evolve`;
 * :mod:`~lifelike_mj.butterfly.flight3d.validate`: the checks of a controller (level, turn, course, the
@@ -52,4 +55,6 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "FlightProblem3D": "evolution", "TASK_SETS": "evolution", "evolve": "evolution", "pd_prior": "evolution",
     "kinematics": ".", "model": ".", "tasks": ".", "controllers": ".", "loop": ".", "flight": ".", "garden": ".",
     "evolution": ".", "validate": ".", "figures": ".", "timing": ".", "view": ".", "view_flight3d": "view",
+    "animals": ".", "measures": ".", "Animal": "animals", "ANIMALS": "animals", "animal": "animals",
+    "level_measures": "measures", "default_base": "controllers",
 }, globals())

@@ -60,11 +60,26 @@ DEFAULT_SCALE = {"offset_sym": 0.3, "offset_asym": 0.3, "amplitude_sym": 0.3, "a
                  "feather_asym": 0.3, "feather_amplitude": 0.3, "abdomen_mean": 0.8, "frequency": 3.0}
 
 
-def default_base():
-    """The base command of the shipped 3D controllers: the paper's 10 Hz flap over [-60, 75] deg (Oe 2010
-    section 6), feathered by 0.3 rad a quarter beat ahead (leading edge down on the downstroke)."""
+def default_base(animal: str = "swallowtail"):
+    """The base command a new 3D controller starts from, per butterfly.
+
+    * ``"swallowtail"`` (the shipped controllers'): the paper's 10 Hz flap over [-60, 75] deg (Oe 2010 section 6),
+      feathered by 0.3 rad a quarter beat ahead (leading edge down on the downstroke), the abdomen still.
+    * ``"monarch"``: the filmed monarch's envelope (the FWUAV group's fit of a free flight): 10.2 Hz; a 120 deg
+      stroke (+-60 deg) about +8 deg, so that the wings stop 44 deg apart at the top (a cruising butterfly's
+      dorsal gap, 35-50 deg, no clap) and reach -52 deg at the bottom; feathering +-39 deg a quarter beat ahead;
+      the abdomen flexed 17 deg down (its mean ventral flexion), swinging +-14 deg, most flexed just after the
+      top of the stroke (roughly against the wings)."""
+    from lifelike_mj.butterfly.flight3d.animals import animal as _animal
     from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
 
+    if _animal(animal).name == "monarch":
+        amp, off = math.radians(60.0), math.radians(8.0)
+        feather = math.radians(39.0)
+        return KinematicsCommand(frequency_hz=10.2, offset_left=off, offset_right=off, amplitude_left=amp,
+                                 amplitude_right=amp, feather_amplitude_left=feather, feather_amplitude_right=feather,
+                                 feather_phase=-math.pi / 2, abdomen_mean=-math.radians(17.0),
+                                 abdomen_amplitude=math.radians(14.0), abdomen_phase=math.pi - 0.6)
     return KinematicsCommand(feather_amplitude_left=0.3, feather_amplitude_right=0.3, feather_phase=-math.pi / 2)
 
 
@@ -72,11 +87,12 @@ class Controller3D:
     """A 3D controller: a network from the observation to the action (module docstring), the base command
     and the actions' scales, how often it runs (``every`` steps), how fast the kinematics follow
     (``omega_c_rad_s``) and what its speeds are measured against (``inputs``: ``"ground"`` or ``"air"``), with
-    its provenance. Plain data: :meth:`to_dict` / :func:`controller_from_dict`."""
+    its provenance, and the butterfly it flies (``animal``, one of
+    :data:`~lifelike_mj.butterfly.flight3d.animals.ANIMALS`). Plain data: :meth:`to_dict` / :func:`controller_from_dict`."""
 
     def __init__(self, layers, weights, base=None, scale: dict | None = None, every: int = 1,
                  omega_c_rad_s: float = 2.0 * math.pi * 10.0, provenance: dict | None = None, name: str = "",
-                 inputs: str = "ground") -> None:
+                 inputs: str = "ground", animal: str = "swallowtail") -> None:
         from lifelike_mj import checks
         from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
         from lifelike_mj.errors import UserError
@@ -102,7 +118,7 @@ class Controller3D:
             raise UserError(f"{where}: layers {layers} need {n_weights(layers)} finite weights, each within "
                             f"+-{MAX_WEIGHT:g}, got {len(self.weights)}"
                             + ("" if len(self.weights) != n_weights(layers) else " with one beyond") + ".")
-        self.base = base if base is not None else default_base()
+        self.base = base if base is not None else default_base(animal)
         if not isinstance(self.base, KinematicsCommand):
             raise UserError(f"{where}: the base is a KinematicsCommand, got {self.base!r}.")
         if scale is not None and not isinstance(scale, dict):
@@ -119,6 +135,9 @@ class Controller3D:
         if inputs not in INPUTS:
             raise UserError(f"{where}: inputs are {' or '.join(repr(v) for v in INPUTS)}, got {inputs!r}.")
         self.inputs = inputs
+        from lifelike_mj.butterfly.flight3d.animals import animal as _animal
+
+        self.animal = _animal(animal).name
         self.provenance = dict(provenance or {})
 
     def to_dict(self) -> dict:
@@ -127,7 +146,8 @@ class Controller3D:
         return {"format": FORMAT, "version": 1, "layers": [int(v) for v in self.layers],
                 "weights": [float(v) for v in self.weights], "base": asdict(self.base),
                 "scale": dict(zip(ACTION_NAMES, (float(v) for v in self.scale))), "every": self.every,
-                "omega_c_rad_s": self.omega_c_rad_s, "inputs": self.inputs, "provenance": self.provenance}
+                "omega_c_rad_s": self.omega_c_rad_s, "inputs": self.inputs, "animal": self.animal,
+                "provenance": self.provenance}
 
     @property
     def air_inputs(self) -> bool:
@@ -137,12 +157,13 @@ class Controller3D:
     def with_weights(self, weights, inputs: str | None = None) -> Controller3D:
         """The same controller with other weights (and, given ``inputs``, other inputs)."""
         return Controller3D(self.layers, weights, self.base, dict(zip(ACTION_NAMES, self.scale)), self.every,
-                            self.omega_c_rad_s, self.provenance, self.name, inputs or self.inputs)
+                            self.omega_c_rad_s, self.provenance, self.name, inputs or self.inputs, self.animal)
 
 
 def json_schema() -> dict:
     """The JSON Schema of a 3D controller file (``docs/schemas/butterfly3d-controller.schema.json``): what
     :func:`controller_from_dict` enforces before building the controller."""
+    from lifelike_mj.butterfly.flight3d.animals import ANIMALS
     from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
     from lifelike_mj.schema import document_schema, number
 
@@ -162,6 +183,8 @@ def json_schema() -> dict:
         "omega_c_rad_s": number("rad/s: how fast the kinematics follow a command", maximum=MAX_OMEGA_C,
                                 exclusive_minimum=0.0),
         "inputs": {"enum": list(INPUTS), "description": "the network's speeds over the ground or through the air"},
+        "animal": {"enum": list(ANIMALS), "description": "the butterfly it flies (module "
+                   "lifelike_mj.butterfly.flight3d.animals); missing: the paper's swallowtail"},
         "provenance": {"type": "object"},
     }
     return document_schema(FORMAT, "lifelike-mj 3D butterfly controller", props, ["layers", "weights"],
@@ -182,7 +205,8 @@ def controller_from_dict(data: object, name: str = "") -> Controller3D:
     if base is not None:
         base = KinematicsCommand(**{k: float(v) for k, v in base.items()})
     return Controller3D(d["layers"], d["weights"], base, d.get("scale"), d.get("every", 1),
-                        d.get("omega_c_rad_s", 2.0 * math.pi * 10.0), d.get("provenance"), name, d.get("inputs", "ground"))
+                        d.get("omega_c_rad_s", 2.0 * math.pi * 10.0), d.get("provenance"), name, d.get("inputs", "ground"),
+                        d.get("animal", "swallowtail"))
 
 
 def load_controller(name_or_path) -> Controller3D:

@@ -92,7 +92,9 @@ class FlightProblem3D:
                 "force_law": self.force_law, "n_strips": self.n_strips, "n_chord": self.n_chord, "layers": t["layers"],
                 "base": t["base"],
                 "scale": t["scale"], "every": t["every"], "omega_c_rad_s": t["omega_c_rad_s"],
-                "prior_sha256": hashlib.sha256(np.asarray(self.prior).tobytes()).hexdigest()}
+                "prior_sha256": hashlib.sha256(np.asarray(self.prior).tobytes()).hexdigest(),
+                # the butterfly, named where it is not the swallowtail (earlier problems' fingerprints hold)
+                **({"animal": self.template.animal} if self.template.animal != "swallowtail" else {})}
 
     def fingerprint(self) -> str:
         return hashlib.sha256(json.dumps(self.describe(), sort_keys=True).encode()).hexdigest()
@@ -105,7 +107,7 @@ class FlightProblem3D:
         if self._model is None:
             from lifelike_mj.butterfly.flight3d import model as mj3d
 
-            self._model = mj3d.build_model(self.params)
+            self._model = mj3d.build_model(self.params, animal=self.template.animal)
             self._model.opt.timestep = self.dt_s
         return self._model
 
@@ -122,7 +124,7 @@ class FlightProblem3D:
         tasks = np.tile(np.array([t.as_array(max_rows) for t in self.tasks]), (len(W), 1))
         ctl = self.template
         datas = [mj3d.setup_data(m, Kinematics(ctl.base, ctl.omega_c_rad_s), self.params, force_law=self.force_law,
-                                 n_strips=self.n_strips, n_chord=self.n_chord) for _ in range(n)]
+                                 n_strips=self.n_strips, n_chord=self.n_chord, animal=ctl.animal) for _ in range(n)]
         batch = Batch(m, datas, tasks, ctl, weights=np.repeat(W, k, axis=0), dt_s=self.dt_s,
                       records=new_record(n, max_rows), tumble_rad=TUMBLE_RAD)
         batch.advance(int(round(self.duration_s / self.dt_s)))
@@ -168,7 +170,7 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
            gene_bound: float = 0.4, checkpoint: str | Path | None = None, resume: bool = False, progress: bool = True,
            overwrite: bool = False, task_set: str = "custom", on_generation=None, start: c3.Controller3D | None = None,
            inputs: str | None = None, executor: str = "serial", workers: int | None = None,
-           ray_address: str | None = None, dt_s: float = DT_S):
+           ray_address: str | None = None, dt_s: float = DT_S, animal: str | None = None):
     """Evolve a 3D controller on ``tasks`` (default: the ``steer`` set) with ``optimizer`` and write it to
     ``out`` with its provenance (the problem, the optimiser, the budget, the time it took, the fitness
     history). Returns ``(result, controller)``; nothing is overwritten unasked (the checks and locks of the
@@ -180,7 +182,10 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     every core: the fastest on one machine), ``"process"`` (a pool of ``workers`` processes, one thread each) or
     ``"ray"`` (a Ray cluster, ``ray_address`` to join one). Every executor gives the same result for the same
     seed, bit for bit: each flight is independent of how the generation is split. ``dt_s``: the time step of the
-    training flights (default :data:`~lifelike_mj.butterfly.flight3d.flight.DT_S`)."""
+    training flights (default :data:`~lifelike_mj.butterfly.flight3d.flight.DT_S`). ``animal``: the butterfly
+    (:data:`~lifelike_mj.butterfly.flight3d.animals.ANIMALS`; default the start's, else the swallowtail); a new
+    controller starts from that butterfly's base kinematics
+    (:func:`~lifelike_mj.butterfly.flight3d.controllers.default_base`)."""
     from lifelike_mj import provenance as _prov
     from lifelike_mj.evolve import make_evaluator, optimize
     from lifelike_mj.evolve.checkpoint import guarded_run_files
@@ -193,12 +198,15 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     if start is not None:
         template = start
         layers = [int(v) for v in start.layers]
-        if inputs is not None:
-            template = start.with_weights(start.weights, inputs=inputs)
+        if inputs is not None or animal is not None:
+            template = c3.Controller3D(start.layers, start.weights, start.base, dict(zip(c3.ACTION_NAMES, start.scale)),
+                                       start.every, start.omega_c_rad_s, start.provenance, start.name,
+                                       inputs or start.inputs, animal or start.animal)
     else:
         layers = [int(v) for v in layers]
+        animal = animal or "swallowtail"
         template = c3.Controller3D(layers, pd_prior(layers) if len(layers) >= 2 and layers[0] == c3.N_OBS else [],
-                                   inputs=inputs or "ground")
+                                   c3.default_base(animal), inputs=inputs or "ground", animal=animal)
     problem = FlightProblem3D(tuple(tasks), template, duration_s=duration_s, gene_bound=gene_bound, dt_s=dt_s)
     out = Path(out)
     with guarded_run_files(out, checkpoint, resume=resume, overwrite=overwrite) as ckpt:

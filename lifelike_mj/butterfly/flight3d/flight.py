@@ -106,6 +106,8 @@ class Flight3D(StepCounter):
     paper's ``A_b`` on every axis), ``masses`` (``animal`` or ``paper``), ``n_strips`` and ``n_chord`` (panels
     per wing, for the panel laws), ``drive_hz`` (the joints' tracking bandwidth), ``omega_c`` (rad/s, how
     fast the kinematics follow a command; default the controller's, else one wing beat).
+    ``animal``: the butterfly (``"swallowtail"``, the paper's, or ``"monarch"``, with measured wings:
+    :mod:`~lifelike_mj.butterfly.flight3d.animals`); default the controller's, else the swallowtail.
     ``end_on_tumble``: a roll or pitch beyond :data:`~lifelike_mj.butterfly.flight3d.loop.TUMBLE_RAD` ends the
     flight there (as in an evolution; :attr:`tumbled`), else it flies on.
     ``assist="hold"`` holds the attitude at ``pitch_law(flight)`` (rad, nose up), set once per step, roll
@@ -119,7 +121,7 @@ class Flight3D(StepCounter):
                  start_m=(0.0, 0.0, 0.0), force_law: str = "exact", drag_frame: str = "body",
                  body_areas_m2=None, masses: str = "animal", dt_s: float = DT_S, n_strips: int = 8,
                  n_chord: int = 2, drive_hz: float = 50.0, omega_c: float | None = None, assist: str = "none",
-                 pitch_law: Callable | None = None, end_on_tumble: bool = False,
+                 pitch_law: Callable | None = None, end_on_tumble: bool = False, animal: str | None = None,
                  _model: mujoco.MjModel | None = None) -> None:
         self.network = None
         if isinstance(controller, (str, Path)):
@@ -131,6 +133,12 @@ class Flight3D(StepCounter):
         elif controller is not None and not callable(controller):
             raise UserError(f"a controller is a 3D controller or a function of the flight returning a command, "
                             f"got {controller!r}.")
+        from lifelike_mj.butterfly.flight3d.animals import animal as _animal
+
+        #: The butterfly flown (:data:`~lifelike_mj.butterfly.flight3d.animals.ANIMALS`): given, else the 3D
+        #: controller's, else the paper's swallowtail.
+        self.animal = _animal(animal if animal is not None else
+                              (self.network.animal if self.network is not None else "swallowtail")).name
         self.command = command or KinematicsCommand()
         if not isinstance(self.command, KinematicsCommand):
             raise UserError(f"a kinematics command is a KinematicsCommand, got {self.command!r}.")
@@ -155,10 +163,10 @@ class Flight3D(StepCounter):
         self.start_m = np.array(checks.vector("start_m", start_m, 3), dtype=float)
         self.options = {"force_law": force_law, "drag_frame": drag_frame, "body_areas_m2": body_areas_m2,
                         "assist": assist, "drive_hz": checks.positive("drive_hz", drive_hz, "Hz"),
-                        "n_strips": n_strips, "n_chord": n_chord}
+                        "n_strips": n_strips, "n_chord": n_chord, "animal": self.animal}
         self.masses, self.omega_c, self.pitch_law = masses, omega_c, pitch_law
         self.end_on_tumble = bool(end_on_tumble)
-        self._model = _model if _model is not None else mj3d.build_model(self.params, masses)
+        self._model = _model if _model is not None else mj3d.build_model(self.params, masses, self.animal)
         self._model.opt.timestep = self.dt
         self._model.opt.gravity[:] = (0.0, 0.0, -self.params.gravity)
         self._root_q = int(self._model.jnt_qposadr[self._model.joint("root").id])

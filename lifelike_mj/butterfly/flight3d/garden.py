@@ -66,8 +66,8 @@ def course_among(blossoms: np.ndarray, seed: int, length: int = COURSE_LENGTH) -
     return blossoms[order[:length]] + np.array([0.0, 0.0, 0.15])
 
 
-def scene_model(n: int, blossoms: np.ndarray, size_m: float = 8.0) -> mujoco.MjModel:
-    """The drawing scene: the ground, the flowers (a stem and a blossom each) and ``n`` butterflies
+def scene_model(n: int, blossoms: np.ndarray, size_m: float = 8.0, animal: str = "swallowtail") -> mujoco.MjModel:
+    """The drawing scene: the ground, the flowers (a stem and a blossom each) and ``n`` butterflies of ``animal``
     (bodies ``b{i}_butterfly``), a fixed camera ``overview``."""
     spec = mujoco.MjSpec.from_file(str(mj3d.model_path()))
     spec.delete(spec.body("butterfly"))
@@ -88,9 +88,11 @@ def scene_model(n: int, blossoms: np.ndarray, size_m: float = 8.0) -> mujoco.MjM
         spec.worldbody.add_geom(name=f"heart_{k}", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.015, 0, 0],
                                 pos=[b[0], b[1], b[2] + 0.01], rgba=(0.95, 0.8, 0.1, 1), contype=0, conaffinity=0)
     for i in range(n):
-        one = mujoco.MjSpec.from_file(str(mj3d.model_path()))
-        one.material("wing").rgba = _WING_COLOURS[i % len(_WING_COLOURS)]
+        one = mj3d.build_spec(animal=animal)
+        if animal == "swallowtail":
+            one.material("wing").rgba = _WING_COLOURS[i % len(_WING_COLOURS)]
         one.visual.map.znear = spec.visual.map.znear  # the scene's (no attach conflict)
+        one.nuserdata = spec.nuserdata
         spec.worldbody.add_frame().attach_body(one.body("butterfly"), f"b{i}_", "")
     d = 0.6 * size_m
     cam = spec.worldbody.add_camera(name="overview", pos=[-d, -d, 0.55 * d])
@@ -128,10 +130,10 @@ class Garden(StepCounter):
                                 wind_to_m_s=wind, gust_m_s=gust_m_s, gust_vertical_m_s=gust_vertical_m_s,
                                 flutter=flutter,
                                 seed=(self.seed * 1000 + i) % 2**32) for i in range(self.n)]
-        self._phys = mj3d.build_model()
+        self._phys = mj3d.build_model(animal=self.controller.animal)
         self._phys.opt.timestep = self.dt
         self._n_strips, self._n_chord, self._force_law = n_strips, n_chord, force_law
-        self._model = scene_model(self.n, self.blossoms, self.size_m)
+        self._model = scene_model(self.n, self.blossoms, self.size_m, self.controller.animal)
         self._data = mujoco.MjData(self._model)
         self._blocks = [int(self._model.jnt_qposadr[self._model.joint(f"b{i}_root").id]) for i in range(self.n)]
         self._task_arr = np.array([t.as_array(COURSE_LENGTH) for t in self.tasks])
@@ -157,7 +159,7 @@ class Garden(StepCounter):
         self._datas = []
         for task in self.tasks:
             d = mj3d.setup_data(self._phys, Kinematics(ctl.base, ctl.omega_c_rad_s), force_law=self._force_law,
-                                n_strips=self._n_strips, n_chord=self._n_chord)
+                                n_strips=self._n_strips, n_chord=self._n_chord, animal=ctl.animal)
             a = rng.uniform(0, 2 * math.pi)
             start = np.array([0.6 * self.size_m * math.cos(a), 0.6 * self.size_m * math.sin(a), rng.uniform(-0.2, 0.2)])
             first = np.array(task.rows[0])

@@ -573,13 +573,20 @@ def model_path():
 
 def build_model(params: ButterflyParams | None = None, masses: str = "animal", animal: str = "swallowtail"
                 ) -> mujoco.MjModel:
-    """Compile the 3D model of ``animal`` (one of :data:`~lifelike_mj.butterfly.flight3d.animals.ANIMALS`).
+    """Compile the 3D model of ``animal`` (one of :data:`~lifelike_mj.butterfly.flight3d.animals.ANIMALS`):
+    :func:`build_spec`, compiled."""
+    return build_spec(params, masses, animal).compile()
 
-    The swallowtail: the model file with the constants of ``params`` applied through ``MjSpec``: the wing meshes
-    and tip sites scaled to ``L`` and ``W``; the parts' masses scaled to add up to ``m`` in the model file's
-    proportions (``masses="animal"``), or all of ``m`` in the thorax (``"paper"``). A measured species
-    (the monarch): its own body, masses, hinges, stroke plane and wing outline (:func:`_apply_animal`);
-    ``params`` then only give the air and gravity."""
+
+def build_spec(params: ButterflyParams | None = None, masses: str = "animal", animal: str = "swallowtail"
+               ) -> mujoco.MjSpec:
+    """The 3D model of ``animal``, before compiling.
+
+    The swallowtail: the model file with the constants of ``params`` applied: the wing meshes and tip sites
+    scaled to ``L`` and ``W``; the parts' masses scaled to add up to ``m`` in the model file's proportions
+    (``masses="animal"``), or all of ``m`` in the thorax (``"paper"``). A measured species (the monarch): its own
+    body, masses, hinges, stroke plane and wing outline (:func:`_apply_animal`); ``params`` then only give the
+    air and gravity."""
     from lifelike_mj.butterfly.flight3d.animals import animal as _animal
 
     p = params or ButterflyParams()
@@ -592,7 +599,7 @@ def build_model(params: ButterflyParams | None = None, masses: str = "animal", a
         if masses != "animal":
             raise UserError(f"the {masses!r} mass layout is the paper's swallowtail's; the {a.name} has its own masses.")
         _apply_animal(spec, a)
-        return spec.compile()
+        return spec
     geoms = {name: spec.geom(name) for name in _MASS_GEOMS}
     if masses == "animal":
         scale = p.mass_kg / sum(g.mass for g in geoms.values())
@@ -606,7 +613,7 @@ def build_model(params: ButterflyParams | None = None, masses: str = "animal", a
     for side, sign in (("left", 1.0), ("right", -1.0)):
         spec.mesh(f"wing_{side}").scale = [p.width_m, p.span_m, 1.0]
         spec.site(f"wing_{side}_tip").pos = [0.0, sign * p.span_m, 0.0]
-    return spec.compile()
+    return spec
 
 
 #: Half the thickness (m) of the drawn wing: a flat slab, so that it has a volume and both faces.
@@ -799,7 +806,9 @@ def setup_data(m: mujoco.MjModel, kinematics: Kinematics, params: ButterflyParam
     ud[U_AIR : U_AIR + 3] = air_m_s
     ud[U_RHO], ud[U_CD], ud[U_KHALF], ud[U_L] = p.rho, p.cd, 0.5 * p.k_wings, p.span_m
     ud[U_CP] = CP_FRACTION * p.span_m
-    ud[U_AB : U_AB + 3] = (p.body_area_m2,) * 3 if body_areas_m2 is None else body_areas_m2
+    if body_areas_m2 is None:
+        body_areas_m2 = a.body_areas_m2() if a.measured else (p.body_area_m2,) * 3
+    ud[U_AB : U_AB + 3] = body_areas_m2
     ud[U_THORAX] = m.body("butterfly").id
     ud[U_WING : U_WING + 2] = (m.body("wing_left").id, m.body("wing_right").id)
     ud[U_NQ], ud[U_NV], ud[U_NBODY] = m.nq, m.nv, m.nbody

@@ -15,7 +15,7 @@ import numpy as np
 from lifelike_mj import checks
 from lifelike_mj.butterfly.controllers import ButterflyController
 from lifelike_mj.butterfly.flight import pitch_command
-from lifelike_mj.errors import UserError
+from lifelike_mj.butterfly.flight3d.measures import MAX_CHECK_S, check_window
 
 
 def kinematics_of(controller: ButterflyController):
@@ -77,23 +77,11 @@ def _beat_means(t: np.ndarray, x: np.ndarray, period_s: float) -> tuple[np.ndarr
     return ts, xs
 
 
-#: The longest flight a check flies (s).
-MAX_CHECK_S = 3600.0
 
 
 def _every_10_ms(flight) -> int:
     """Steps between two samples 10 ms apart (12 at 1/1200 s), as :meth:`Flight3D.record` samples by default."""
     return max(1, round(0.01 / flight.dt))
-
-
-def check_window(what: str, duration_s: float, settle_s: float, least_s: float, why: str) -> None:
-    """Before a check flies: :class:`UserError` unless its ``duration_s`` is finite, at most :data:`MAX_CHECK_S`,
-    and leaves at least ``least_s`` after its own settling time ``settle_s`` (``why``: what it measures then)."""
-    checks.number(f"{what}'s settling time", settle_s, 0.0, MAX_CHECK_S, unit="s")
-    d = checks.number(f"{what}'s duration", duration_s, 0.0, MAX_CHECK_S, lo_open=True, unit="s")
-    if d < settle_s + least_s:
-        raise UserError(f"{what} needs a duration of at least {settle_s + least_s:g} s ({settle_s:g} s of settling "
-                        f"and {least_s:g} s to measure{'; ' + why if why else ''}), got {d:g} s.")
 
 
 def level_check(controller, speed_m_s: float = 1.5, duration_s: float = 60.0, settle_s: float = 5.0, **flight) -> dict:

@@ -220,3 +220,26 @@ def test_measured_wings_refuse_the_papers_tip_law_and_mass_layout(monarch_model)
         mj3d.build_model(masses="paper", animal="monarch")
     with pytest.raises(UserError, match="unknown butterfly 'monach'.*monarch"):
         animals.animal("monach")
+
+
+def test_a_controller_carries_its_butterfly_through_its_file_and_into_a_flight(tmp_path):
+    """A controller evolved on the monarch says so in its file; loading it flies the monarch's model (its
+    masses), while the shipped controllers (no "animal" key) keep flying the swallowtail they were evolved on."""
+    import json
+
+    from lifelike_mj.butterfly import flight3d
+
+    res, ctrl = flight3d.evolve(flight3d.TASK_SETS["steer"]()[:1], tmp_path / "m.json", population=4, generations=1,
+                                duration_s=0.25, progress=False, animal="monarch")
+    data = json.loads((tmp_path / "m.json").read_text())
+    assert data["animal"] == "monarch" and data["provenance"]["problem"]["animal"] == "monarch"
+    assert data["base"]["frequency_hz"] == pytest.approx(10.2)  # the monarch's base kinematics
+    f = flight3d.Flight3D(controller=tmp_path / "m.json")
+    assert f.animal == "monarch"
+    assert f.model.body_subtreemass[1] == pytest.approx(MONARCH.mass_kg, rel=1e-12)
+    steer = flight3d.Flight3D(controller="steer")
+    assert steer.animal == "swallowtail" and steer.model.body_subtreemass[1] == pytest.approx(0.319e-3, rel=1e-9)
+    bad = dict(data, animal="moth")
+    (tmp_path / "bad.json").write_text(json.dumps(bad))
+    with pytest.raises(UserError, match="animal"):
+        flight3d.load_controller(tmp_path / "bad.json")
