@@ -9,8 +9,12 @@ butterfly of a run, its bones the model's bodies (thorax ``butterfly``, ``abdome
   the leading part of the fan to its full span, the hindwing the trailing part to 0.8 of it, with a scalloped
   margin and a swallowtail's tail. Both faces show (a double-sided material); the texture is in the same fan
   coordinates, so veins run radially: one of :data:`PATTERNS`.
+  A wing drawn in the model as measured surfaces (the 3D monarch's fore and hind wing: several drawn mesh geoms
+  on the wing body) is exported as exactly those outlines (:func:`outline_surfaces`), textured in the wing's own
+  plane with a pattern drawn from the outline itself (:func:`outline_texture`): a black margin with white spots,
+  black veins from the hinge and along the fore wing's inner margin, the ground colour between.
 * **Body.** Thorax, a six-ringed abdomen, head, eyes and clubbed antennae, sized from the model's thorax,
-  head and abdomen geoms.
+  head and abdomen geoms (capsules or ellipsoids).
 * **Antennae** follow the head with a damped lag: each antenna bone turns by a damped oscillator's response
   (:data:`ANTENNA_HZ`, :data:`ANTENNA_ZETA`) to the thorax's acceleration felt in its own frame,
   :data:`ANTENNA_DEG_PER_G` per g. These three numbers are a look, not a measurement (none is published).
@@ -143,6 +147,97 @@ def planform(model, wing_body: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     return root, lead, trail
 
 
+def outline_surfaces(model, wing_body: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """The drawn surfaces of a wing whose model draws its measured outline (more than one drawn mesh geom, or a
+    mesh with more than a triangle's six slab vertices), each as ``(vertices (V, 3), triangles (T, 3), boundary
+    edges (E, 2, 2))`` in the wing body's frame (m), its plane ``z = 0``: the slab's upper face. Empty for the
+    paper's triangle."""
+    geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] == wing_body
+             and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH and model.geom_group[g] <= 2]
+    meshes = [int(model.geom_dataid[g]) for g in geoms]
+    if len(geoms) < 2 and all(model.mesh_vertnum[k] <= 6 for k in meshes):
+        return []
+    out = []
+    for g, k in zip(geoms, meshes):
+        v = model.mesh_vert[model.mesh_vertadr[k]: model.mesh_vertadr[k] + model.mesh_vertnum[k]].astype(float)
+        f = model.mesh_face[model.mesh_faceadr[k]: model.mesh_faceadr[k] + model.mesh_facenum[k]].astype(np.int64)
+        R = np.empty(9)
+        mujoco.mju_quat2Mat(R, model.geom_quat[g])
+        v = v @ R.reshape(3, 3).T + model.geom_pos[g]
+        top = v[:, 2] > 0.0
+        tris = f[top[f].all(axis=1)]
+        keep = np.unique(tris)
+        new = -np.ones(len(v), dtype=np.int64)
+        new[keep] = np.arange(len(keep))
+        verts = v[keep].copy()
+        verts[:, 2] = 0.0
+        tris = new[tris]
+        edges = np.sort(np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]]), axis=1)
+        uniq, counts = np.unique(edges, axis=0, return_counts=True)
+        out.append((verts, tris, verts[uniq[counts == 1]][:, :, :2]))
+    return out
+
+
+def _distance_to_edges(pts: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Each point's distance (m) to the nearest of the segments ``edges`` ``(E, 2, 2)``."""
+    a, b = edges[:, 0], edges[:, 1]
+    ab = b - a
+    t = np.clip(np.einsum("pek,ek->pe", pts[:, None, :] - a[None], ab) / np.maximum(np.sum(ab * ab, 1), 1e-18), 0, 1)
+    near = a[None] + t[..., None] * ab[None]
+    return np.linalg.norm(pts[:, None, :] - near, axis=2).min(axis=1)
+
+
+def outline_texture(surfaces, box: tuple[float, float, float, float], pattern: str = "monarch",
+                    px: int = TEXTURE_PX) -> np.ndarray:
+    """A wing pattern ``(px, px, 4)`` over the wing's plane (``box``: x and y ranges the texture spans, m; u along
+    x, v along y from the hinge), drawn from the outline: the ground colour, a black margin (6 % of the span)
+    with two rows of white spots, black veins fanning from the hinge, and the fore wing's inner margin black."""
+    if pattern not in PATTERNS:
+        raise UserError(f"the wing pattern is one of {', '.join(PATTERNS)}, got {pattern!r}.")
+    base, dark, spot, _ = (np.array(c, dtype=float) for c in PATTERNS[pattern])
+    x0, x1, y0, y1 = box
+    u, v = np.meshgrid((np.arange(px) + 0.5) / px, (np.arange(px) + 0.5) / px)
+    pts = np.stack([x0 + u * (x1 - x0), y0 + v * (y1 - y0)], axis=-1).reshape(-1, 2)
+    span = y1 - y0
+    edges = np.concatenate([e for _, _, e in surfaces])
+    keyed = np.round(np.sort(edges.reshape(-1, 4).reshape(-1, 2, 2), axis=1).reshape(-1, 4), 9)
+    uniq, counts = np.unique(keyed, axis=0, return_counts=True)
+    outer = uniq[counts == 1].reshape(-1, 2, 2)  # the union's outline: edges of one surface only
+    inner = uniq[counts > 1].reshape(-1, 2, 2)  # shared: the fore wing's inner margin
+    d_out = _distance_to_edges(pts, outer) / span
+    img = np.broadcast_to(base, (len(pts), 3)).copy()
+    img *= (0.85 + 0.15 * np.clip(pts[:, 1] / span, 0, 1))[:, None]
+    angle = np.arctan2(pts[:, 0], np.maximum(pts[:, 1], 1e-9))
+    r = np.hypot(pts[:, 0], pts[:, 1]) / span
+    veins = (np.abs(np.sin(angle * 9.0)) < 0.06 + 0.04 * (1 - r)) & (r > 0.1)
+    margin = d_out < 0.06
+    img[veins | margin] = dark
+    if len(inner):
+        img[_distance_to_edges(pts, inner) / span < 0.012] = dark
+    along = np.sin(angle * 26.0)
+    img[margin & (np.abs(d_out - 0.02) < 0.008) & (along > 0.6)] = spot
+    img[margin & (np.abs(d_out - 0.042) < 0.007) & (along < -0.6)] = spot
+    img = img.reshape(px, px, 3)
+    return np.concatenate([np.clip(img, 0, 255), np.full((px, px, 1), 255.0)], axis=-1).astype(np.uint8)
+
+
+def _outline_pieces(surfaces, look_of, bone: int, sign: float) -> list[Piece]:
+    """The measured wing's surfaces as mesh pieces bound to ``bone``, drawn on both faces, fore wing above."""
+    allv = np.concatenate([v for v, _, _ in surfaces])
+    x0, x1 = float(allv[:, 0].min()), float(allv[:, 0].max())
+    y0, y1 = 0.0, float(np.abs(allv[:, 1]).max())
+    look = look_of(surfaces if sign > 0 else [(v * [1, -1, 1], t, e * [1, -1]) for v, t, e in surfaces], (x0, x1, y0, y1))
+    pieces = []
+    for k, (v, t, _) in enumerate(surfaces):
+        pos = v.copy()
+        pos[:, 2] = 0.00012 if k == 0 else -0.00012
+        uv = np.stack([(v[:, 0] - x0) / (x1 - x0), np.abs(v[:, 1]) / y1], axis=1)
+        nrm = np.tile([0.0, 0.0, 1.0], (len(v), 1))
+        j, w = rigid(len(v), bone)
+        pieces.append(Piece(pos, nrm, uv, t, j, w, look))  # the slabs' upper faces run counter-clockwise
+    return pieces
+
+
 def _wing(root, lead, trail, look: Look, bone: int, fore: bool, lift: float) -> Piece:
     """One wing surface over the planform (module docstring)."""
     n_s, n_r = (22, 12)
@@ -169,6 +264,7 @@ def butterfly_rig(poses, root: int, indices: list[int], pattern: str = "swallowt
         index[body] = len(bones)
         bones.append(body_bone(poses, i, parent))
     rname = poses.body_names[indices[0]]
+    pattern = _species_pattern(m, pattern)
     prefix = rname[: -len("butterfly")] if rname.endswith("butterfly") else ""
     wing_ids = {side: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, f"{prefix}wing_{side}") for side in ("left", "right")}
     wings = {side: index.get(w) for side, w in wing_ids.items()}
@@ -176,8 +272,7 @@ def butterfly_rig(poses, root: int, indices: list[int], pattern: str = "swallowt
     abdomen = index.get(abdomen_id)
     # body sizes from the model's geoms
     thorax_g, head_g = _geom(m, root, "thorax"), _geom(m, root, "head")
-    half = float(m.geom_size[thorax_g, 1]) if thorax_g is not None else 0.005
-    radius = float(m.geom_size[thorax_g, 0]) if thorax_g is not None else 0.003
+    half, radius = _half_and_radius(m, thorax_g, 0.005, 0.003)
     head_x = float(m.geom_pos[head_g, 0]) if head_g is not None else half + 0.002
     head_r = float(m.geom_size[head_g, 0]) if head_g is not None else 0.002
     # antennae: from the top of the head, forward and up, with a damped lag of the thorax's felt acceleration
@@ -201,6 +296,14 @@ def butterfly_rig(poses, root: int, indices: list[int], pattern: str = "swallowt
                                                                        0.7 * head_r), turn, rest))
     # the mesh
     wing_look = Look("wing", (1.0, 1.0, 1.0, 1.0), wing_texture(pattern), double_sided=True, roughness=0.8)
+    outline_looks: dict = {}
+
+    def outline_look(surfaces, box) -> Look:
+        # one texture for both wings: the left wing's, mirrored by the right wing's texture coordinates
+        if "look" not in outline_looks:
+            outline_looks["look"] = Look("wing", (1.0, 1.0, 1.0, 1.0), outline_texture(surfaces, box, pattern),
+                                         double_sided=True, roughness=0.8)
+        return outline_looks["look"]
     body_look = Look("body", (0.12, 0.10, 0.08, 1.0), roughness=0.9)
     eye_look = Look("eye", (0.03, 0.03, 0.03, 1.0), roughness=0.3)
     pieces: list[Piece] = []
@@ -213,8 +316,8 @@ def butterfly_rig(poses, root: int, indices: list[int], pattern: str = "swallowt
                              rigid(1, 0), segments=8))
     if abdomen is not None:
         ab_g = _geom(m, abdomen_id, "abdomen")
-        ab_len = 2 * float(m.geom_size[ab_g, 1]) if ab_g is not None else 0.01
-        ab_r = float(m.geom_size[ab_g, 0]) if ab_g is not None else 0.0025
+        ab_half, ab_r = _half_and_radius(m, ab_g, 0.005, 0.0025)
+        ab_len = 2 * ab_half
         base = bones[abdomen].bind[:3, 3]
         u = np.linspace(0.0, 1.0, 25)
         rings = 1.0 - 0.09 * np.abs(np.sin(u * 6 * np.pi))
@@ -232,6 +335,13 @@ def butterfly_rig(poses, root: int, indices: list[int], pattern: str = "swallowt
         w = wings[side]
         if w is None:
             continue
+        measured = outline_surfaces(m, wing_ids[side])
+        if measured:
+            for piece in _outline_pieces(measured, outline_look, w, sign):
+                piece.positions = piece.positions @ bones[w].bind[:3, :3].T + bones[w].bind[:3, 3]
+                piece.normals = piece.normals @ bones[w].bind[:3, :3].T
+                pieces.append(piece)
+            continue
         root_pt, lead, trail = planform(m, wing_ids[side])
         for fore, lift in ((True, 0.00012), (False, -0.00012)):
             piece = _wing(root_pt, lead, trail, wing_look, w, fore, lift)
@@ -239,6 +349,28 @@ def butterfly_rig(poses, root: int, indices: list[int], pattern: str = "swallowt
             piece.normals = piece.normals @ bones[w].bind[:3, :3].T
             pieces.append(piece)
     return Rig(rname, bones, assemble(f"{rname} ({pattern})", pieces), {"pattern": pattern})
+
+
+def _species_pattern(m, pattern: str) -> str:
+    """A model that names its species in its wings' material (the 3D monarch's ``monarch_0``) is drawn in that
+    species' pattern, whatever ``pattern`` asks."""
+    for g in range(m.ngeom):
+        mat = int(m.geom_matid[g])
+        name = (mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_MATERIAL, mat) or "") if mat >= 0 else ""
+        species = name.rsplit("/", 1)[-1].split("_")[0]
+        if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH and species in PATTERNS and species != "wing":
+            return species
+    return pattern
+
+
+def _half_and_radius(m, g, half: float, radius: float) -> tuple[float, float]:
+    """A body part's half length less its radius, and its radius (m), from its drawn capsule or ellipsoid."""
+    if g is None:
+        return half, radius
+    size = m.geom_size[g]
+    if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_ELLIPSOID:
+        return float(size[0] - size[1]), float(size[1])
+    return float(size[1]), float(size[0])
 
 
 def _rest_antenna(sign: float) -> np.ndarray:

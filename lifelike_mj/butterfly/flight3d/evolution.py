@@ -5,6 +5,11 @@
 on its own ``mjData``, all flown by one :class:`~lifelike_mj.butterfly.flight3d.loop.Batch` on every core. The
 score of a flight is the mean reward per second (:func:`~lifelike_mj.butterfly.flight3d.loop.reward`, in
 ``[0, 1]``); a flight that tumbles or diverges earns nothing after that.
+
+With ``natural=True`` the fitness also asks the flight to look like a butterfly's (issue 27): each measure of
+:data:`NATURAL` beyond its bound adds to a cost, computed from the flight's style integrals
+(:data:`~lifelike_mj.butterfly.flight3d.tasks.STYLE_NAMES`) by :func:`style` and :func:`unnatural`, and each
+flight's score is multiplied by ``exp(-cost)``.
 """
 
 from __future__ import annotations
@@ -20,9 +25,81 @@ from lifelike_mj import checks
 from lifelike_mj.butterfly.flight3d import controllers as c3
 from lifelike_mj.butterfly.flight3d.flight import DT_S
 from lifelike_mj.butterfly.flight3d.loop import TUMBLE_RAD, Batch
-from lifelike_mj.butterfly.flight3d.tasks import DRYDEN_VERTICAL_RATIO, R_FIT, Task3D, course, level, new_record, turn
+from lifelike_mj.butterfly.flight3d.tasks import (
+    DRYDEN_VERTICAL_RATIO,
+    N_STYLE,
+    R_FIT,
+    R_STEPS,
+    R_STYLE,
+    Task3D,
+    course,
+    level,
+    new_record,
+    turn,
+)
 from lifelike_mj.butterfly.params import ButterflyParams
 from lifelike_mj.errors import UserError
+
+#: What a natural flight keeps within (issue 27), each ``(bound, cost)``: the cost per unit beyond the bound (a
+#: flight's score is multiplied by ``exp(-cost)``). Sources: a filmed cruising monarch beats both wings within about 4 deg of each
+#: other and stops them 35-50 deg apart at the top (the FWUAV group's fit); straight flight needs no bank; Dudley
+#: (1991) puts the mechanical power of neotropical butterflies at 12.5-20.2 W/kg (perfect to no elastic storage).
+#: ``stroke_top_deg``: the higher wing's top of the stroke, 67-74 deg, where the monarch's measured dorsal gap is
+#: 35-50 deg (``measures``: 48.5 deg at a 68 deg top; the gap falls 2 deg per degree). ``body_angle_deg``: within
+#: the bound of :func:`body_angle_target_deg` at the task's speed, on straight tasks.
+NATURAL = {
+    "roll_deg": (3.0, 0.05),
+    "stroke_difference_deg": (4.0, 0.05),
+    "offset_difference_deg": (3.0, 0.05),
+    "stroke_top_deg": ((67.0, 74.0), 0.05),
+    "power_W_kg": (20.2, 0.02),
+    "body_angle_deg": (5.0, 0.02),
+}
+
+
+def body_angle_target_deg(speed_m_s: float) -> float:
+    """The body angle (deg, the thorax's long axis above the horizontal) asked of straight flight at ``speed_m_s``:
+    20 deg at 1 m/s, falling by 10 deg per m/s, never below 5 deg. Our choice: through the filmed monarch (18.6 deg
+    at 1.3 m/s, in a slow climb) and falling towards the near-horizontal body Dudley (1990) reports in fast forward
+    flight; his regression itself is not restated here."""
+    return float(min(25.0, max(5.0, 20.0 - 10.0 * (speed_m_s - 1.0))))
+
+
+def straight(task: Task3D) -> bool:
+    """Whether ``task`` asks for straight flight: a schedule whose rows keep one heading."""
+    return task.kind == "schedule" and len({round(r[1], 12) for r in task.rows}) == 1
+
+
+def style(rec: np.ndarray, dt_s: float, mass_kg: float) -> dict:
+    """The means of a flight's style integrals (a run record's ``R_STYLE`` slots over the steps flown): mean roll
+    and pitch (deg), stroke difference (deg, top to bottom: twice the amplitudes' difference), offset difference
+    (deg), the higher wing's top of the stroke (deg), the drive's positive power per kg (W/kg) and the mean stroke
+    times frequency (rad/s; ``2 Phi f`` in the advance ratio)."""
+    t = max(rec[R_STEPS] * dt_s, dt_s)
+    m = rec[R_STYLE : R_STYLE + N_STYLE] / t
+    deg = float(np.degrees(1.0))
+    return {"roll_deg": m[0] * deg, "pitch_deg": m[1] * deg, "stroke_difference_deg": 2.0 * m[2] * deg,
+            "offset_difference_deg": m[3] * deg, "stroke_top_deg": m[4] * deg, "power_W_kg": m[5] / mass_kg,
+            "stroke_frequency_rad_s": m[6]}
+
+
+def unnatural(st: dict, task: Task3D) -> float:
+    """The fitness a flight of style ``st`` (:func:`style`) on ``task`` loses to :data:`NATURAL`."""
+    cost = 0.0
+    b, c = NATURAL["stroke_difference_deg"]
+    cost += c * max(0.0, st["stroke_difference_deg"] - b)
+    b, c = NATURAL["offset_difference_deg"]
+    cost += c * max(0.0, st["offset_difference_deg"] - b)
+    (lo, hi), c = NATURAL["stroke_top_deg"]
+    cost += c * (max(0.0, lo - st["stroke_top_deg"]) + max(0.0, st["stroke_top_deg"] - hi))
+    b, c = NATURAL["power_W_kg"]
+    cost += c * max(0.0, st["power_W_kg"] - b)
+    if straight(task):
+        b, c = NATURAL["roll_deg"]
+        cost += c * max(0.0, abs(st["roll_deg"]) - b)
+        b, c = NATURAL["body_angle_deg"]
+        cost += c * max(0.0, abs(st["pitch_deg"] - body_angle_target_deg(task.rows[0][3])) - b)
+    return cost
 
 
 @dataclass
@@ -40,6 +117,7 @@ class FlightProblem3D:
     n_chord: int = 2
     force_law: str = "exact"
     prior: tuple[float, ...] = ()
+    natural: bool = False
 
     def __post_init__(self) -> None:
         if not self.tasks:
@@ -93,8 +171,10 @@ class FlightProblem3D:
                 "base": t["base"],
                 "scale": t["scale"], "every": t["every"], "omega_c_rad_s": t["omega_c_rad_s"],
                 "prior_sha256": hashlib.sha256(np.asarray(self.prior).tobytes()).hexdigest(),
-                # the butterfly, named where it is not the swallowtail (earlier problems' fingerprints hold)
-                **({"animal": self.template.animal} if self.template.animal != "swallowtail" else {})}
+                # the butterfly and the naturalness asked, named where they are new (earlier fingerprints hold)
+                **({"animal": self.template.animal} if self.template.animal != "swallowtail" else {}),
+                **({"natural": {k: list(v) if isinstance(v, tuple) else v for k, v in NATURAL.items()}}
+                   if self.natural else {})}
 
     def fingerprint(self) -> str:
         return hashlib.sha256(json.dumps(self.describe(), sort_keys=True).encode()).hexdigest()
@@ -133,7 +213,13 @@ class FlightProblem3D:
     def evaluate(self, X: np.ndarray) -> np.ndarray:
         X = np.atleast_2d(np.asarray(X, dtype=np.float64))
         recs = self.fly(np.asarray(self.prior)[None, :] + X)
-        return recs[:, :, R_FIT].mean(axis=1) / self.duration_s
+        if not self.natural:
+            return recs[:, :, R_FIT].mean(axis=1) / self.duration_s
+        # each flight's score shrinks by exp(-cost): a flight that ends early (a tumble) keeps the little it earned,
+        # so that falling is never a way out of looking unnatural
+        mass = float(self.model().body_subtreemass[1])
+        return np.array([np.mean([r[R_FIT] / self.duration_s * np.exp(-unnatural(style(r, self.dt_s, mass), t))
+                                  for r, t in zip(row, self.tasks)]) for row in recs])
 
 
 #: The gusts of the ``wind`` task set: 0.5 m/s (horizontal), half that vertically (:data:`DRYDEN_VERTICAL_RATIO`).
@@ -154,13 +240,27 @@ TASK_SETS = {
 }
 
 
-def pd_prior(layers) -> np.ndarray:
-    """The hand-made starting point of a linear controller: the feathering follows the body's pitch (1 rad of
-    feathering, leading edge down, per rad nose up), which alone keeps the body upright for seconds.
-    Networks with hidden layers start from zero."""
+def pd_prior(layers, animal: str = "swallowtail") -> np.ndarray:
+    """The hand-made starting point of a linear controller. The swallowtail: the feathering follows the body's
+    pitch (1 rad of feathering, leading edge down, per rad nose up), which alone keeps the body upright for
+    seconds. The monarch, whose body turns about five times faster in pitch: the stroke's offset follows the
+    pitch and its rate (3 per rad, 1.5 per 10 rad/s; a lower stroke pitches the body up), and the frequency the
+    altitude and the climb (both -1), which keep it upright and flying for the 4 s of a training flight (it still
+    sinks about 0.4 m/s). Networks with hidden layers start from zero."""
     w = np.zeros(c3.n_weights(layers))
-    if len(layers) == 2:
-        w[c3.ACTION_NAMES.index("feather_sym") * (c3.N_OBS + 1) + c3.OBS_NAMES.index("pitch_rad")] = 1.0
+    if len(layers) != 2:
+        return w
+
+    def at(action, obs):
+        return c3.ACTION_NAMES.index(action) * (c3.N_OBS + 1) + c3.OBS_NAMES.index(obs)
+
+    if animal == "monarch":
+        w[at("offset_sym", "pitch_rad")] = 3.0
+        w[at("offset_sym", "pitch_rate_rad_s")] = 1.5
+        w[at("frequency", "altitude_error_m")] = -1.0
+        w[at("frequency", "climb_m_s")] = -1.0
+    else:
+        w[at("feather_sym", "pitch_rad")] = 1.0
     return w
 
 
@@ -170,7 +270,7 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
            gene_bound: float = 0.4, checkpoint: str | Path | None = None, resume: bool = False, progress: bool = True,
            overwrite: bool = False, task_set: str = "custom", on_generation=None, start: c3.Controller3D | None = None,
            inputs: str | None = None, executor: str = "serial", workers: int | None = None,
-           ray_address: str | None = None, dt_s: float = DT_S, animal: str | None = None):
+           ray_address: str | None = None, dt_s: float = DT_S, animal: str | None = None, natural: bool = False):
     """Evolve a 3D controller on ``tasks`` (default: the ``steer`` set) with ``optimizer`` and write it to
     ``out`` with its provenance (the problem, the optimiser, the budget, the time it took, the fitness
     history). Returns ``(result, controller)``; nothing is overwritten unasked (the checks and locks of the
@@ -185,7 +285,8 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     training flights (default :data:`~lifelike_mj.butterfly.flight3d.flight.DT_S`). ``animal``: the butterfly
     (:data:`~lifelike_mj.butterfly.flight3d.animals.ANIMALS`; default the start's, else the swallowtail); a new
     controller starts from that butterfly's base kinematics
-    (:func:`~lifelike_mj.butterfly.flight3d.controllers.default_base`)."""
+    (:func:`~lifelike_mj.butterfly.flight3d.controllers.default_base`) and prior (:func:`pd_prior`). ``natural``:
+    the fitness also asks for :data:`NATURAL` (module docstring)."""
     from lifelike_mj import provenance as _prov
     from lifelike_mj.evolve import make_evaluator, optimize
     from lifelike_mj.evolve.checkpoint import guarded_run_files
@@ -205,9 +306,10 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     else:
         layers = [int(v) for v in layers]
         animal = animal or "swallowtail"
-        template = c3.Controller3D(layers, pd_prior(layers) if len(layers) >= 2 and layers[0] == c3.N_OBS else [],
-                                   c3.default_base(animal), inputs=inputs or "ground", animal=animal)
-    problem = FlightProblem3D(tuple(tasks), template, duration_s=duration_s, gene_bound=gene_bound, dt_s=dt_s)
+        template = c3.Controller3D(layers, pd_prior(layers, animal) if len(layers) >= 2 and layers[0] == c3.N_OBS
+                                   else [], c3.default_base(animal), inputs=inputs or "ground", animal=animal)
+    problem = FlightProblem3D(tuple(tasks), template, duration_s=duration_s, gene_bound=gene_bound, dt_s=dt_s,
+                              natural=bool(natural))
     out = Path(out)
     with guarded_run_files(out, checkpoint, resume=resume, overwrite=overwrite) as ckpt:
         with make_evaluator(problem, executor=executor, workers=workers, ray_address=ray_address) as ev:

@@ -25,6 +25,7 @@ from lifelike_mj.butterfly.flight3d.tasks import (
     R_GUST,
     R_PASSED,
     R_STEPS,
+    R_STYLE,
     R_TUMBLED,
     R_WP,
     T_FLUTTER,
@@ -287,7 +288,26 @@ def _after(mptr, dptr, ud, qvel, time, dt, rec, obs, p, dp, ddp):
         rec[R_DIVERGED] = step + 1
         return False
     rec[R_FIT] += reward(obs) * dt
+    style(ud, qvel, obs, p, dt, rec)
     return True
+
+
+@njit(cache=True)
+def style(ud, qvel, obs, p, dt, rec):
+    """Add this step's share of the style integrals (:data:`~lifelike_mj.butterfly.flight3d.tasks.STYLE_NAMES`) to
+    the record: they do not enter the reward, only the naturalness an evolution may ask for."""
+    rec[R_STYLE] += obs[0] * dt
+    rec[R_STYLE + 1] += obs[1] * dt
+    rec[R_STYLE + 2] += abs(p[3] - p[4]) * dt
+    rec[R_STYLE + 3] += abs(p[1] - p[2]) * dt
+    rec[R_STYLE + 4] += max(p[1] + p[3], p[2] + p[4]) * dt
+    work = 0.0
+    for j in range(5):
+        pw = ud[mj3d.U_OUT + mj3d.O_DRIVE + j] * qvel[int(ud[mj3d.U_DRIVEN_D + j])]
+        if pw > 0.0:
+            work += pw
+    rec[R_STYLE + 5] += work * dt
+    rec[R_STYLE + 6] += (p[3] + p[4]) * p[0] * dt
 
 
 @njit(cache=True)

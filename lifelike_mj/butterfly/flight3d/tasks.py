@@ -27,9 +27,19 @@ T_KIND, T_ROWS, T_RADIUS, T_SPEED, T_WIND = 0, 1, 2, 3, 4
 T_GUST, T_GUST_TAU, T_FLUTTER, T_FLUTTER_TAU, T_SEED, T_GUST_W, T_ROW0 = 7, 8, 9, 10, 11, 12, 13
 
 # per-copy run record (float64): fitness, steps flown, diverged step, waypoints passed, tumble step, the gust
-# (3, m/s) and the flutter (one per action) now, then the closest approach to each waypoint
+# (3, m/s) and the flutter (one per action) now, the style integrals (R_STYLE, below), then the closest approach to
+# each waypoint
 R_FIT, R_STEPS, R_DIVERGED, R_PASSED, R_TUMBLED, R_GUST, R_FLUTTER = 0, 1, 2, 3, 4, 5, 8
-R_WP = R_FLUTTER + 9
+R_STYLE = R_FLUTTER + 9
+#: The style integrals over the flight (each ``int x dt``), from which the naturalness of a flight is judged
+#: (:mod:`~lifelike_mj.butterfly.flight3d.evolution`): roll (rad s), pitch (rad s), the two wings' stroke amplitudes'
+#: difference ``|A_l - A_r|`` and stroke offsets' difference (rad s), the higher wing's top of the stroke
+#: ``max(offset + amplitude)`` (rad s), the drive's positive work summed over the joints (J: ``sum_j max(tau_j
+#: dq_j/dt, 0)``, torques of the step's last stage), and ``(A_l + A_r) f`` (rad: the mean stroke times the frequency).
+STYLE_NAMES = ("roll", "pitch", "amplitude_difference", "offset_difference", "stroke_top", "positive_work_J",
+               "stroke_frequency")
+N_STYLE = len(STYLE_NAMES)
+R_WP = R_STYLE + N_STYLE
 
 #: A task's most rows, and the largest number in a row (m, s, rad, m/s): far beyond a garden, finite in the loop.
 MAX_TASK_ROWS = 10_000

@@ -243,3 +243,32 @@ def test_a_controller_carries_its_butterfly_through_its_file_and_into_a_flight(t
     (tmp_path / "bad.json").write_text(json.dumps(bad))
     with pytest.raises(UserError, match="animal"):
         flight3d.load_controller(tmp_path / "bad.json")
+
+
+def test_the_exported_rig_draws_the_outline_the_air_pushes():
+    """The rig an animator gets (glTF skin, USD skeleton) carries the monarch's wings as the model draws them:
+    each surface's upper face, the same area as the outline the force integrates over, bound to its wing's bone,
+    in the monarch's pattern (orange ground, black margin)."""
+    from lifelike_mj.butterfly import look
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
+    from lifelike_mj.export.poses import record_poses
+
+    f = Flight3D(KinematicsCommand(frequency_hz=10.2), animal="monarch")
+    poses = record_poses(f, 0.05, fps=30.0)
+    (rig,) = look.rigs(poses)
+    assert rig.extras["pattern"] == "monarch"
+    for side in ("left", "right"):
+        surfaces = look.outline_surfaces(f.model, f.model.body(f"wing_{side}").id)
+        assert len(surfaces) == 2
+        area = 0.0
+        for v, t, _ in surfaces:
+            a, b, c = v[t[:, 0], :2], v[t[:, 1], :2], v[t[:, 2], :2]
+            twice = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+            assert (twice > 0).all()  # every upper-face triangle faces up
+            area += 0.5 * twice.sum()
+        assert area == pytest.approx(MONARCH.moments["area_m2"], rel=1e-6)
+    wing = next(p for p in rig.mesh.parts if p[0].name == "wing")[0]
+    img = wing.image.reshape(-1, 4)[:, :3].astype(int)
+    orange = np.all(np.abs(img - [235, 120, 20]) < 60, axis=1).mean()
+    black = np.all(img < 40, axis=1).mean()
+    assert orange > 0.2 and black > 0.1

@@ -83,3 +83,60 @@ def test_too_short_a_flight_is_one_sentence():
     with pytest.raises(UserError, match="at least"):
         M.level_measures("steer", settle_s=5.0, window_s=0.1)
     assert np.isfinite(M.body_numbers(f)["mass_kg"])
+
+
+def test_the_compiled_style_integrals_agree_with_the_measures():
+    """What the evolution's naturalness reads (the style integrals the compiled loop adds up at every step) is
+    what ``measures`` computes from the states: a symmetric monarch flight (no network, the attitude held) shows
+    no stroke or offset difference, the commanded top of the stroke, and the drive's positive power within a few
+    per cent (the loop takes each step's torques at its last Runge-Kutta stage)."""
+    from lifelike_mj.butterfly.flight3d import evolution as E
+    from lifelike_mj.butterfly.flight3d.tasks import N_STYLE, R_STYLE
+
+    f = _held(MONARCH_BASE)
+    f.step(200)
+    f._rec[R_STYLE : R_STYLE + N_STYLE] = 0.0
+    steps0 = f._rec[1]
+    s = M.sample(f, 0.6)
+    rec = f._rec.copy()
+    rec[1] -= steps0
+    mass = float(f.model.body_subtreemass[1])
+    st = E.style(rec, f.dt, mass)
+    m = M.measures(s, **M.body_numbers(f))
+    assert st["stroke_difference_deg"] < 1e-9 and st["offset_difference_deg"] < 1e-9
+    assert st["stroke_top_deg"] == pytest.approx(68.0, abs=1e-6)
+    assert st["power_W_kg"] == pytest.approx(m["power_W_kg"], rel=0.05)
+    assert st["stroke_frequency_rad_s"] == pytest.approx(2 * math.radians(60.0) * 10.2, rel=1e-9)
+
+
+def test_unnatural_flight_costs_and_natural_flight_does_not():
+    from lifelike_mj.butterfly.flight3d import evolution as E
+    from lifelike_mj.butterfly.flight3d.tasks import level, turn
+
+    natural = {"roll_deg": 1.0, "pitch_deg": E.body_angle_target_deg(1.5), "stroke_difference_deg": 2.0,
+               "offset_difference_deg": 1.0, "stroke_top_deg": 70.0, "power_W_kg": 15.0}
+    assert E.unnatural(natural, level(1.5)) == 0.0
+    banked = dict(natural, roll_deg=13.0)
+    assert E.unnatural(banked, level(1.5)) == pytest.approx(0.5)  # 10 deg beyond 3, 0.05 per deg
+    assert E.unnatural(banked, turn(90.0, 1.5, 1.5)) == 0.0  # a turn banks
+    assert E.unnatural(dict(natural, power_W_kg=40.2), level(1.5)) == pytest.approx(0.4)
+    assert E.unnatural(dict(natural, stroke_top_deg=80.0), level(1.5)) == pytest.approx(0.3)
+    assert E.body_angle_target_deg(1.0) == 20.0 and E.body_angle_target_deg(2.0) == 10.0
+    assert E.body_angle_target_deg(3.0) == 5.0
+
+
+def test_falling_is_no_way_out_of_looking_unnatural():
+    """With naturalness asked, a flight's score is its reward times exp(-cost): never above the reward, so a
+    candidate that tumbles (little reward) cannot beat one that flies by escaping the cost."""
+    from lifelike_mj.butterfly.flight3d import evolution as E
+    from lifelike_mj.butterfly.flight3d.controllers import Controller3D
+    from lifelike_mj.butterfly.flight3d.tasks import level
+
+    c = Controller3D([10, 9], E.pd_prior([10, 9], "monarch"), MONARCH_BASE, animal="monarch")
+    plain = E.FlightProblem3D((level(1.0),), c, duration_s=1.0)
+    natural = E.FlightProblem3D((level(1.0),), c, duration_s=1.0, natural=True)
+    x = np.zeros((2, plain.dim))
+    x[1] = 0.5  # a worse candidate
+    a, b = plain.evaluate(x), natural.evaluate(x)
+    assert (b <= a + 1e-12).all() and (b > 0).all()
+    assert plain.fingerprint() != natural.fingerprint()
