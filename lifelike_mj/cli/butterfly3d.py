@@ -89,7 +89,7 @@ def cmd_evolve3d(args) -> None:
                        checkpoint=args.checkpoint, resume=args.resume, progress=not args.quiet,
                        overwrite=args.overwrite, task_set=args.tasks, start=start, gene_bound=args.gene_bound,
                        inputs=args.inputs, executor=args.executor, workers=args.workers, ray_address=args.ray_address,
-                       dt_s=args.dt, animal=args.animal, natural=args.natural)
+                       dt_s=args.dt, animal=args.animal, natural=args.natural, force_law=args.force_law)
     if ctrl is None:
         raise KeyboardInterrupt("stopped before the first generation was evaluated; nothing was written")
     state = "stopped early (Ctrl-C); best so far" if res.interrupted else "done"
@@ -261,6 +261,10 @@ def add_commands(bf) -> None:
     p.add_argument("--animal", default=None, choices=("swallowtail", "monarch"),
                    help="the butterfly: swallowtail (the paper's triangular wings) or monarch (measured wings, masses "
                         "and stroke plane); default: the start's, else swallowtail")
+    p.add_argument("--force-law", default=None, choices=("exact", "strip", "quasi_steady"),
+                   help="the wing-force law of the training flights, kept in the controller: exact (eq. 1 over the "
+                        "outline), strip (eq. 1 on panels) or quasi_steady (blade elements with a revolving fruit-fly "
+                        "wing's coefficients); default: the start's, else exact")
     p.add_argument("--natural", action="store_true",
                    help="also ask the flight to look like a butterfly's: level wings and even strokes in straight "
                         "flight, a dorsal gap of 35-50 deg, at most 20.2 W/kg, the body angle falling with speed")

@@ -157,7 +157,7 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
         if every is not None or inputs is not None or animal is not None:
             ctl = flight3d.Controller3D(ctl.layers, ctl.weights, ctl.base, dict(zip(flight3d.ACTION_NAMES, ctl.scale)),
                                         ctl.every if every is None else every, ctl.omega_c_rad_s, ctl.provenance,
-                                        ctl.name, inputs or ctl.inputs, animal or ctl.animal)
+                                        ctl.name, inputs or ctl.inputs, animal or ctl.animal, ctl.force_law)
         self.controller = ctl
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise UserError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}.")
@@ -351,7 +351,8 @@ class ButterflyFlight3DVectorEnv(VectorEnv):
         from lifelike_mj.butterfly.flight3d import model as mj3d
 
         c = self.single.controller
-        return mj3d.setup_data(self._model, flight3d.Kinematics(c.base, c.omega_c_rad_s), animal=c.animal)
+        return mj3d.setup_data(self._model, flight3d.Kinematics(c.base, c.omega_c_rad_s), animal=c.animal,
+                               force_law=c.force_law)
 
     def _reset_one(self, i: int) -> None:
         b, s = self._batch, self.single

@@ -87,12 +87,14 @@ class Controller3D:
     """A 3D controller: a network from the observation to the action (module docstring), the base command
     and the actions' scales, how often it runs (``every`` steps), how fast the kinematics follow
     (``omega_c_rad_s``) and what its speeds are measured against (``inputs``: ``"ground"`` or ``"air"``), with
-    its provenance, and the butterfly it flies (``animal``, one of
-    :data:`~lifelike_mj.butterfly.flight3d.animals.ANIMALS`). Plain data: :meth:`to_dict` / :func:`controller_from_dict`."""
+    its provenance, the butterfly it flies (``animal``, one of
+    :data:`~lifelike_mj.butterfly.flight3d.animals.ANIMALS`) and the wing-force law it was evolved with
+    (``force_law``: ``"exact"``, ``"strip"`` or ``"quasi_steady"``; flights take it unless told otherwise). Plain
+    data: :meth:`to_dict` / :func:`controller_from_dict`."""
 
     def __init__(self, layers, weights, base=None, scale: dict | None = None, every: int = 1,
                  omega_c_rad_s: float = 2.0 * math.pi * 10.0, provenance: dict | None = None, name: str = "",
-                 inputs: str = "ground", animal: str = "swallowtail") -> None:
+                 inputs: str = "ground", animal: str = "swallowtail", force_law: str = "exact") -> None:
         from lifelike_mj import checks
         from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
         from lifelike_mj.errors import UserError
@@ -138,6 +140,11 @@ class Controller3D:
         from lifelike_mj.butterfly.flight3d.animals import animal as _animal
 
         self.animal = _animal(animal).name
+        from lifelike_mj.butterfly.flight3d.model import FORCE_LAWS
+
+        if force_law not in FORCE_LAWS or force_law in ("none", "tip"):
+            raise UserError(f"{where}: force_law is 'exact', 'strip' or 'quasi_steady', got {force_law!r}.")
+        self.force_law = force_law
         self.provenance = dict(provenance or {})
 
     def to_dict(self) -> dict:
@@ -147,7 +154,7 @@ class Controller3D:
                 "weights": [float(v) for v in self.weights], "base": asdict(self.base),
                 "scale": dict(zip(ACTION_NAMES, (float(v) for v in self.scale))), "every": self.every,
                 "omega_c_rad_s": self.omega_c_rad_s, "inputs": self.inputs, "animal": self.animal,
-                "provenance": self.provenance}
+                "force_law": self.force_law, "provenance": self.provenance}
 
     @property
     def air_inputs(self) -> bool:
@@ -157,7 +164,8 @@ class Controller3D:
     def with_weights(self, weights, inputs: str | None = None) -> Controller3D:
         """The same controller with other weights (and, given ``inputs``, other inputs)."""
         return Controller3D(self.layers, weights, self.base, dict(zip(ACTION_NAMES, self.scale)), self.every,
-                            self.omega_c_rad_s, self.provenance, self.name, inputs or self.inputs, self.animal)
+                            self.omega_c_rad_s, self.provenance, self.name, inputs or self.inputs, self.animal,
+                            self.force_law)
 
 
 def json_schema() -> dict:
@@ -185,6 +193,8 @@ def json_schema() -> dict:
         "inputs": {"enum": list(INPUTS), "description": "the network's speeds over the ground or through the air"},
         "animal": {"enum": list(ANIMALS), "description": "the butterfly it flies (module "
                    "lifelike_mj.butterfly.flight3d.animals); missing: the paper's swallowtail"},
+        "force_law": {"enum": ["exact", "strip", "quasi_steady"], "description": "the wing-force law it was evolved "
+                      "with and flies with (module lifelike_mj.butterfly.flight3d.model); missing: exact"},
         "provenance": {"type": "object"},
     }
     return document_schema(FORMAT, "lifelike-mj 3D butterfly controller", props, ["layers", "weights"],
@@ -206,7 +216,7 @@ def controller_from_dict(data: object, name: str = "") -> Controller3D:
         base = KinematicsCommand(**{k: float(v) for k, v in base.items()})
     return Controller3D(d["layers"], d["weights"], base, d.get("scale"), d.get("every", 1),
                         d.get("omega_c_rad_s", 2.0 * math.pi * 10.0), d.get("provenance"), name, d.get("inputs", "ground"),
-                        d.get("animal", "swallowtail"))
+                        d.get("animal", "swallowtail"), d.get("force_law", "exact"))
 
 
 def load_controller(name_or_path) -> Controller3D:

@@ -270,7 +270,8 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
            gene_bound: float = 0.4, checkpoint: str | Path | None = None, resume: bool = False, progress: bool = True,
            overwrite: bool = False, task_set: str = "custom", on_generation=None, start: c3.Controller3D | None = None,
            inputs: str | None = None, executor: str = "serial", workers: int | None = None,
-           ray_address: str | None = None, dt_s: float = DT_S, animal: str | None = None, natural: bool = False):
+           ray_address: str | None = None, dt_s: float = DT_S, animal: str | None = None, natural: bool = False,
+           force_law: str | None = None):
     """Evolve a 3D controller on ``tasks`` (default: the ``steer`` set) with ``optimizer`` and write it to
     ``out`` with its provenance (the problem, the optimiser, the budget, the time it took, the fitness
     history). Returns ``(result, controller)``; nothing is overwritten unasked (the checks and locks of the
@@ -286,7 +287,8 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     (:data:`~lifelike_mj.butterfly.flight3d.animals.ANIMALS`; default the start's, else the swallowtail); a new
     controller starts from that butterfly's base kinematics
     (:func:`~lifelike_mj.butterfly.flight3d.controllers.default_base`) and prior (:func:`pd_prior`). ``natural``:
-    the fitness also asks for :data:`NATURAL` (module docstring)."""
+    the fitness also asks for :data:`NATURAL` (module docstring). ``force_law``: the wing-force law of the training
+    flights, recorded in the controller (default the start's, else ``"exact"``)."""
     from lifelike_mj import provenance as _prov
     from lifelike_mj.evolve import make_evaluator, optimize
     from lifelike_mj.evolve.checkpoint import guarded_run_files
@@ -299,17 +301,18 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     if start is not None:
         template = start
         layers = [int(v) for v in start.layers]
-        if inputs is not None or animal is not None:
+        if inputs is not None or animal is not None or force_law is not None:
             template = c3.Controller3D(start.layers, start.weights, start.base, dict(zip(c3.ACTION_NAMES, start.scale)),
                                        start.every, start.omega_c_rad_s, start.provenance, start.name,
-                                       inputs or start.inputs, animal or start.animal)
+                                       inputs or start.inputs, animal or start.animal, force_law or start.force_law)
     else:
         layers = [int(v) for v in layers]
         animal = animal or "swallowtail"
         template = c3.Controller3D(layers, pd_prior(layers, animal) if len(layers) >= 2 and layers[0] == c3.N_OBS
-                                   else [], c3.default_base(animal), inputs=inputs or "ground", animal=animal)
+                                   else [], c3.default_base(animal), inputs=inputs or "ground", animal=animal,
+                                   force_law=force_law or "exact")
     problem = FlightProblem3D(tuple(tasks), template, duration_s=duration_s, gene_bound=gene_bound, dt_s=dt_s,
-                              natural=bool(natural))
+                              natural=bool(natural), force_law=template.force_law)
     out = Path(out)
     with guarded_run_files(out, checkpoint, resume=resume, overwrite=overwrite) as ckpt:
         with make_evaluator(problem, executor=executor, workers=workers, ray_address=ray_address) as ev:

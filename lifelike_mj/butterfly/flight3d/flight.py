@@ -100,7 +100,8 @@ class Flight3D(StepCounter):
     frame, m/s), replacing the task's (``wind_m_s``, the older spelling of ``wind_to_m_s``, with a note; gusts and
     flutter are the task's: :class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`); ``start_m``: the thorax's start
     position.
-    Model options: ``force_law`` (``exact``: eq. 1 integrated exactly over each wing; ``strip``: eq. 1 on wing
+    Model options: ``force_law`` (default the 3D controller's, else ``exact``; ``exact``: eq. 1 integrated exactly
+    over each wing; ``strip``: eq. 1 on wing
     panels; ``quasi_steady``: blade elements on the panels; ``tip``: the paper's tip-speed formula; ``none``),
     ``drag_frame`` (``body`` or ``world``), ``body_areas_m2`` (the body's drag areas along x, y, z; default the
     paper's ``A_b`` on every axis), ``masses`` (``animal`` or ``paper``), ``n_strips`` and ``n_chord`` (panels
@@ -118,7 +119,7 @@ class Flight3D(StepCounter):
     def __init__(self, command: KinematicsCommand | None = None, params: ButterflyParams | None = None, *,
                  controller=None, task=None, control_every: int = 1, wind_to_m_s=None, wind_from_m_s=None,
                  wind_m_s=None,
-                 start_m=(0.0, 0.0, 0.0), force_law: str = "exact", drag_frame: str = "body",
+                 start_m=(0.0, 0.0, 0.0), force_law: str | None = None, drag_frame: str = "body",
                  body_areas_m2=None, masses: str = "animal", dt_s: float = DT_S, n_strips: int = 8,
                  n_chord: int = 2, drive_hz: float = 50.0, omega_c: float | None = None, assist: str = "none",
                  pitch_law: Callable | None = None, end_on_tumble: bool = False, animal: str | None = None,
@@ -161,6 +162,8 @@ class Flight3D(StepCounter):
             self.task = replace(self.task, wind_to_m_s=wind)
         self.wind_to_m_s = np.array(self.task.wind_to_m_s)
         self.start_m = np.array(checks.vector("start_m", start_m, 3), dtype=float)
+        if force_law is None:
+            force_law = self.network.force_law if self.network is not None else "exact"
         self.options = {"force_law": force_law, "drag_frame": drag_frame, "body_areas_m2": body_areas_m2,
                         "assist": assist, "drive_hz": checks.positive("drive_hz", drive_hz, "Hz"),
                         "n_strips": n_strips, "n_chord": n_chord, "animal": self.animal}

@@ -116,7 +116,7 @@ class Garden(StepCounter):
     def __init__(self, n: int = 20, controller="steer", *, seed: int = 0, n_flowers: int = 10, size_m: float = 6.0,
                  speed_m_s: float = 1.5, flutter: float = 0.1, gust_m_s: float = 0.0, wind_to_m_s=None,
                  gust_vertical_m_s: float | None = None, dt_s: float = DT_S, n_strips: int = 8, n_chord: int = 2,
-                 force_law: str = "exact", wind_from_m_s=None, wind_m_s=None) -> None:
+                 force_law: str | None = None, wind_from_m_s=None, wind_m_s=None) -> None:
         self.n = checks.whole("the number of butterflies", n, 1, 500)
         self.controller = controller if isinstance(controller, Controller3D) else load_controller(controller)
         self.seed = checks.whole("seed", seed, 0, 2**32 - 1)
@@ -132,7 +132,8 @@ class Garden(StepCounter):
                                 seed=(self.seed * 1000 + i) % 2**32) for i in range(self.n)]
         self._phys = mj3d.build_model(animal=self.controller.animal)
         self._phys.opt.timestep = self.dt
-        self._n_strips, self._n_chord, self._force_law = n_strips, n_chord, force_law
+        self._n_strips, self._n_chord = n_strips, n_chord
+        self._force_law = force_law or self.controller.force_law
         self._model = scene_model(self.n, self.blossoms, self.size_m, self.controller.animal)
         self._data = mujoco.MjData(self._model)
         self._blocks = [int(self._model.jnt_qposadr[self._model.joint(f"b{i}_root").id]) for i in range(self.n)]

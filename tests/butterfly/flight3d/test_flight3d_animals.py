@@ -239,10 +239,15 @@ def test_a_controller_carries_its_butterfly_through_its_file_and_into_a_flight(t
     assert f.model.body_subtreemass[1] == pytest.approx(MONARCH.mass_kg, rel=1e-12)
     steer = flight3d.Flight3D(controller="steer")
     assert steer.animal == "swallowtail" and steer.model.body_subtreemass[1] == pytest.approx(0.319e-3, rel=1e-9)
-    bad = dict(data, animal="moth")
-    (tmp_path / "bad.json").write_text(json.dumps(bad))
-    with pytest.raises(UserError, match="animal"):
-        flight3d.load_controller(tmp_path / "bad.json")
+    assert data["force_law"] == "exact" and f.options["force_law"] == "exact"
+    qs = dict(data, force_law="quasi_steady")
+    (tmp_path / "qs.json").write_text(json.dumps(qs))
+    assert flight3d.Flight3D(controller=tmp_path / "qs.json").options["force_law"] == "quasi_steady"
+    assert flight3d.Flight3D(controller=tmp_path / "qs.json", force_law="exact").options["force_law"] == "exact"
+    for key, value in (("animal", "moth"), ("force_law", "tip")):
+        (tmp_path / "bad.json").write_text(json.dumps(dict(data, **{key: value})))
+        with pytest.raises(UserError, match=key):
+            flight3d.load_controller(tmp_path / "bad.json")
 
 
 def test_the_exported_rig_draws_the_outline_the_air_pushes():
