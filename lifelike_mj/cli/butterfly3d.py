@@ -1,4 +1,5 @@
-"""``lifelike-mj butterfly fly3d | evolve3d | assess3d | measure3d``: the butterfly in three dimensions."""
+"""``lifelike-mj butterfly fly3d | evolve3d | assess3d | measure3d | strobe3d``: the butterfly in three
+dimensions."""
 
 from __future__ import annotations
 
@@ -27,6 +28,16 @@ MAX_DURATION_S = 3600.0
 #: The settling time of assess3d's level flight (s), and the most courses it flies.
 LEVEL_SETTLE_S = 5.0
 MAX_COURSES = 1000
+
+
+def _views(text: str) -> str:
+    from lifelike_mj.butterfly.flight3d.strobe import VIEWS
+
+    parts = [v.strip() for v in text.split(",")]
+    bad = [v for v in parts if v not in VIEWS]
+    if bad or not parts:
+        raise argparse.ArgumentTypeError(f"views are some of {', '.join(VIEWS)}, comma-separated; got {text!r}")
+    return ",".join(parts)
 
 
 def _task(args):
@@ -142,6 +153,25 @@ def cmd_measure3d(args) -> None:
              f"{m['power_W_kg']:.1f} W/kg ({m['power_net_W_kg']:.1f} net), J {m['advance_ratio']:.2f} at "
              f"{m['air_speed_m_s']:.2f} m/s through the air")
     emit(args, d, human)
+
+
+def cmd_strobe3d(args) -> None:
+    from lifelike_mj.butterfly import flight3d
+    from lifelike_mj.butterfly.flight3d.controllers import load_controller
+    from lifelike_mj.butterfly.flight3d.strobe import strobe
+    from lifelike_mj.render.video import check_size, write_png
+
+    check_outputs(args, files={"--out": (".png",)})
+    check_size(args.width, args.height, "panel")
+    ctrl = load_controller(args.controller)
+    f = flight3d.Flight3D(controller=ctrl, task=flight3d.level(args.speed), dt_s=args.dt)
+    with stage(f"level flight at {args.speed:g} m/s, {args.settle:g} s, then one beat"):
+        f.step(int(round(args.settle / f.dt)))
+        img = strobe(f, args.n, tuple(args.views.split(",")), args.width, args.height)
+    write_png(args.out, img)
+    emit(args, {"out": str(args.out), "controller": ctrl.name or args.controller, "moments": args.n,
+                "views": args.views.split(","), "at_s": args.settle},
+         f"{args.n} moments of one wing beat after {args.settle:g} s, {args.views}: written to {args.out}")
 
 
 def cmd_garden(args) -> None:
@@ -318,6 +348,20 @@ def add_commands(bf) -> None:
     _add_dt(p)
     add_json(p)
     p.set_defaults(func=cmd_measure3d)
+    p = bf.add_parser("strobe3d", help="a stroboscopic picture of one wing beat in level flight, from the side and "
+                                       "from ahead")
+    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name or a file")
+    p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s")
+    p.add_argument("--settle", type=num(0, 600, unit="s"), default=3.0, help="seconds of flight before the beat")
+    p.add_argument("--n", type=count(2, 64), default=8, help="moments of the beat drawn, 2 to 64")
+    p.add_argument("--views", default="side,front", type=_views, help="side, front and/or top, comma-separated")
+    p.add_argument("--width", type=count(16, 1920), default=480, help="width of each view, pixels")
+    p.add_argument("--height", type=count(16, 1080), default=360, help="height, pixels")
+    p.add_argument("--out", required=True, help="the picture (.png)")
+    _add_dt(p)
+    add_overwrite(p)
+    add_json(p)
+    p.set_defaults(func=cmd_strobe3d)
 
 
 HELP = "the butterfly in three dimensions: one on a task, or a garden of them"

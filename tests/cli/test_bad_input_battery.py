@@ -152,6 +152,11 @@ CASES = [
     (["butterfly", "measure3d", "--window", "0"], "--window", {}),
     (["butterfly", "measure3d", "--settle", "1", "--window", "0.2"], "needs a duration of at least 1.5 s", {}),
     (["butterfly", "measure3d", "--controller", "nope"], "nope", {}),
+    (["butterfly", "strobe3d", "--out", "s.png", "--views", "side,back"], "--views", {}),
+    (["butterfly", "strobe3d", "--out", "s.gif"], ".png", {}),
+    (["butterfly", "strobe3d", "--out", "s.png"], "already exists", {"s.png": "x"}),
+    (["butterfly", "strobe3d", "--out", "s.png", "--n", "1"], "--n", {}),
+    (["butterfly", "evolve3d", "--force-law", "tip"], "invalid choice", {}),
     # --- fish
     (SWIM + ["--fish", "0"], "--fish", {}),
     (SWIM + ["--fish", "10000000"], "from 1 to 5,000", {}),

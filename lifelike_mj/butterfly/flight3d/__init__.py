@@ -34,6 +34,7 @@ What is here, one layer on the next:
 * :mod:`~lifelike_mj.butterfly.flight3d.flight`: the stepper :class:`Flight3D`;
 * :mod:`~lifelike_mj.butterfly.flight3d.measures`: how natural a flight is (:func:`level_measures`);
 * :mod:`~lifelike_mj.butterfly.flight3d.garden`: :class:`Garden`, many butterflies among flowers;
+* :mod:`~lifelike_mj.butterfly.flight3d.strobe`: stroboscopic pictures of one wing beat;
 * :mod:`~lifelike_mj.butterfly.flight3d.evolution`: :class:`FlightProblem3D`, :data:`TASK_SETS`, :func:`evolve`;
 * :mod:`~lifelike_mj.butterfly.flight3d.validate`: the checks of a controller (level, turn, course, the
   reduction to the planar model); :mod:`~lifelike_mj.butterfly.flight3d.figures`: their figures.
@@ -56,5 +57,5 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "kinematics": ".", "model": ".", "tasks": ".", "controllers": ".", "loop": ".", "flight": ".", "garden": ".",
     "evolution": ".", "validate": ".", "figures": ".", "timing": ".", "view": ".", "view_flight3d": "view",
     "animals": ".", "measures": ".", "Animal": "animals", "ANIMALS": "animals", "animal": "animals",
-    "level_measures": "measures", "default_base": "controllers",
+    "level_measures": "measures", "default_base": "controllers", "strobe": ".",
 }, globals())
