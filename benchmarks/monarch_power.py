@@ -33,7 +33,7 @@ from lifelike_mj.provenance import provenance
 
 LAWS = ("exact", "quasi_steady")
 FREQUENCIES_HZ = (8.0, 10.0, 12.0)
-AMPLITUDES_DEG = (50.0, 60.0)
+AMPLITUDES_DEG = (40.0, 50.0, 60.0)
 PITCHES_DEG = (10.0, 25.0, 40.0)
 FEATHERING_RAD = (0.4, 0.68, 0.9)
 SETTLE_S, WINDOW_S = 1.0, 0.6
