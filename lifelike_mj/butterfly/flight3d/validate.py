@@ -174,39 +174,23 @@ def course_check(controller, seed: int, n: int = 10, max_s: float = 60.0, weathe
 def kinematics_check(controller, speed_m_s: float = 1.5, settle_s: float = 5.0, window_s: float = 5.0,
                      force_law: str = "exact", **flight) -> dict:
     """The measures of free flight Dudley 1990 reports, from a level flight of ``controller`` at ``speed_m_s``
-    (after ``settle_s``, over ``window_s``): the flap frequency (Hz) and stroke amplitude (deg, the angle the
-    wing sweeps from top to bottom), the speed over ground (m/s), the advance ratio ``J = U / (2 Phi f R)``
-    (``Phi`` the stroke amplitude in rad, ``R`` the wing length), the body's mean pitch and its swing within a
-    beat (deg), and the bobbing within a beat (m, top to bottom of the thorax). Also the mean vertical force
-    coefficient the flight needs, ``m g / (1/2 rho S (2 Phi f R)^2)`` with ``S`` both wings' area: the figure
-    Sunada et al. 1993 estimate at about 4 for a cabbage white taking off."""
-    from lifelike_mj.butterfly.flight3d import tasks
-    from lifelike_mj.butterfly.flight3d.flight import Flight3D
+    (after ``settle_s``, over ``window_s``; :func:`~lifelike_mj.butterfly.flight3d.measures.level_measures`): the flap
+    frequency (Hz) and stroke amplitude (deg, the angle each wing sweeps from top to bottom, the mean of the two),
+    the speed over ground (m/s), the advance ratio over both wings ``J = U / (2 Phi f R)`` (``Phi`` the mean stroke
+    in rad, ``R`` the wing length, ``U`` the speed through the air), the body's mean pitch and its swing within a
+    beat (deg), the bobbing within a beat (m, top to bottom of the thorax, less the beat's mean climb), and the
+    mean vertical force coefficient the flight needs, ``m g / (1/2 rho S (2 Phi f R)^2)`` with ``S`` both wings'
+    area: the figure Sunada et al. 1993 estimate at about 4 for a cabbage white taking off. ``roll_mean_deg``:
+    whether the flight stayed upright enough for these to mean anything."""
+    from lifelike_mj.butterfly.flight3d.measures import level_measures
 
-    check_window("the kinematics check", settle_s + window_s, settle_s, 0.5, "it measures whole wing beats in the "
-                 "window after settling")
-    f = Flight3D(controller=controller, task=tasks.level(speed_m_s), force_law=force_law, **flight)
-    f.step(int(round(settle_s / f.dt)))
-    rec = f.record(duration_s=window_s, every=1)
-    t, pos, att, joints = rec["t_s"], rec["position_m"], rec["attitude_rad"], rec["joints_rad"]
-    flap = joints[:, 0]
-    mid = 0.5 * (flap.max() + flap.min())
-    ups = np.nonzero((flap[:-1] < mid) & (flap[1:] >= mid))[0]
-    freq = (len(ups) - 1) / (t[ups[-1]] - t[ups[0]])
-    beats = [(a, b) for a, b in zip(ups[:-1], ups[1:])]
-    stroke = float(np.mean([np.ptp(flap[a:b]) for a, b in beats]))
-    pitch_swing = float(np.mean([np.ptp(att[a:b, 1]) for a, b in beats]))
-    bob = float(np.mean([np.ptp(pos[a:b, 2]) for a, b in beats]))
-    speed = float(np.linalg.norm(pos[ups[-1], :2] - pos[ups[0], :2]) / (t[ups[-1]] - t[ups[0]]))
-    R = f.params.span_m
-    tip = 2.0 * stroke * freq * R
-    area = f.params.width_m * f.params.span_m  # both planform-2 wings: 2 x W L / 2
-    return {"force_law": force_law, "speed_command_m_s": speed_m_s, "flap_frequency_hz": float(freq),
-            "stroke_amplitude_deg": float(np.degrees(stroke)), "speed_m_s": speed,
-            "advance_ratio": speed / tip, "body_pitch_mean_deg": float(np.degrees(att[:, 1].mean())),
-            "body_pitch_swing_deg": float(np.degrees(pitch_swing)), "bobbing_m": bob,
-            "vertical_force_coefficient": float(f.params.mass_kg * f.params.gravity / (0.5 * f.params.rho * area * tip**2)),
-            "beats": len(beats)}
+    m = level_measures(controller, speed_m_s, settle_s, window_s, force_law=force_law, **flight)
+    return {"force_law": force_law, "speed_command_m_s": speed_m_s, "flap_frequency_hz": m["flap_frequency_hz"],
+            "stroke_amplitude_deg": 0.5 * (m["stroke_left_deg"] + m["stroke_right_deg"]),
+            "speed_m_s": m["ground_speed_m_s"], "advance_ratio": m["advance_ratio"],
+            "body_pitch_mean_deg": m["body_angle_deg"], "body_pitch_swing_deg": m["body_pitch_swing_deg"],
+            "bobbing_m": 1e-3 * m["bobbing_mm"], "vertical_force_coefficient": m["vertical_force_coefficient"],
+            "roll_mean_deg": m["roll_mean_deg"], "beats": m["beats"]}
 
 
 def target_check(controller, duration_s: float = 40.0, catch_s: float = 10.0, **target) -> dict:
