@@ -109,6 +109,8 @@ class Flight3D(StepCounter):
     fast the kinematics follow a command; default the controller's, else one wing beat).
     ``animal``: the butterfly (``"swallowtail"``, the paper's, or ``"monarch"``, with measured wings:
     :mod:`~lifelike_mj.butterfly.flight3d.animals`); default the controller's, else the swallowtail.
+    ``contact``: the butterfly has legs that touch the ground (:func:`~lifelike_mj.butterfly.flight3d.model.add_contact`);
+    without it nothing touches anything.
     ``end_on_tumble``: a roll or pitch beyond :data:`~lifelike_mj.butterfly.flight3d.loop.TUMBLE_RAD` ends the
     flight there (as in an evolution; :attr:`tumbled`), else it flies on.
     ``assist="hold"`` holds the attitude at ``pitch_law(flight)`` (rad, nose up), set once per step, roll
@@ -123,6 +125,7 @@ class Flight3D(StepCounter):
                  body_areas_m2=None, masses: str = "animal", dt_s: float = DT_S, n_strips: int = 8,
                  n_chord: int = 2, drive_hz: float = 50.0, omega_c: float | None = None, assist: str = "none",
                  pitch_law: Callable | None = None, end_on_tumble: bool = False, animal: str | None = None,
+                 contact: bool = False,
                  _model: mujoco.MjModel | None = None) -> None:
         self.network = None
         if isinstance(controller, (str, Path)):
@@ -169,7 +172,9 @@ class Flight3D(StepCounter):
                         "n_strips": n_strips, "n_chord": n_chord, "animal": self.animal}
         self.masses, self.omega_c, self.pitch_law = masses, omega_c, pitch_law
         self.end_on_tumble = bool(end_on_tumble)
-        self._model = _model if _model is not None else mj3d.build_model(self.params, masses, self.animal)
+        self.contact = bool(contact)
+        self._model = _model if _model is not None else mj3d.build_model(self.params, masses, self.animal,
+                                                                          contact=self.contact)
         self._model.opt.timestep = self.dt
         self._model.opt.gravity[:] = (0.0, 0.0, -self.params.gravity)
         self._root_q = int(self._model.jnt_qposadr[self._model.joint("root").id])

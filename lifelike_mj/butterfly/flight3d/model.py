@@ -571,11 +571,49 @@ def model_path():
     return paths.model_path("butterfly", "butterfly3d.xml")
 
 
-def build_model(params: ButterflyParams | None = None, masses: str = "animal", animal: str = "swallowtail"
-                ) -> mujoco.MjModel:
+def build_model(params: ButterflyParams | None = None, masses: str = "animal", animal: str = "swallowtail",
+                contact: bool = False) -> mujoco.MjModel:
     """Compile the 3D model of ``animal`` (one of :data:`~lifelike_mj.butterfly.flight3d.animals.ANIMALS`):
-    :func:`build_spec`, compiled."""
-    return build_spec(params, masses, animal).compile()
+    :func:`build_spec`, compiled; ``contact``: with legs that touch the ground (:func:`add_contact`)."""
+    spec = build_spec(params, masses, animal)
+    if contact:
+        add_contact(spec)
+    return spec.compile()
+
+
+#: The legs' friction with what they stand on: sliding, torsional, rolling (a foot's claws grip).
+LEG_FRICTION = (1.5, 0.01, 0.001)
+#: The legs' radius (m), and where the feet stand, as fractions of the thorax's length (forward of its centre) and
+#: width (out from the middle line): two pairs, as a nymphalid walks (its forelegs are folded), and how far below
+#: the thorax's axis (in thorax widths).
+LEG_RADIUS_M = 0.0003
+FEET = ((0.3, 1.3), (-0.6, 1.4))
+FOOT_DEPTH = 1.3
+
+
+def add_contact(spec: mujoco.MjSpec) -> None:
+    """Give the butterfly of ``spec`` legs and let them touch: contact switched on, two pairs of legs under the
+    thorax (drawn, massless capsules from the thorax's underside to the feet, with :data:`LEG_FRICTION`), and the
+    ground touching them. Nothing else touches: the wings, the body and the abdomen have no contact, so the legs
+    carry the butterfly when it stands (on the ground, or on a flower added with ``contype=conaffinity=1``)."""
+    spec.option.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+    ground = spec.geom("ground")
+    ground.contype, ground.conaffinity = 1, 1
+    ground.friction = list(LEG_FRICTION)
+    thorax = spec.geom("thorax")
+    if thorax.type == mujoco.mjtGeom.mjGEOM_ELLIPSOID:
+        half, width = float(thorax.size[0]), 2.0 * float(thorax.size[1])
+    else:
+        half, width = 0.5 * float(np.linalg.norm(np.subtract(thorax.fromto[3:], thorax.fromto[:3]))), 2.0 * float(
+            thorax.size[0])
+    body = spec.body("butterfly")
+    for k, (fx, fy) in enumerate(FEET):
+        for side, sign in (("left", 1.0), ("right", -1.0)):
+            top = [fx * 2.0 * half, sign * 0.25 * width, -0.35 * width]
+            foot = [fx * 2.0 * half * 1.2, sign * fy * width, -FOOT_DEPTH * width]
+            body.add_geom(name=f"leg_{k}_{side}", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=top + foot,
+                          size=[LEG_RADIUS_M, 0.0, 0.0], mass=0.0, contype=1, conaffinity=1, condim=3,
+                          friction=list(LEG_FRICTION), rgba=[0.1, 0.08, 0.06, 1.0], group=0)
 
 
 def build_spec(params: ButterflyParams | None = None, masses: str = "animal", animal: str = "swallowtail"

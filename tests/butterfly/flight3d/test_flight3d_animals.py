@@ -277,3 +277,28 @@ def test_the_exported_rig_draws_the_outline_the_air_pushes():
     orange = np.all(np.abs(img - [235, 120, 20]) < 60, axis=1).mean()
     black = np.all(img < 40, axis=1).mean()
     assert orange > 0.2 and black > 0.1
+
+
+def test_a_butterfly_with_legs_stands_on_the_ground_with_its_wings_closed():
+    """With contact, the monarch's legs carry it: dropped from 8 mm with its wings closed over its back, it stands
+    on its four feet, upright and still (within 0.1 mm and 1 deg over a second); the wings, the body and the
+    abdomen touch nothing. Without contact (the flight model) it falls through the ground."""
+    import math
+
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
+
+    closed = KinematicsCommand(frequency_hz=10.2, offset_left=math.radians(85.0), offset_right=math.radians(85.0),
+                               amplitude_left=0.0, amplitude_right=0.0, abdomen_mean=-0.3)
+    f = Flight3D(closed, animal="monarch", contact=True, start_m=(0.0, 0.0, -4.0 + 0.008))
+    f.step(400)
+    before = f.data.qpos[:7].copy()
+    f.step(800)
+    assert np.abs(f.data.qpos[:3] - before[:3]).max() < 1e-4
+    att = np.degrees(f.state()["attitude_rad"])
+    assert abs(att[0]) < 1.0 and abs(att[1]) < 5.0
+    m = f.model
+    touching = {m.geom(int(g)).name for c in f.data.contact[: f.data.ncon] for g in (c.geom1, c.geom2)}
+    assert touching == {"ground", "leg_0_left", "leg_0_right", "leg_1_left", "leg_1_right"}
+    g = Flight3D(closed, animal="monarch", start_m=(0.0, 0.0, -4.0 + 0.008))
+    g.step(400)
+    assert g.data.qpos[2] < -4.2 and g.data.ncon == 0
