@@ -280,11 +280,12 @@ def add_commands(bf) -> None:
     p = bf.add_parser("evolve3d", help="evolve a 3D controller (CMA-ES or the paper's GA) on the MuJoCo batch")
     p.add_argument("--optimizer", default="cmaes", choices=("cmaes", "rcga", "crs2", "esch", "isres"),
                    help="cmaes, rcga (the paper's GA) or an nlopt method")
-    p.add_argument("--tasks", default="steer", choices=("steer", "cruise", "wind"),
+    p.add_argument("--tasks", default="steer", choices=("steer", "cruise", "wind", "natural"),
                    help="the task set: steer (level at 1 and 2 m/s, turns of 90 and -180 deg), cruise (level at 1.5 "
                         "and 2 m/s, the turns, and two flights in 1 m/s wind with 0.5 m/s gusts) or wind (courses "
                         "1-4 in 1 m/s wind from four sides with gusts of 0.5 m/s, 0.25 m/s vertically, course 5 and "
-                        "the -180 deg turn in still air, level flight in wind)")
+                        "the -180 deg turn in still air, level flight in wind) or natural (level at 1, 1.5 and 2 m/s, "
+                        "the turns, course 5, and course 1 in 1 m/s wind with gusts of 0.5 m/s on every axis)")
     p.add_argument("--inputs", default=None, choices=("ground", "air"),
                    help="the network's speeds over the ground or through the air (default: the start's, else ground)")
     p.add_argument("--start", default=None, help="a 3D controller to start from (its network; genes are its changes)")

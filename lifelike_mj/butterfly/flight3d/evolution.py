@@ -237,6 +237,10 @@ TASK_SETS = {
                      course(4).with_weather((0.0, 1.0, 0.0), **_GUSTS, seed=4),
                      course(5), turn(-180.0, 1.5, 1.5, 0.3),
                      level(1.5).with_weather((0.7, 0.7, 0.0), **_GUSTS, seed=6)),
+    # the monarch's, with --natural: straight flight at three speeds (the body angle falling with them), the turns,
+    # a calm course and one in 1 m/s wind with gusts of 0.5 m/s on every axis
+    "natural": lambda: (level(1.0), level(1.5), level(2.0), turn(90.0, 1.5, 1.5), turn(-180.0, 1.5, 1.5, 0.3), course(5),
+                        course(1).with_weather((1.0, 0.0, 0.0), gust_m_s=0.5, gust_vertical_m_s=0.5, seed=1)),
 }
 
 
