@@ -29,7 +29,6 @@ from lifelike_mj.butterfly.flight3d.tasks import (
     DRYDEN_VERTICAL_RATIO,
     N_STYLE,
     R_FIT,
-    R_STEPS,
     R_STYLE,
     Task3D,
     course,
@@ -71,11 +70,12 @@ def straight(task: Task3D) -> bool:
 
 
 def style(rec: np.ndarray, dt_s: float, mass_kg: float) -> dict:
-    """The means of a flight's style integrals (a run record's ``R_STYLE`` slots over the steps flown): mean roll
+    """The means of a flight's style integrals (a run record's ``R_STYLE`` slots, over the time they cover: the
+    flight after its first second; a flight that ended sooner has none, and costs nothing here): mean roll
     and pitch (deg), stroke difference (deg, top to bottom: twice the amplitudes' difference), offset difference
     (deg), the higher wing's top of the stroke (deg), the drive's positive power per kg (W/kg) and the mean stroke
     times frequency (rad/s; ``2 Phi f`` in the advance ratio)."""
-    t = max(rec[R_STEPS] * dt_s, dt_s)
+    t = max(rec[R_STYLE + N_STYLE - 1], dt_s)  # the time the integrals cover
     m = rec[R_STYLE : R_STYLE + N_STYLE] / t
     deg = float(np.degrees(1.0))
     return {"roll_deg": m[0] * deg, "pitch_deg": m[1] * deg, "stroke_difference_deg": 2.0 * m[2] * deg,

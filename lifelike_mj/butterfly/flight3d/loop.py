@@ -28,6 +28,7 @@ from lifelike_mj.butterfly.flight3d.tasks import (
     R_STYLE,
     R_TUMBLED,
     R_WP,
+    STYLE_FROM_S,
     T_FLUTTER,
     T_FLUTTER_TAU,
     T_GUST,
@@ -288,14 +289,16 @@ def _after(mptr, dptr, ud, qvel, time, dt, rec, obs, p, dp, ddp):
         rec[R_DIVERGED] = step + 1
         return False
     rec[R_FIT] += reward(obs) * dt
-    style(ud, qvel, obs, p, dt, rec)
+    if t0 >= STYLE_FROM_S:
+        style(ud, qvel, obs, p, dt, rec)
     return True
 
 
 @njit(cache=True)
 def style(ud, qvel, obs, p, dt, rec):
     """Add this step's share of the style integrals (:data:`~lifelike_mj.butterfly.flight3d.tasks.STYLE_NAMES`) to
-    the record: they do not enter the reward, only the naturalness an evolution may ask for."""
+    the record (after the flight's first :data:`~lifelike_mj.butterfly.flight3d.tasks.STYLE_FROM_S`): they do not
+    enter the reward, only the naturalness an evolution may ask for."""
     rec[R_STYLE] += obs[0] * dt
     rec[R_STYLE + 1] += obs[1] * dt
     rec[R_STYLE + 2] += abs(p[3] - p[4]) * dt
@@ -308,6 +311,7 @@ def style(ud, qvel, obs, p, dt, rec):
             work += pw
     rec[R_STYLE + 5] += work * dt
     rec[R_STYLE + 6] += (p[3] + p[4]) * p[0] * dt
+    rec[R_STYLE + 7] += dt
 
 
 @njit(cache=True)

@@ -31,13 +31,16 @@ T_GUST, T_GUST_TAU, T_FLUTTER, T_FLUTTER_TAU, T_SEED, T_GUST_W, T_ROW0 = 7, 8, 9
 # each waypoint
 R_FIT, R_STEPS, R_DIVERGED, R_PASSED, R_TUMBLED, R_GUST, R_FLUTTER = 0, 1, 2, 3, 4, 5, 8
 R_STYLE = R_FLUTTER + 9
-#: The style integrals over the flight (each ``int x dt``), from which the naturalness of a flight is judged
-#: (:mod:`~lifelike_mj.butterfly.flight3d.evolution`): roll (rad s), pitch (rad s), the two wings' stroke amplitudes'
-#: difference ``|A_l - A_r|`` and stroke offsets' difference (rad s), the higher wing's top of the stroke
-#: ``max(offset + amplitude)`` (rad s), the drive's positive work summed over the joints (J: ``sum_j max(tau_j
-#: dq_j/dt, 0)``, torques of the step's last stage), and ``(A_l + A_r) f`` (rad: the mean stroke times the frequency).
+#: The style integrals over the flight after its first :data:`STYLE_FROM_S` (each ``int x dt``), from which the
+#: naturalness of a flight is judged (:mod:`~lifelike_mj.butterfly.flight3d.evolution`): roll (rad s), pitch (rad s),
+#: the two wings' stroke amplitudes' difference ``|A_l - A_r|`` and stroke offsets' difference (rad s), the higher
+#: wing's top of the stroke ``max(offset + amplitude)`` (rad s), the drive's positive work summed over the joints
+#: (J: ``sum_j max(tau_j dq_j/dt, 0)``, torques of the step's last stage), ``(A_l + A_r) f`` (rad: the mean stroke
+#: times the frequency), and the time they cover (s).
 STYLE_NAMES = ("roll", "pitch", "amplitude_difference", "offset_difference", "stroke_top", "positive_work_J",
-               "stroke_frequency")
+               "stroke_frequency", "time_s")
+#: The style integrals leave out the flight's first second: the start from rest, not the way it flies.
+STYLE_FROM_S = 1.0
 N_STYLE = len(STYLE_NAMES)
 R_WP = R_STYLE + N_STYLE
 
