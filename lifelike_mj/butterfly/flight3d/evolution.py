@@ -74,12 +74,16 @@ def style(rec: np.ndarray, dt_s: float, mass_kg: float) -> dict:
     flight after its first second; a flight that ended sooner has none, and costs nothing here): mean roll
     and pitch (deg), stroke difference (deg, top to bottom: twice the amplitudes' difference), offset difference
     (deg), the higher wing's top of the stroke (deg), the drive's positive power per kg (W/kg) and the mean stroke
-    times frequency (rad/s; ``2 Phi f`` in the advance ratio)."""
-    t = max(rec[R_STYLE + N_STYLE - 1], dt_s)  # the time the integrals cover
-    m = rec[R_STYLE : R_STYLE + N_STYLE] / t
+    times frequency (rad/s; ``2 Phi f`` in the advance ratio). The top of the stroke is the flown one, the higher
+    wing's largest flap angle in each whole beat, averaged (a network that lowers the stroke's offset just as the
+    wings reach the top flies a lower top than its command's mean)."""
+    r = rec[R_STYLE : R_STYLE + N_STYLE]
+    t = max(r[7], dt_s)  # the time the integrals cover
+    m = r / t
     deg = float(np.degrees(1.0))
+    top = r[4] / r[11] * deg if r[11] > 0 else 0.0
     return {"roll_deg": m[0] * deg, "pitch_deg": m[1] * deg, "stroke_difference_deg": 2.0 * m[2] * deg,
-            "offset_difference_deg": m[3] * deg, "stroke_top_deg": m[4] * deg, "power_W_kg": m[5] / mass_kg,
+            "offset_difference_deg": m[3] * deg, "stroke_top_deg": top, "power_W_kg": m[5] / mass_kg,
             "stroke_frequency_rad_s": m[6]}
 
 

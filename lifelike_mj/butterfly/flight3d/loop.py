@@ -271,7 +271,7 @@ def _act(u, dt, every, base, scale, task, rec, ud):
 
 
 @njit(cache=True)
-def _after(mptr, dptr, ud, qvel, time, dt, rec, obs, p, dp, ddp):
+def _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp):
     """The second half of a step: one ``mj_step``, the kinematics advanced exactly, the reward of the observation
     ``obs`` added. Returns ``False`` if the flight diverged (recorded in ``rec``)."""
     step = int(rec[R_STEPS])
@@ -290,12 +290,12 @@ def _after(mptr, dptr, ud, qvel, time, dt, rec, obs, p, dp, ddp):
         return False
     rec[R_FIT] += reward(obs) * dt
     if t0 >= STYLE_FROM_S:
-        style(ud, qvel, obs, p, dt, rec)
+        style(ud, qpos, qvel, obs, p, dt, rec)
     return True
 
 
 @njit(cache=True)
-def style(ud, qvel, obs, p, dt, rec):
+def style(ud, qpos, qvel, obs, p, dt, rec):
     """Add this step's share of the style integrals (:data:`~lifelike_mj.butterfly.flight3d.tasks.STYLE_NAMES`) to
     the record (after the flight's first :data:`~lifelike_mj.butterfly.flight3d.tasks.STYLE_FROM_S`): they do not
     enter the reward, only the naturalness an evolution may ask for."""
@@ -303,7 +303,20 @@ def style(ud, qvel, obs, p, dt, rec):
     rec[R_STYLE + 1] += obs[1] * dt
     rec[R_STYLE + 2] += abs(p[3] - p[4]) * dt
     rec[R_STYLE + 3] += abs(p[1] - p[2]) * dt
-    rec[R_STYLE + 4] += max(p[1] + p[3], p[2] + p[4]) * dt
+    # the top of the stroke as flown: the higher wing's largest flap angle in each beat, added up beat by beat
+    flap = max(qpos[int(ud[mj3d.U_DRIVEN_Q])], qpos[int(ud[mj3d.U_DRIVEN_Q + 1])])
+    beat = math.floor(ud[mj3d.U_PSI0] / (2.0 * math.pi))
+    if rec[R_STYLE + 9] == 0.0:  # the first step counted: this beat is under way
+        rec[R_STYLE + 10] = beat
+        rec[R_STYLE + 8] = flap
+    elif beat != rec[R_STYLE + 10]:
+        rec[R_STYLE + 4] += rec[R_STYLE + 8]
+        rec[R_STYLE + 11] += 1.0
+        rec[R_STYLE + 10] = beat
+        rec[R_STYLE + 8] = flap
+    else:
+        rec[R_STYLE + 8] = max(rec[R_STYLE + 8], flap)
+    rec[R_STYLE + 9] = 1.0
     work = 0.0
     for j in range(5):
         pw = ud[mj3d.U_OUT + mj3d.O_DRIVE + j] * qvel[int(ud[mj3d.U_DRIVEN_D + j])]
@@ -348,7 +361,7 @@ def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, base
         if int(rec[R_STEPS]) % every == 0 and len(weights) > 0:
             network(layers, weights, obs, u, scratch)
             _act(u, dt, every, base, scale, task, rec, ud)
-        if not _after(mptr, dptr, ud, qvel, time, dt, rec, obs, p, dp, ddp):
+        if not _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp):
             return
 
 
@@ -375,7 +388,7 @@ def to_decision(mptr, dptr, off, nq, nv, n_max, dt, every, action, act, base, sc
     if act:
         u = action.copy()
         _act(u, dt, every, base, scale, task, rec, ud)
-        if not _after(mptr, dptr, ud, qvel, time, dt, rec, obs, p, dp, ddp):
+        if not _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp):
             return False
     while True:
         tumbled, _ = _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, none, 0, 0, tumble_rad)
@@ -384,7 +397,7 @@ def to_decision(mptr, dptr, off, nq, nv, n_max, dt, every, action, act, base, sc
         step = int(rec[R_STEPS])
         if step >= n_max or step % every == 0:
             return True
-        if not _after(mptr, dptr, ud, qvel, time, dt, rec, obs, p, dp, ddp):
+        if not _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp):
             return False
 
 

@@ -33,12 +33,14 @@ R_FIT, R_STEPS, R_DIVERGED, R_PASSED, R_TUMBLED, R_GUST, R_FLUTTER = 0, 1, 2, 3,
 R_STYLE = R_FLUTTER + 9
 #: The style integrals over the flight after its first :data:`STYLE_FROM_S` (each ``int x dt``), from which the
 #: naturalness of a flight is judged (:mod:`~lifelike_mj.butterfly.flight3d.evolution`): roll (rad s), pitch (rad s),
-#: the two wings' stroke amplitudes' difference ``|A_l - A_r|`` and stroke offsets' difference (rad s), the higher
-#: wing's top of the stroke ``max(offset + amplitude)`` (rad s), the drive's positive work summed over the joints
-#: (J: ``sum_j max(tau_j dq_j/dt, 0)``, torques of the step's last stage), ``(A_l + A_r) f`` (rad: the mean stroke
-#: times the frequency), and the time they cover (s).
-STYLE_NAMES = ("roll", "pitch", "amplitude_difference", "offset_difference", "stroke_top", "positive_work_J",
-               "stroke_frequency", "time_s")
+#: the two wings' stroke amplitudes' difference ``|A_l - A_r|`` and stroke offsets' difference (rad s), the sum over
+#: whole beats of the top of the stroke as flown (rad: the higher wing's largest flap angle in the beat), the drive's
+#: positive work summed over the joints (J: ``sum_j max(tau_j dq_j/dt, 0)``, torques of the step's last stage),
+#: ``(A_l + A_r) f`` (rad: the mean stroke times the frequency), the time they cover (s); then the loop's own
+#: bookkeeping of the beats: the running beat's top so far, whether counting began, the beat's index (whole turns of
+#: the flap phase), and the whole beats added up.
+STYLE_NAMES = ("roll", "pitch", "amplitude_difference", "offset_difference", "stroke_tops", "positive_work_J",
+               "stroke_frequency", "time_s", "beat_top", "counting", "beat_index", "beats")
 #: The style integrals leave out the flight's first second: the start from rest, not the way it flies.
 STYLE_FROM_S = 1.0
 N_STYLE = len(STYLE_NAMES)

@@ -91,7 +91,7 @@ def test_the_compiled_style_integrals_agree_with_the_measures():
     no stroke or offset difference, the commanded top of the stroke, and the drive's positive power within a few
     per cent (the loop takes each step's torques at its last Runge-Kutta stage)."""
     from lifelike_mj.butterfly.flight3d import evolution as E
-    from lifelike_mj.butterfly.flight3d.tasks import N_STYLE, R_STYLE
+    from lifelike_mj.butterfly.flight3d.tasks import N_STYLE, R_STYLE, STYLE_NAMES
 
     f = _held(MONARCH_BASE)
     f.step(400)
@@ -100,12 +100,15 @@ def test_the_compiled_style_integrals_agree_with_the_measures():
     f._rec[R_STYLE : R_STYLE + N_STYLE] = 0.0
     s = M.sample(f, 0.6)
     rec = f._rec.copy()
-    assert rec[R_STYLE + N_STYLE - 1] == pytest.approx(0.6, abs=1.5 * f.dt)  # (the 1 s boundary within a step)
+    assert rec[R_STYLE + STYLE_NAMES.index("time_s")] == pytest.approx(0.6, abs=1.5 * f.dt)  # (the 1 s boundary within a step)
     mass = float(f.model.body_subtreemass[1])
     st = E.style(rec, f.dt, mass)
     m = M.measures(s, **M.body_numbers(f))
     assert st["stroke_difference_deg"] < 1e-9 and st["offset_difference_deg"] < 1e-9
-    assert st["stroke_top_deg"] == pytest.approx(68.0, abs=1e-6)
+    flown = np.degrees(np.max(s["joints_rad"][:, :2], axis=1))
+    tops = [flown[a:b].max() for a, b in M.beats(0.5 * (s["joints_rad"][:, 0] + s["joints_rad"][:, 1]))]
+    assert st["stroke_top_deg"] == pytest.approx(np.mean(tops), abs=0.3)  # the top as flown, beat by beat
+    assert 60.0 < st["stroke_top_deg"] < 68.5  # the drive follows the 68 deg command a little short
     assert st["power_W_kg"] == pytest.approx(m["power_W_kg"], rel=0.05)
     assert st["stroke_frequency_rad_s"] == pytest.approx(2 * math.radians(60.0) * 10.2, rel=1e-9)
 
