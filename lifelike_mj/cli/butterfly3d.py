@@ -30,6 +30,13 @@ LEVEL_SETTLE_S = 5.0
 MAX_COURSES = 1000
 
 
+def _add_level_flight(p: argparse.ArgumentParser, settle_s: float, settle_help: str) -> None:
+    """The options of a level flight that is flown, then looked at: the controller, its speed, the settling time."""
+    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name or a file")
+    p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s")
+    p.add_argument("--settle", type=num(0, 600, unit="s"), default=settle_s, help=settle_help)
+
+
 def _views(text: str) -> str:
     from lifelike_mj.butterfly.flight3d.strobe import VIEWS
 
@@ -341,9 +348,7 @@ def add_commands(bf) -> None:
     p.set_defaults(func=cmd_assess3d)
     p = bf.add_parser("measure3d", help="how natural a 3D controller's level flight is: roll, strokes, dorsal gap, "
                                         "body angle, bobbing, abdomen, power, advance ratio")
-    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name or a file")
-    p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s")
-    p.add_argument("--settle", type=num(0, MAX_DURATION_S, unit="s"), default=5.0, help="seconds of settling first")
+    _add_level_flight(p, 5.0, "seconds of settling first")
     p.add_argument("--window", type=num(0, 600, lo_open=True, unit="s"), default=5.0,
                    help="seconds measured after settling (whole wing beats)")
     _add_dt(p)
@@ -351,9 +356,7 @@ def add_commands(bf) -> None:
     p.set_defaults(func=cmd_measure3d)
     p = bf.add_parser("strobe3d", help="a stroboscopic picture of one wing beat in level flight, from the side and "
                                        "from ahead")
-    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name or a file")
-    p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s")
-    p.add_argument("--settle", type=num(0, 600, unit="s"), default=3.0, help="seconds of flight before the beat")
+    _add_level_flight(p, 3.0, "seconds of flight before the beat")
     p.add_argument("--n", type=count(2, 64), default=8, help="moments of the beat drawn, 2 to 64")
     p.add_argument("--views", default="side,front", type=_views, help="side, front and/or top, comma-separated")
     p.add_argument("--width", type=count(16, 1920), default=480, help="width of each view, pixels")
