@@ -302,3 +302,17 @@ def test_a_butterfly_with_legs_stands_on_the_ground_with_its_wings_closed():
     g = Flight3D(closed, animal="monarch", start_m=(0.0, 0.0, -4.0 + 0.008))
     g.step(400)
     assert g.data.qpos[2] < -4.2 and g.data.ncon == 0
+
+
+def test_a_garden_of_monarchs_draws_and_flies_monarchs():
+    """A garden flown by the monarch controller: its physics is the monarch's (masses, the quasi-steady law the
+    controller keeps) and its drawing scene shows monarchs (their measured outlines, in orange)."""
+    from lifelike_mj.butterfly.flight3d.garden import Garden
+
+    g = Garden(2, "monarch", seed=3, n_flowers=3)
+    assert g.controller.animal == "monarch" and g._force_law == "quasi_steady"
+    assert g._phys.body_subtreemass[1] == pytest.approx(MONARCH.mass_kg, rel=1e-12)
+    names = {g.model.geom(i).name for i in range(g.model.ngeom)}
+    assert {"b0_wing_left", "b0_wing_left_1", "b1_wing_right_1"} <= names
+    g.step(80)
+    assert np.isfinite(g._batch.records[:, 0]).all()
