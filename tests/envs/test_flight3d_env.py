@@ -139,3 +139,24 @@ def test_bad_actions_are_one_sentence():
             env.step(bad)
     with pytest.raises(UserError, match="unknown reset option"):
         env.reset(options={"tasks": "level"})
+
+
+def test_the_monarch_flies_through_the_env_with_its_own_wings_and_law():
+    """The shipped monarch as the env's controller: the env's flights are the monarch's (its measured wings and the
+    quasi-steady law the controller keeps), single and vectorised alike."""
+    env = gym.make("lifelike_mj/ButterflyFlight3D-v0", controller="monarch", duration_s=0.2)
+    obs, _ = env.reset(seed=0)
+    flight = env.unwrapped.flight
+    assert flight.animal == "monarch" and flight.options["force_law"] == "quasi_steady"
+    for _ in range(20):
+        obs, *_ = env.step(np.zeros(flight3d.N_ACT))
+    assert np.isfinite(obs).all()
+    venv = gym.make_vec("lifelike_mj/ButterflyFlight3D-v0", num_envs=2, vectorization_mode="vector_entry_point",
+                        controller="monarch", duration_s=0.2)
+    vobs, _ = venv.reset(seed=0)
+    assert np.isfinite(vobs).all()
+    from lifelike_mj.butterfly.flight3d import model as mj3d
+
+    d = venv.unwrapped._new_data()
+    assert d.userdata[mj3d.U_MODE] == mj3d.FORCE_LAWS["quasi_steady"]
+    assert venv.unwrapped._model.body_subtreemass[1] == pytest.approx(flight.model.body_subtreemass[1])
