@@ -221,12 +221,17 @@ def outline_texture(surfaces, box: tuple[float, float, float, float], pattern: s
     return np.concatenate([np.clip(img, 0, 255), np.full((px, px, 1), 255.0)], axis=-1).astype(np.uint8)
 
 
-def _outline_pieces(surfaces, look_of, bone: int, sign: float) -> list[Piece]:
-    """The measured wing's surfaces as mesh pieces bound to ``bone``, drawn on both faces, fore wing above."""
+def _outline_box(surfaces) -> tuple[float, float, float, float]:
+    """The chord range and the span range ``(0, R)`` a measured wing's texture spans (m; either wing: the span's
+    size)."""
     allv = np.concatenate([v for v, _, _ in surfaces])
-    x0, x1 = float(allv[:, 0].min()), float(allv[:, 0].max())
-    y0, y1 = 0.0, float(np.abs(allv[:, 1]).max())
-    look = look_of(surfaces if sign > 0 else [(v * [1, -1, 1], t, e * [1, -1]) for v, t, e in surfaces], (x0, x1, y0, y1))
+    return float(allv[:, 0].min()), float(allv[:, 0].max()), 0.0, float(np.abs(allv[:, 1]).max())
+
+
+def _outline_pieces(surfaces, look: Look, bone: int) -> list[Piece]:
+    """The measured wing's surfaces as mesh pieces bound to ``bone``, drawn on both faces, fore wing above; texture
+    coordinates over :func:`_outline_box` (the right wing mirrors the left's)."""
+    x0, x1, _, y1 = _outline_box(surfaces)
     pieces = []
     for k, (v, t, _) in enumerate(surfaces):
         pos = v.copy()
@@ -296,14 +301,7 @@ def butterfly_rig(poses, root: int, indices: list[int], pattern: str = "swallowt
                                                                        0.7 * head_r), turn, rest))
     # the mesh
     wing_look = Look("wing", (1.0, 1.0, 1.0, 1.0), wing_texture(pattern), double_sided=True, roughness=0.8)
-    outline_looks: dict = {}
-
-    def outline_look(surfaces, box) -> Look:
-        # one texture for both wings: the left wing's, mirrored by the right wing's texture coordinates
-        if "look" not in outline_looks:
-            outline_looks["look"] = Look("wing", (1.0, 1.0, 1.0, 1.0), outline_texture(surfaces, box, pattern),
-                                         double_sided=True, roughness=0.8)
-        return outline_looks["look"]
+    outline_look = None  # one texture for both measured wings, made from the first in the left wing's frame
     body_look = Look("body", (0.12, 0.10, 0.08, 1.0), roughness=0.9)
     eye_look = Look("eye", (0.03, 0.03, 0.03, 1.0), roughness=0.3)
     pieces: list[Piece] = []
@@ -337,7 +335,11 @@ def butterfly_rig(poses, root: int, indices: list[int], pattern: str = "swallowt
             continue
         measured = outline_surfaces(m, wing_ids[side])
         if measured:
-            for piece in _outline_pieces(measured, outline_look, w, sign):
+            if outline_look is None:
+                left = [(v * [1, sign, 1], t, e * [1, sign]) for v, t, e in measured]
+                outline_look = Look("wing", (1.0, 1.0, 1.0, 1.0), outline_texture(left, _outline_box(measured), pattern),
+                                    double_sided=True, roughness=0.8)
+            for piece in _outline_pieces(measured, outline_look, w):
                 piece.positions = piece.positions @ bones[w].bind[:3, :3].T + bones[w].bind[:3, 3]
                 piece.normals = piece.normals @ bones[w].bind[:3, :3].T
                 pieces.append(piece)

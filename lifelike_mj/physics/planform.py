@@ -16,6 +16,7 @@ sum of closed forms over the triangles, from the barycentric monomials
 from __future__ import annotations
 
 import math
+from itertools import product
 
 import numpy as np
 
@@ -111,8 +112,6 @@ def _monomial(tris: np.ndarray, i: int, j: int) -> float:
     n = i + j
     # expand x^i y^j in the barycentric coordinates: x = sum_k l_k x_k; average the monomial's value over
     # the exact rule of degree n (every l_a^p l_b^q l_c^r with p + q + r = n)
-    from itertools import product
-
     for t, area in zip(tris, areas):
         s = 0.0
         for combo in product(range(3), repeat=n):

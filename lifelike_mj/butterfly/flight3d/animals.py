@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -70,7 +70,6 @@ class Animal:
     stroke_plane_deg: float = 0.0
     colours: tuple = ()  # each surface's drawn colour (RGBA)
     source: str = ""
-    extra: dict = field(default_factory=dict)
 
     @property
     def mass_kg(self) -> float:

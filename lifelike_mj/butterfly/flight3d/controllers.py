@@ -55,6 +55,9 @@ FORMAT = "lifelike-mj/butterfly3d-controller"
 MAX_LAYERS, MAX_WIDTH, MAX_WEIGHT, MAX_EVERY, MAX_OMEGA_C = 6, 256, 1.0e6, 12_000, 1.0e4
 #: What a controller's forward and sideways speeds are measured against (module docstring).
 INPUTS = ("ground", "air")
+#: The wing-force laws a controller can be evolved with and fly (those of the model's callback that act over the
+#: wing's area: :data:`~lifelike_mj.butterfly.flight3d.model.FORCE_LAWS` less ``none`` and the paper's ``tip``).
+FORCE_LAWS_FLOWN = ("exact", "strip", "quasi_steady")
 #: Default ``scale`` of the actions (rad; Hz for the frequency).
 DEFAULT_SCALE = {"offset_sym": 0.3, "offset_asym": 0.3, "amplitude_sym": 0.3, "amplitude_asym": 0.3, "feather_sym": 0.5,
                  "feather_asym": 0.3, "feather_amplitude": 0.3, "abdomen_mean": 0.8, "frequency": 3.0}
@@ -140,10 +143,8 @@ class Controller3D:
         from lifelike_mj.butterfly.flight3d.animals import animal as _animal
 
         self.animal = _animal(animal).name
-        from lifelike_mj.butterfly.flight3d.model import FORCE_LAWS
-
-        if force_law not in FORCE_LAWS or force_law in ("none", "tip"):
-            raise UserError(f"{where}: force_law is 'exact', 'strip' or 'quasi_steady', got {force_law!r}.")
+        if force_law not in FORCE_LAWS_FLOWN:
+            raise UserError(f"{where}: force_law is {', '.join(repr(v) for v in FORCE_LAWS_FLOWN)}, got {force_law!r}.")
         self.force_law = force_law
         self.provenance = dict(provenance or {})
 
@@ -193,7 +194,7 @@ def json_schema() -> dict:
         "inputs": {"enum": list(INPUTS), "description": "the network's speeds over the ground or through the air"},
         "animal": {"enum": list(ANIMALS), "description": "the butterfly it flies (module "
                    "lifelike_mj.butterfly.flight3d.animals); missing: the paper's swallowtail"},
-        "force_law": {"enum": ["exact", "strip", "quasi_steady"], "description": "the wing-force law it was evolved "
+        "force_law": {"enum": list(FORCE_LAWS_FLOWN), "description": "the wing-force law it was evolved "
                       "with and flies with (module lifelike_mj.butterfly.flight3d.model); missing: exact"},
         "provenance": {"type": "object"},
     }

@@ -88,22 +88,21 @@ def style(rec: np.ndarray, dt_s: float, mass_kg: float) -> dict:
 
 
 def unnatural(st: dict, task: Task3D) -> float:
-    """The fitness a flight of style ``st`` (:func:`style`) on ``task`` loses to :data:`NATURAL`."""
-    cost = 0.0
-    b, c = NATURAL["stroke_difference_deg"]
-    cost += c * max(0.0, st["stroke_difference_deg"] - b)
-    b, c = NATURAL["offset_difference_deg"]
-    cost += c * max(0.0, st["offset_difference_deg"] - b)
-    (lo, hi), c = NATURAL["stroke_top_deg"]
-    cost += c * (max(0.0, lo - st["stroke_top_deg"]) + max(0.0, st["stroke_top_deg"] - hi))
-    b, c = NATURAL["power_W_kg"]
-    cost += c * max(0.0, st["power_W_kg"] - b)
+    """The cost of a flight of style ``st`` (:func:`style`) on ``task`` under :data:`NATURAL` (its score is multiplied
+    by ``exp(-cost)``)."""
+    def over(key: str, value: float) -> float:
+        bound, c = NATURAL[key]
+        return c * max(0.0, value - bound)
+
+    (lo, hi), c_top = NATURAL["stroke_top_deg"]
+    terms = [over("stroke_difference_deg", st["stroke_difference_deg"]),
+             over("offset_difference_deg", st["offset_difference_deg"]),
+             c_top * (max(0.0, lo - st["stroke_top_deg"]) + max(0.0, st["stroke_top_deg"] - hi)),
+             over("power_W_kg", st["power_W_kg"])]
     if straight(task):
-        b, c = NATURAL["roll_deg"]
-        cost += c * max(0.0, abs(st["roll_deg"]) - b)
-        b, c = NATURAL["body_angle_deg"]
-        cost += c * max(0.0, abs(st["pitch_deg"] - body_angle_target_deg(task.rows[0][3])) - b)
-    return cost
+        terms += [over("roll_deg", abs(st["roll_deg"])),
+                  over("body_angle_deg", abs(st["pitch_deg"] - body_angle_target_deg(task.rows[0][3])))]
+    return sum(terms, 0.0)
 
 
 @dataclass

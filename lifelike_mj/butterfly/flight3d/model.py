@@ -106,8 +106,7 @@ U_ASTAR = U_C + MAX_NV  # 8: the driven dofs' accelerations asked
 U_TAU = U_ASTAR + 8  # 8: their torques
 U_REF = U_TAU + 8  # 15: the joints' references (5 x 3)
 U_KIN = U_REF + 15  # 3 * N_PARAMS: the parameters at the stage (p, dp, ddp)
-U_WL = U_KIN + 3 * N_PARAMS  # W / L: the chord per span of the planform-2 triangle
-U_NPANEL = U_WL + 1
+U_NPANEL = U_KIN + 3 * N_PARAMS
 U_PANEL = U_NPANEL + 1  # per panel: chord position (m, + forward), span position (m, > 0), area (m^2), local chord (m)
 MAX_PANELS = 240
 N_PANEL = 4  # numbers per panel
@@ -859,7 +858,6 @@ def setup_data(m: mujoco.MjModel, kinematics: Kinematics, params: ButterflyParam
     ud[U_FREE_D : U_FREE_D + len(free)] = free
     ud[U_ASSIST] = ASSISTS[assist]
     pan = outline_panels(a, n_strips, n_chord) if a.measured else panels(p, n_strips, n_chord)
-    ud[U_WL] = p.width_m / p.span_m
     ud[U_NPANEL] = len(pan)
     ud[U_PANEL : U_PANEL + pan.size] = pan.ravel()
     tris, rc = wing_triangles(p, a.name)

@@ -46,6 +46,7 @@ def strobe(flight, n: int = 8, views=("side", "front"), width: int = 480, height
             flight.step(steps)
         d = mujoco.MjData(m)
         mujoco.mj_copyData(d, m, flight.data)
+        mujoco.mj_kinematics(m, d)  # the places of this moment (a step leaves them at its start)
         states.append(d)
     root = int(m.jnt_qposadr[m.joint("root").id])
     first = states[0].qpos[root : root + 3].copy()
@@ -55,14 +56,15 @@ def strobe(flight, n: int = 8, views=("side", "front"), width: int = 480, height
     dress(m)
     with Offscreen(m, width, height) as r:
         for view in views:
-            shown = []
-            for d in states:
-                e = mujoco.MjData(m)
-                mujoco.mj_copyData(e, m, d)
-                if view != "side":
-                    e.qpos[root : root + 3] = first  # around the body: the stroke's envelope
-                mujoco.mj_kinematics(m, e)
-                shown.append(e)
+            shown = states
+            if view != "side":  # around the body: the stroke's envelope
+                shown = []
+                for d in states:
+                    e = mujoco.MjData(m)
+                    mujoco.mj_copyData(e, m, d)
+                    e.qpos[root : root + 3] = first
+                    mujoco.mj_kinematics(m, e)
+                    shown.append(e)
             centre = path.mean(axis=0) if view == "side" else first
             reach = float(np.ptp(path[:, 0])) if view == "side" else 0.0
             cam = mujoco.MjvCamera()
