@@ -77,6 +77,21 @@ def vector(name: str, v: object, n: int, unit: str = "") -> tuple[float, ...]:
     return tuple(float(x) for x in items)
 
 
+def points(name: str, v: object, unit: str = "", max_n: int = 1000, bound: float = 1e4) -> tuple[tuple[float, ...], ...]:
+    """``v`` as ``n`` points of 3 floats, ``1 <= n <= max_n``, each coordinate finite and within ``+-bound``; a
+    :class:`UserError` otherwise."""
+    try:
+        items = [vector(f"each of {name}", p, 3, unit) for p in v]  # type: ignore[union-attr]
+    except TypeError:
+        items = []
+    if not 1 <= len(items) <= max_n:
+        raise UserError(f"{name} must be 1 to {max_n:,} points (x, y, z), got {v!r}.")
+    if max(abs(x) for p in items for x in p) > bound:
+        u = f" {unit}" if unit else ""
+        raise UserError(f"{name} must lie within {bound:g}{u} of the origin.")
+    return tuple(items)
+
+
 # ---- how much work a command may ask for ---------------------------------------------------------------
 
 #: The most simulation steps one command may ask for, summed over every body it simulates (a flight, each fish

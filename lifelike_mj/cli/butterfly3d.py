@@ -107,7 +107,8 @@ def cmd_evolve3d(args) -> None:
                        checkpoint=args.checkpoint, resume=args.resume, progress=not args.quiet,
                        overwrite=args.overwrite, task_set=args.tasks, start=start, gene_bound=args.gene_bound,
                        inputs=args.inputs, executor=args.executor, workers=args.workers, ray_address=args.ray_address,
-                       dt_s=args.dt, animal=args.animal, natural=args.natural, force_law=args.force_law)
+                       dt_s=args.dt, animal=args.animal, natural=args.natural, force_law=args.force_law,
+                       take_off=args.take_off)
     if ctrl is None:
         raise KeyboardInterrupt("stopped before the first generation was evaluated; nothing was written")
     state = "stopped early (Ctrl-C); best so far" if res.interrupted else "done"
@@ -269,7 +270,7 @@ def _hidden(text: str) -> list[int]:
 def add_commands(bf) -> None:
     """``fly3d``, ``evolve3d`` and ``assess3d`` under ``lifelike-mj butterfly``."""
     p = bf.add_parser("fly3d", help="fly the 3D butterfly with a 3D controller")
-    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name (steer, cruise, wind) or a file")
+    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name (monarch, steer, wind) or a file")
     p.add_argument("--task", default="level", choices=("level", "turn", "course"),
                    help="level flight, a turn (--angle) or a course of 10 waypoints drawn by --seed")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
@@ -287,12 +288,14 @@ def add_commands(bf) -> None:
     p = bf.add_parser("evolve3d", help="evolve a 3D controller (CMA-ES or the paper's GA) on the MuJoCo batch")
     p.add_argument("--optimizer", default="cmaes", choices=("cmaes", "rcga", "crs2", "esch", "isres"),
                    help="cmaes, rcga (the paper's GA) or an nlopt method")
-    p.add_argument("--tasks", default="steer", choices=("steer", "cruise", "wind", "natural"),
+    p.add_argument("--tasks", default="steer", choices=("steer", "cruise", "wind", "natural", "garden"),
                    help="the task set: steer (level at 1 and 2 m/s, turns of 90 and -180 deg), cruise (level at 1.5 "
                         "and 2 m/s, the turns, and two flights in 1 m/s wind with 0.5 m/s gusts) or wind (courses "
                         "1-4 in 1 m/s wind from four sides with gusts of 0.5 m/s, 0.25 m/s vertically, course 5 and "
                         "the -180 deg turn in still air, level flight in wind) or natural (level at 1, 1.5 and 2 m/s, "
-                        "the turns, course 5, and course 1 in 1 m/s wind with gusts of 0.5 m/s on every axis)")
+                        "the turns, course 5, and course 1 in 1 m/s wind with gusts of 0.5 m/s on every axis) or garden "
+                        "(the monarch's: level at 1, 2 and 2.5 m/s, the turns, course 5, course 1 in 1 m/s wind "
+                        "with gusts on every axis, course 3 in a 1.5 m/s wind, and three landings on flowers)")
     p.add_argument("--inputs", default=None, choices=("ground", "air"),
                    help="the network's speeds over the ground or through the air (default: the start's, else ground)")
     p.add_argument("--start", default=None, help="a 3D controller to start from (its network; genes are its changes)")
@@ -306,6 +309,8 @@ def add_commands(bf) -> None:
     p.add_argument("--natural", action="store_true",
                    help="also ask the flight to look like a butterfly's: level wings and even strokes in straight "
                         "flight, a dorsal gap of 35-50 deg, at most 20.2 W/kg, the body angle falling with speed")
+    p.add_argument("--take-off", action="store_true",
+                   help="every training flight starts perched on a flower, its wings closed, and takes off clapping")
     p.add_argument("--gene-bound", type=num(0, 10, lo_open=True), default=0.4,
                    help="bound of each gene (a weight's change from the start)")
     p.add_argument("--hidden", type=_hidden, default=[], help="hidden layer sizes, e.g. 16 (default: none, a linear network)")
@@ -384,7 +389,7 @@ def view_keys() -> str:
 def add_export_args(p: argparse.ArgumentParser) -> None:
     from lifelike_mj.cli.export import add_window
 
-    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name (steer, cruise, wind) or a file")
+    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name (monarch, steer, wind) or a file")
     p.add_argument("--task", default="course", choices=("level", "turn", "course"),
                    help="level flight, a turn (--angle) or a course of 10 waypoints drawn by --seed")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
@@ -431,7 +436,7 @@ def export_rigs(poses) -> list:
 
 
 def add_view_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--controller", default="wind", help="a shipped 3D controller's name (wind, steer, cruise) or a file")
+    p.add_argument("--controller", default="wind", help="a shipped 3D controller's name (wind, steer, monarch) or a file")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
     p.add_argument("--duration", type=num(0, None, lo_open=True, unit="s"), default=None,
                    help="stop after this many seconds (default: run until the window is closed)")

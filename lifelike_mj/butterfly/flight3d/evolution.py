@@ -26,12 +26,19 @@ from lifelike_mj.butterfly.flight3d import controllers as c3
 from lifelike_mj.butterfly.flight3d.flight import DT_S
 from lifelike_mj.butterfly.flight3d.loop import TUMBLE_RAD, Batch
 from lifelike_mj.butterfly.flight3d.tasks import (
+    CLAP_S,
     DRYDEN_VERTICAL_RATIO,
     N_STYLE,
+    R_CLAP_UNTIL,
     R_FIT,
+    R_LANDED_AT,
     R_STYLE,
+    R_TOUCH_SPEED,
+    R_WP,
+    TOUCHDOWN_M_S,
     Task3D,
     course,
+    land,
     level,
     new_record,
     turn,
@@ -105,10 +112,37 @@ def unnatural(st: dict, task: Task3D) -> float:
     return sum(terms, 0.0)
 
 
+def start_blossom(animal: str) -> tuple[float, float, float]:
+    """The centre of the flower a :class:`FlightProblem3D` with ``take_off`` starts on (m): right under the start, its
+    butterfly's thorax at the origin standing on it."""
+    from lifelike_mj.butterfly.flight3d.flowers import BLOSSOM_SIZE_M
+    from lifelike_mj.butterfly.flight3d.model import standing_height_m
+
+    return (0.0, 0.0, -standing_height_m(animal) - BLOSSOM_SIZE_M[2])
+
+
+#: How a landing is scored (:func:`landing_score`): the closest approach's scale (m) before touchdown, and the scale of
+#: the touchdown speed beyond :data:`~lifelike_mj.butterfly.flight3d.tasks.TOUCHDOWN_M_S` (m/s).
+LANDING_SCALES_M = (0.1, 0.25)
+
+
+def landing_score(rec: np.ndarray) -> float:
+    """A landing flight's score in ``[0, 1]`` from its run record: a touchdown scores at least 0.5, all of 1 within the
+    touchdown speed bound (``TOUCHDOWN_M_S``), falling off beyond it; a flight that does not touch down scores at most
+    0.5, by its closest approach to the point where it would stand (:data:`LANDING_SCALES_M`)."""
+    near, fast = LANDING_SCALES_M
+    if rec[R_LANDED_AT] >= 0.0:
+        return 0.5 + 0.5 * float(np.exp(-max(0.0, rec[R_TOUCH_SPEED] - TOUCHDOWN_M_S) / fast))
+    return 0.5 * float(np.exp(-rec[R_WP] / near))
+
+
 @dataclass
 class FlightProblem3D:
     """Evolve a 3D controller's weights (genes = weights less the ``prior``'s) to fly ``tasks`` well: the
-    fitness is the mean over the tasks of the mean reward per second (``[0, 1]``, larger is better)."""
+    fitness is the mean over the tasks of the mean reward per second (``[0, 1]``, larger is better). With
+    ``take_off`` every flight starts standing on a flower at the start (:func:`start_blossom`), its wings at the top
+    of the stroke, and takes off clapping, as a garden's perched butterflies do
+    (:meth:`~lifelike_mj.butterfly.flight3d.flight.Flight3D.take_off`)."""
 
     tasks: tuple[Task3D, ...]
     template: c3.Controller3D
@@ -121,6 +155,7 @@ class FlightProblem3D:
     force_law: str = "exact"
     prior: tuple[float, ...] = ()
     natural: bool = False
+    take_off: bool = False
 
     def __post_init__(self) -> None:
         if not self.tasks:
@@ -176,6 +211,7 @@ class FlightProblem3D:
                 "prior_sha256": hashlib.sha256(np.asarray(self.prior).tobytes()).hexdigest(),
                 # the butterfly and the naturalness asked, named where they are new (earlier fingerprints hold)
                 **({"animal": self.template.animal} if self.template.animal != "swallowtail" else {}),
+                **({"take_off": True} if self.take_off else {}),
                 **({"natural": {k: list(v) if isinstance(v, tuple) else v for k, v in NATURAL.items()}}
                    if self.natural else {})}
 
@@ -190,7 +226,8 @@ class FlightProblem3D:
         if self._model is None:
             from lifelike_mj.butterfly.flight3d import model as mj3d
 
-            self._model = mj3d.build_model(self.params, animal=self.template.animal)
+            flowers = [start_blossom(self.template.animal)] if self.take_off else None
+            self._model = mj3d.build_model(self.params, animal=self.template.animal, flowers=flowers)
             self._model.opt.timestep = self.dt_s
         return self._model
 
@@ -208,21 +245,31 @@ class FlightProblem3D:
         ctl = self.template
         datas = [mj3d.setup_data(m, Kinematics(ctl.base, ctl.omega_c_rad_s), self.params, force_law=self.force_law,
                                  n_strips=self.n_strips, n_chord=self.n_chord, animal=ctl.animal) for _ in range(n)]
+        records = new_record(n, max_rows)
+        if self.take_off:
+            records[:, R_CLAP_UNTIL] = CLAP_S
         batch = Batch(m, datas, tasks, ctl, weights=np.repeat(W, k, axis=0), dt_s=self.dt_s,
-                      records=new_record(n, max_rows), tumble_rad=TUMBLE_RAD)
+                      records=records, tumble_rad=TUMBLE_RAD)
         batch.advance(int(round(self.duration_s / self.dt_s)))
         return batch.records.reshape(len(W), k, -1)
 
     def evaluate(self, X: np.ndarray) -> np.ndarray:
         X = np.atleast_2d(np.asarray(X, dtype=np.float64))
         recs = self.fly(np.asarray(self.prior)[None, :] + X)
-        if not self.natural:
+        landing = [t.kind == "land" for t in self.tasks]
+        if not self.natural and not any(landing):
             return recs[:, :, R_FIT].mean(axis=1) / self.duration_s
         # each flight's score shrinks by exp(-cost): a flight that ends early (a tumble) keeps the little it earned,
-        # so that falling is never a way out of looking unnatural
+        # so that falling is never a way out of looking unnatural; a landing is scored by landing_score alone
         mass = float(self.model().body_subtreemass[1])
-        return np.array([np.mean([r[R_FIT] / self.duration_s * np.exp(-unnatural(style(r, self.dt_s, mass), t))
-                                  for r, t in zip(row, self.tasks)]) for row in recs])
+
+        def score(r, t, lands):
+            if lands:
+                return landing_score(r)
+            cost = unnatural(style(r, self.dt_s, mass), t) if self.natural else 0.0
+            return r[R_FIT] / self.duration_s * np.exp(-cost)
+
+        return np.array([np.mean([score(r, t, k) for r, t, k in zip(row, self.tasks, landing)]) for row in recs])
 
 
 #: The gusts of the ``wind`` task set: 0.5 m/s (horizontal), half that vertically (:data:`DRYDEN_VERTICAL_RATIO`).
@@ -244,7 +291,22 @@ TASK_SETS = {
     # a calm course and one in 1 m/s wind with gusts of 0.5 m/s on every axis
     "natural": lambda: (level(1.0), level(1.5), level(2.0), turn(90.0, 1.5, 1.5), turn(-180.0, 1.5, 1.5, 0.3), course(5),
                         course(1).with_weather((1.0, 0.0, 0.0), gust_m_s=0.5, gust_vertical_m_s=0.5, seed=1)),
+    # everything a monarch in a garden does, with --natural: straight flight from slow to fast (2.5 m/s, where J passes
+    # 0.9), the turns, a calm course, a course in 1 m/s wind with gusts of 0.5 m/s on every axis and one in a steady
+    # 1.5 m/s wind, and three landings on flowers (scored by landing_score)
+    "garden": lambda: (level(1.0), level(2.0), level(2.5), turn(90.0, 1.5, 1.5), turn(-180.0, 1.5, 1.5, 0.3), course(5),
+                       course(1).with_weather((1.0, 0.0, 0.0), gust_m_s=0.5, gust_vertical_m_s=0.5, seed=1),
+                       course(3).with_weather((-1.5, 0.0, 0.0), seed=3),
+                       *_landings()),
 }
+
+
+def _landings() -> tuple[Task3D, ...]:
+    """The ``garden`` set's landings: three flowers ahead, left and right, below and above the start, 0.9-1.4 m away."""
+    from lifelike_mj.butterfly.flight3d.model import standing_height_m
+
+    h = standing_height_m("monarch")
+    return tuple(land(p, h) for p in ((1.2, 0.3, -0.15), (0.7, -0.6, 0.05), (0.4, 1.0, -0.3)))
 
 
 def pd_prior(layers, animal: str = "swallowtail") -> np.ndarray:
@@ -278,7 +340,7 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
            overwrite: bool = False, task_set: str = "custom", on_generation=None, start: c3.Controller3D | None = None,
            inputs: str | None = None, executor: str = "serial", workers: int | None = None,
            ray_address: str | None = None, dt_s: float = DT_S, animal: str | None = None, natural: bool = False,
-           force_law: str | None = None):
+           force_law: str | None = None, take_off: bool = False):
     """Evolve a 3D controller on ``tasks`` (default: the ``steer`` set) with ``optimizer`` and write it to
     ``out`` with its provenance (the problem, the optimiser, the budget, the time it took, the fitness
     history). Returns ``(result, controller)``; nothing is overwritten unasked (the checks and locks of the
@@ -295,7 +357,8 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     controller starts from that butterfly's base kinematics
     (:func:`~lifelike_mj.butterfly.flight3d.controllers.default_base`) and prior (:func:`pd_prior`). ``natural``:
     the fitness also asks for :data:`NATURAL` (module docstring). ``force_law``: the wing-force law of the training
-    flights, recorded in the controller (default the start's, else ``"exact"``)."""
+    flights, recorded in the controller (default the start's, else ``"exact"``). ``take_off``: every training flight
+    starts perched on a flower and takes off (:class:`FlightProblem3D`)."""
     from lifelike_mj import provenance as _prov
     from lifelike_mj.evolve import make_evaluator, optimize
     from lifelike_mj.evolve.checkpoint import guarded_run_files
@@ -319,7 +382,7 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
                                    else [], c3.default_base(animal), inputs=inputs or "ground", animal=animal,
                                    force_law=force_law or "exact")
     problem = FlightProblem3D(tuple(tasks), template, duration_s=duration_s, gene_bound=gene_bound, dt_s=dt_s,
-                              natural=bool(natural), force_law=template.force_law)
+                              natural=bool(natural), force_law=template.force_law, take_off=bool(take_off))
     out = Path(out)
     with guarded_run_files(out, checkpoint, resume=resume, overwrite=overwrite) as ckpt:
         with make_evaluator(problem, executor=executor, workers=workers, ray_address=ray_address) as ev:

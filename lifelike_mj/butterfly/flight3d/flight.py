@@ -35,13 +35,14 @@ import numpy as np
 from lifelike_mj import checks
 from lifelike_mj.butterfly.flight3d import model as mj3d
 from lifelike_mj.butterfly.flight3d.controllers import Controller3D, load_controller
-from lifelike_mj.butterfly.flight3d.kinematics import JOINTS, N_PARAMS, Kinematics, KinematicsCommand
+from lifelike_mj.butterfly.flight3d.kinematics import JOINTS, N_PARAMS, Kinematics, KinematicsCommand, joint_refs
 from lifelike_mj.butterfly.flight3d.loop import TUMBLE_RAD, Batch
 from lifelike_mj.butterfly.flight3d.tasks import (
     R_DIVERGED,
     R_PASSED,
     R_TUMBLED,
     R_WP,
+    T_KIND,
     T_ROW0,
     T_WIND,
     Task3D,
@@ -110,7 +111,10 @@ class Flight3D(StepCounter):
     ``animal``: the butterfly (``"swallowtail"``, the paper's, or ``"monarch"``, with measured wings:
     :mod:`~lifelike_mj.butterfly.flight3d.animals`); default the controller's, else the swallowtail.
     ``contact``: the butterfly has legs that touch the ground (:func:`~lifelike_mj.butterfly.flight3d.model.add_contact`);
-    without it nothing touches anything.
+    without it nothing touches anything. ``flowers``: blossoms' centres (``(n, 3)``, m) whose blossoms the legs touch
+    too (:mod:`~lifelike_mj.butterfly.flight3d.flowers`; implies ``contact``), for landings
+    (:func:`~lifelike_mj.butterfly.flight3d.tasks.land`, :meth:`land_on`, :meth:`take_off`); ``ground_m``: the
+    ground's height (m; default 4 m below the start's altitude 0).
     ``end_on_tumble``: a roll or pitch beyond :data:`~lifelike_mj.butterfly.flight3d.loop.TUMBLE_RAD` ends the
     flight there (as in an evolution; :attr:`tumbled`), else it flies on.
     ``assist="hold"`` holds the attitude at ``pitch_law(flight)`` (rad, nose up), set once per step, roll
@@ -125,7 +129,7 @@ class Flight3D(StepCounter):
                  body_areas_m2=None, masses: str = "animal", dt_s: float = DT_S, n_strips: int = 8,
                  n_chord: int = 2, drive_hz: float = 50.0, omega_c: float | None = None, assist: str = "none",
                  pitch_law: Callable | None = None, end_on_tumble: bool = False, animal: str | None = None,
-                 contact: bool = False,
+                 contact: bool = False, flowers=None, ground_m: float | None = None,
                  _model: mujoco.MjModel | None = None) -> None:
         self.network = None
         if isinstance(controller, (str, Path)):
@@ -172,9 +176,14 @@ class Flight3D(StepCounter):
                         "n_strips": n_strips, "n_chord": n_chord, "animal": self.animal}
         self.masses, self.omega_c, self.pitch_law = masses, omega_c, pitch_law
         self.end_on_tumble = bool(end_on_tumble)
-        self.contact = bool(contact)
+        #: The blossoms' centres (``(n, 3)``, m), or ``None``.
+        self.flowers = None if flowers is None else np.array(checks.points("flowers", flowers, "m"))
+        if ground_m is not None:
+            ground_m = checks.number("ground_m", ground_m, -1000.0, 1000.0, unit="m")
+        self.contact = bool(contact) or self.flowers is not None
         self._model = _model if _model is not None else mj3d.build_model(self.params, masses, self.animal,
-                                                                          contact=self.contact)
+                                                                          contact=self.contact, flowers=self.flowers,
+                                                                          ground_m=ground_m)
         self._model.opt.timestep = self.dt
         self._model.opt.gravity[:] = (0.0, 0.0, -self.params.gravity)
         self._root_q = int(self._model.jnt_qposadr[self._model.joint("root").id])
@@ -340,6 +349,93 @@ class Flight3D(StepCounter):
         self._batch.decide(action, limit)
         self._settle()
         return self._batch.observations[0].copy()
+
+    # ---- landing, perching and take-off -----------------------------------------------------------
+
+    def land_on(self, flower: int, radius_m: float = 0.03, speed_m_s: float = 1.0):
+        """The landing task (:func:`~lifelike_mj.butterfly.flight3d.tasks.land`) on this flight's flower ``flower``
+        (an index into :attr:`flowers`): its blossom's top, at this butterfly's standing height."""
+        from lifelike_mj.butterfly.flight3d.flowers import landing_surface
+        from lifelike_mj.butterfly.flight3d.tasks import land
+
+        if self.flowers is None:
+            raise UserError("this flight has no flowers to land on; give Flight3D flowers=[(x, y, z), ...].")
+        k = checks.whole("flower", flower, 0, len(self.flowers) - 1)
+        return land(landing_surface(self.flowers[k]), mj3d.standing_height_m(self.animal), radius_m, speed_m_s,
+                    name=f"land on flower {k}")
+
+    @property
+    def perched(self) -> bool:
+        """Whether the butterfly has touched down on a landing task's flower and sits there (until :meth:`take_off`)."""
+        from lifelike_mj.butterfly.flight3d.tasks import TASK_PERCH
+
+        return int(self._task[T_KIND]) == TASK_PERCH
+
+    @property
+    def touchdown(self) -> dict | None:
+        """The last touchdown of this landing: ``time_s`` and ``speed_m_s`` (over the ground), or ``None``."""
+        from lifelike_mj.butterfly.flight3d.tasks import R_LANDED_AT, R_TOUCH_SPEED
+
+        if self._rec[R_LANDED_AT] < 0:
+            return None
+        return {"time_s": float(self._rec[R_LANDED_AT]), "speed_m_s": float(self._rec[R_TOUCH_SPEED])}
+
+    def take_off(self, task: Task3D, clap_s: float | None = None) -> None:
+        """Take off from the perch and fly ``task`` (a course, a schedule, or the landing on the next flower,
+        :meth:`land_on`): the wings open to the top of the stroke (:func:`~lifelike_mj.butterfly.flight3d.loop.
+        take_off_kinematics`) and the network flies again, its first ``clap_s`` s (default
+        :data:`~lifelike_mj.butterfly.flight3d.tasks.CLAP_S`) with larger strokes whose tops meet: a clap."""
+        from lifelike_mj.butterfly.flight3d import tasks as t3
+        from lifelike_mj.butterfly.flight3d.loop import take_off_kinematics
+
+        if not self.perched:
+            raise UserError("take_off: the butterfly is not perched (it perches when a landing task touches down).")
+        if not isinstance(task, Task3D):
+            raise UserError(f"a task is a Task3D (flight3d.level, course, land), got {task!r}.")
+        clap = t3.CLAP_S if clap_s is None else checks.number("clap_s", clap_s, 0.0, 10.0, unit="s")
+        n_rows = len(task.rows)
+        rec = new_record(1, n_rows)
+        keep = [i for i in range(t3.R_WP) if i not in (t3.R_PASSED, t3.R_LANDED_AT, t3.R_TOUCH_SPEED)]
+        rec[0, keep] = self._rec[keep]
+        rec[0, t3.R_CLAP_UNTIL] = self.time + clap
+        self.task, self._n_rows = task, n_rows
+        self._batch = Batch(self._model, [self._data], task.as_array(n_rows), self.network, dt_s=self.dt,
+                            records=rec, base=None if self.network else self.command.as_array(),
+                            tumble_rad=self._batch.tumble_rad)
+        self._task = self._batch.tasks[0]
+        self._rec = self._batch.records[0]
+        take_off_kinematics(self._data.userdata, self._batch.base)
+
+    def perch_on(self, flower: int) -> None:
+        """Put the butterfly at rest on flower ``flower`` (an index into :attr:`flowers`), standing, facing its
+        heading now, its wings closed: perched, as after a landing's touchdown (ready for :meth:`take_off`)."""
+        from lifelike_mj.butterfly.flight3d import tasks as t3
+        from lifelike_mj.butterfly.flight3d.loop import perch_command
+
+        task = self.land_on(flower)
+        row = task.rows[0]
+        yaw = float(euler_from_quat(self._data.qpos[self._root_q + 3 : self._root_q + 7])[2])
+        self.task, self._n_rows = task, len(task.rows)
+        self._batch = Batch(self._model, [self._data], task.as_array(self._n_rows), self.network, dt_s=self.dt,
+                            records=new_record(1, self._n_rows),
+                            base=None if self.network else self.command.as_array(), tumble_rad=self._batch.tumble_rad)
+        self._task = self._batch.tasks[0]
+        self._rec = self._batch.records[0]
+        self._task[T_KIND] = t3.TASK_PERCH
+        self._rec[t3.R_LANDED_AT], self._rec[t3.R_AIM] = self.time, yaw
+        d, rq = self._data, self._root_q
+        d.qpos[rq : rq + 3] = (row[0], row[1], row[2] + row[3])
+        d.qpos[rq + 3 : rq + 7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
+        d.qvel[:] = 0.0
+        ud = d.userdata
+        perch_command(self._batch.base, ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS])
+        ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS] = ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS]
+        ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS] = 0.0
+        refs = np.zeros((len(JOINTS), 3))
+        joint_refs(ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS], np.zeros(N_PARAMS), np.zeros(N_PARAMS), float(ud[mj3d.U_PSI0]),
+                   refs)
+        d.qpos[self._q] = refs[:, 0]
+        d.qvel[self._driven] = 0.0
 
     @property
     def tumbled(self) -> bool:

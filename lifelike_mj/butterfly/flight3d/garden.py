@@ -1,12 +1,15 @@
-"""A garden of 3D butterflies: flowers as waypoints, each butterfly on its own course, all in one scene.
+"""A garden of 3D butterflies: each butterfly visits the flowers in its own order, all in one scene.
 
 :class:`Garden` is a stepper (the shape of :mod:`lifelike_mj.stepper`): ``n`` butterflies, each simulated on
 its own ``mjData`` of the one-butterfly model and flown together by the compiled threaded batch
 (:class:`~lifelike_mj.butterfly.flight3d.loop.Batch`). They do not touch or disturb each other (the
-air's force law has no wake). Each butterfly's course visits the garden's flowers in an order drawn by
-its own seed, with its own flutter; ``model``/``data`` are a drawing scene (ground, flowers, ``n``
-butterflies) posed from the simulations by :meth:`Garden.sync`, with a fixed camera ``overview`` and
-a chase camera from :func:`chase_camera`.
+air's force law has no wake). Each butterfly visits the garden's flowers in an order drawn by its own seed, with
+its own flutter, in one of two ways: it **lands** on each flower (a landing task,
+:func:`~lifelike_mj.butterfly.flight3d.tasks.land`: it touches down on the blossom with its legs, perches with its
+wings closed for a time drawn between :data:`PERCH_S`, and takes off for the next flower with a clap), or it
+**passes** each flower 0.15 m above its blossom (a course of waypoints). ``model``/``data`` are a drawing scene
+(ground, flowers, ``n`` butterflies) posed from the simulations by :meth:`Garden.sync`, with a fixed camera
+``overview`` and a chase camera from :func:`chase_camera`.
 """
 
 from __future__ import annotations
@@ -18,18 +21,25 @@ import numpy as np
 
 from lifelike_mj import checks
 from lifelike_mj.butterfly.flight3d import model as mj3d
+from lifelike_mj.butterfly.flight3d import tasks as t3
 from lifelike_mj.butterfly.flight3d.controllers import Controller3D, load_controller
 from lifelike_mj.butterfly.flight3d.flight import DT_S
+from lifelike_mj.butterfly.flight3d.flowers import add_flowers, landing_surface
 from lifelike_mj.butterfly.flight3d.kinematics import Kinematics
-from lifelike_mj.butterfly.flight3d.loop import Batch, attitude
+from lifelike_mj.butterfly.flight3d.loop import Batch, attitude, take_off_kinematics
 from lifelike_mj.butterfly.flight3d.tasks import R_DIVERGED, R_PASSED, Task3D, new_record
 from lifelike_mj.errors import Diverged, UserError
 from lifelike_mj.stepper import StepCounter
 
 #: The ground lies this far below the flight altitude 0 (m).
 GROUND_M = -1.0
-#: Flower colours (RGBA).
-_PETALS = ((0.92, 0.3, 0.55, 1), (0.98, 0.85, 0.2, 1), (0.55, 0.35, 0.85, 1), (0.98, 0.55, 0.2, 1), (1, 1, 1, 1))
+#: How long a butterfly stays perched on a flower (s): drawn uniformly between these, by its own seed.
+PERCH_S = (2.0, 4.0)
+#: A butterfly that has not touched down this long (s) after aiming at a flower gives it up for the next (a missed
+#: visit, counted in :meth:`Garden.visits`).
+GIVE_UP_S = 20.0
+#: The landings are checked (a perch's end, a give-up) every this many seconds of flight.
+CHECK_S = 0.05
 _WING_COLOURS = ((0.98, 0.85, 0.25, 0.95), (0.95, 0.55, 0.15, 0.95), (0.35, 0.55, 0.95, 0.95), (0.95, 0.95, 0.9, 0.95))
 #: Waypoints on each butterfly's course (the flowers visited, in its order, over and over).
 COURSE_LENGTH = 40
@@ -37,7 +47,8 @@ COURSE_LENGTH = 40
 STATE_UNITS = {
     "position_m": "m: each thorax's origin, x and y in the garden's plane, z up",
     "attitude_rad": "rad: each body's roll (right wing down > 0), pitch (nose up > 0), yaw (left > 0)",
-    "waypoints_passed": "flowers passed on each butterfly's course, in order",
+    "waypoints_passed": "flowers passed on each butterfly's course, in order (landing: flowers landed on)",
+    "perched": "whether each butterfly sits on a flower now",
 }
 
 
@@ -53,22 +64,30 @@ def flowers(seed: int, n: int = 12, size_m: float = 8.0, heights_m: float = 0.5)
     return np.array(pts)
 
 
-def course_among(blossoms: np.ndarray, seed: int, length: int = COURSE_LENGTH) -> np.ndarray:
-    """A course of ``length`` waypoints visiting the blossoms in random orders drawn by ``seed``, never the
-    same flower twice in a row, each waypoint 0.15 m above its blossom."""
+def visiting_order(n_flowers: int, seed: int, length: int = COURSE_LENGTH) -> list[int]:
+    """``length`` flower indices: the ``n_flowers`` flowers in random orders drawn by ``seed``, one round after
+    another, never the same flower twice in a row."""
     rng = np.random.default_rng([seed, 2])
     order: list[int] = []
     while len(order) < length:
-        perm = list(rng.permutation(len(blossoms)))
+        perm = [int(k) for k in rng.permutation(n_flowers)]
         if order and perm[0] == order[-1]:
             perm.append(perm.pop(0))
         order += perm
-    return blossoms[order[:length]] + np.array([0.0, 0.0, 0.15])
+    return order[:length]
 
 
-def scene_model(n: int, blossoms: np.ndarray, size_m: float = 8.0, animal: str = "swallowtail") -> mujoco.MjModel:
-    """The drawing scene: the ground, the flowers (a stem and a blossom each) and ``n`` butterflies of ``animal``
-    (bodies ``b{i}_butterfly``), a fixed camera ``overview``."""
+def course_among(blossoms: np.ndarray, seed: int, length: int = COURSE_LENGTH) -> np.ndarray:
+    """A course of ``length`` waypoints visiting the blossoms in :func:`visiting_order`, each waypoint 0.15 m above
+    its blossom."""
+    return blossoms[visiting_order(len(blossoms), seed, length)] + np.array([0.0, 0.0, 0.15])
+
+
+def scene_model(n: int, blossoms: np.ndarray, size_m: float = 8.0, animal: str = "swallowtail",
+                legs: bool = False) -> mujoco.MjModel:
+    """The drawing scene: the ground, the flowers (:func:`~lifelike_mj.butterfly.flight3d.flowers.add_flowers`) and
+    ``n`` butterflies of ``animal`` (bodies ``b{i}_butterfly``; with ``legs``, the legs they stand on), a fixed camera
+    ``overview``."""
     spec = mujoco.MjSpec.from_file(str(mj3d.model_path()))
     spec.delete(spec.body("butterfly"))
     ground = spec.geom("ground")
@@ -78,17 +97,11 @@ def scene_model(n: int, blossoms: np.ndarray, size_m: float = 8.0, animal: str =
     spec.visual.global_.offheight = 1080
     spec.visual.map.znear = 0.001
     spec.visual.map.zfar = 200.0
-    stem = (0.25, 0.55, 0.2, 1.0)
-    for k, b in enumerate(blossoms):
-        spec.worldbody.add_geom(name=f"stem_{k}", type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[0.006, 0, 0],
-                                fromto=[b[0], b[1], GROUND_M, b[0], b[1], b[2] - 0.01], rgba=stem,
-                                contype=0, conaffinity=0)
-        spec.worldbody.add_geom(name=f"blossom_{k}", type=mujoco.mjtGeom.mjGEOM_ELLIPSOID, size=[0.05, 0.05, 0.015],
-                                pos=list(b), rgba=_PETALS[k % len(_PETALS)], contype=0, conaffinity=0)
-        spec.worldbody.add_geom(name=f"heart_{k}", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.015, 0, 0],
-                                pos=[b[0], b[1], b[2] + 0.01], rgba=(0.95, 0.8, 0.1, 1), contype=0, conaffinity=0)
+    add_flowers(spec, blossoms, GROUND_M)
     for i in range(n):
         one = mj3d.build_spec(animal=animal)
+        if legs:
+            mj3d.add_legs(one)
         if animal == "swallowtail":
             one.material("wing").rgba = _WING_COLOURS[i % len(_WING_COLOURS)]
         one.visual.map.znear = spec.visual.map.znear  # the scene's (no attach conflict)
@@ -110,34 +123,48 @@ class Garden(StepCounter):
     ``flutter``, ``gust_m_s``, ``gust_vertical_m_s``, ``wind_to_m_s`` (or ``wind_from_m_s``; ``wind_m_s``, the
     older spelling of ``wind_to_m_s``): each butterfly's flutter and the weather
     (:class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`); ``speed_m_s``: the cruise speed; ``dt_s`` the time step.
+    ``land``: the butterflies land on the flowers (module docstring); default: a controller evolved to land (the
+    ``garden`` task set, :mod:`~lifelike_mj.butterfly.flight3d.evolution`) lands, the others pass the flowers by.
     """
 
     @checks.known_keywords
     def __init__(self, n: int = 20, controller="steer", *, seed: int = 0, n_flowers: int = 10, size_m: float = 6.0,
                  speed_m_s: float = 1.5, flutter: float = 0.1, gust_m_s: float = 0.0, wind_to_m_s=None,
                  gust_vertical_m_s: float | None = None, dt_s: float = DT_S, n_strips: int = 8, n_chord: int = 2,
-                 force_law: str | None = None, wind_from_m_s=None, wind_m_s=None) -> None:
+                 force_law: str | None = None, wind_from_m_s=None, wind_m_s=None, land: bool | None = None) -> None:
         self.n = checks.whole("the number of butterflies", n, 1, 500)
         self.controller = controller if isinstance(controller, Controller3D) else load_controller(controller)
         self.seed = checks.whole("seed", seed, 0, 2**32 - 1)
         self.size_m = checks.number("garden size", size_m, 2.0, 100.0, unit="m")
         self.blossoms = flowers(self.seed, checks.whole("the number of flowers", n_flowers, 2, 200), self.size_m)
         self.dt = checks.positive("time step dt_s", dt_s, "s")
+        #: Whether the butterflies land on the flowers (else they pass them by).
+        self.land = lands(self.controller) if land is None else bool(land)
         wind = checks.one_wind("Garden", wind_to_m_s, wind_from_m_s, wind_m_s, "to") or (0.0, 0.0, 0.0)
-        self.tasks = [Task3D("waypoints", tuple(tuple(float(v) for v in p)
-                                                   for p in course_among(self.blossoms, self.seed * 1000 + i)),
-                                speed_m_s=checks.positive("speed_m_s", speed_m_s, "m/s"), name=f"butterfly {i}",
-                                wind_to_m_s=wind, gust_m_s=gust_m_s, gust_vertical_m_s=gust_vertical_m_s,
-                                flutter=flutter,
-                                seed=(self.seed * 1000 + i) % 2**32) for i in range(self.n)]
-        self._phys = mj3d.build_model(animal=self.controller.animal)
+        speed_m_s = checks.positive("speed_m_s", speed_m_s, "m/s")
+        weather = {"wind_to_m_s": wind, "gust_m_s": gust_m_s, "gust_vertical_m_s": gust_vertical_m_s,
+                   "flutter": flutter}
+        self._orders = [visiting_order(len(self.blossoms), self.seed * 1000 + i) for i in range(self.n)]
+        if self.land:
+            self._standing = mj3d.standing_height_m(self.controller.animal)
+            self.tasks = [t3.land(landing_surface(self.blossoms[o[0]]), self._standing, speed_m_s=speed_m_s,
+                                  name=f"butterfly {i}").with_weather(**weather, seed=(self.seed * 1000 + i) % 2**32)
+                          for i, o in enumerate(self._orders)]
+        else:
+            self.tasks = [Task3D("waypoints", tuple(tuple(float(v) for v in p)
+                                                       for p in course_among(self.blossoms, self.seed * 1000 + i)),
+                                 speed_m_s=speed_m_s, name=f"butterfly {i}", **weather,
+                                 seed=(self.seed * 1000 + i) % 2**32) for i in range(self.n)]
+        self._phys = (mj3d.build_model(animal=self.controller.animal, flowers=self.blossoms, ground_m=GROUND_M)
+                      if self.land else mj3d.build_model(animal=self.controller.animal))
         self._phys.opt.timestep = self.dt
         self._n_strips, self._n_chord = n_strips, n_chord
         self._force_law = force_law or self.controller.force_law
-        self._model = scene_model(self.n, self.blossoms, self.size_m, self.controller.animal)
+        self._model = scene_model(self.n, self.blossoms, self.size_m, self.controller.animal, legs=self.land)
         self._data = mujoco.MjData(self._model)
         self._blocks = [int(self._model.jnt_qposadr[self._model.joint(f"b{i}_root").id]) for i in range(self.n)]
-        self._task_arr = np.array([t.as_array(COURSE_LENGTH) for t in self.tasks])
+        self._rows = 2 if self.land else COURSE_LENGTH
+        self._task_arr = np.array([t.as_array(self._rows) for t in self.tasks])
         #: Set to a list to collect the butterflies' positions (``(n, 3)``, m) at every :meth:`sync`.
         self.track: list[np.ndarray] | None = None
         self.reset()
@@ -169,22 +196,71 @@ class Garden(StepCounter):
             d.qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
             self._datas.append(d)
         self._batch = Batch(self._phys, self._datas, self._task_arr, ctl, dt_s=self.dt,
-                            records=new_record(self.n, COURSE_LENGTH))
+                            records=new_record(self.n, self._rows))
         self._recs = self._batch.records
+        # each butterfly's visits: (flower, touchdown time s, touchdown speed m/s, take-off time s or None), and
+        # where it is in its order, since when it aims at its flower, how long it perches there
+        self._visits: list[list[dict]] = [[] for _ in range(self.n)]
+        self._at = [0] * self.n
+        self._aim_since = [0.0] * self.n
+        perch_rng = [np.random.default_rng([self.seed, 4, i]) for i in range(self.n)]
+        self._perch_s = [[float(r.uniform(*PERCH_S)) for _ in range(COURSE_LENGTH)] for r in perch_rng]
 
     def step(self, n: int = 1) -> None:
-        """Advance every butterfly ``n`` steps (threads over the butterflies)."""
+        """Advance every butterfly ``n`` steps (threads over the butterflies); a landing garden looks after its
+        perches and take-offs every :data:`CHECK_S` s."""
         n = checks.whole("the number of steps", n, 0)
-        if n == 0:
-            return
-        self._batch.advance(n)
-        self._k += n
-        bad = self._batch.diverged()
-        if len(bad):
-            i = int(bad[0])
-            step = int(self._recs[i, R_DIVERGED])
-            raise Diverged(f"butterfly {i} of the garden diverged at step {step}: its speed ran away or MuJoCo found "
-                           f"its state unstable; the likely cause is the time step ({self.dt:g} s) or the wind.", step)
+        chunk = max(1, int(round(CHECK_S / self.dt))) if self.land else max(n, 1)
+        while n > 0:
+            k = min(n, chunk)
+            self._batch.advance(k)
+            self._k += k
+            n -= k
+            bad = self._batch.diverged()
+            if len(bad):
+                i = int(bad[0])
+                step = int(self._recs[i, R_DIVERGED])
+                raise Diverged(f"butterfly {i} of the garden diverged at step {step}: its speed ran away or MuJoCo found "
+                               f"its state unstable; the likely cause is the time step ({self.dt:g} s) or the wind.",
+                               step)
+            if self.land:
+                self._visit()
+
+    def _visit(self) -> None:
+        """The landing garden's bookkeeping after a chunk of steps: a touchdown is logged; a perch that has lasted its
+        time ends in a take-off for the next flower; a flower not reached within :data:`GIVE_UP_S` is given up."""
+        tasks, t = self._batch.tasks, self.time
+        for i in range(self.n):
+            rec, visits = self._recs[i], self._visits[i]
+            perched = int(tasks[i, t3.T_KIND]) == t3.TASK_PERCH
+            if perched and (not visits or visits[-1]["take_off_s"] is not None or visits[-1]["touchdown_s"] is None):
+                visits.append({"flower": self._orders[i][self._at[i] % COURSE_LENGTH],
+                               "touchdown_s": float(rec[t3.R_LANDED_AT]),
+                               "touchdown_speed_m_s": float(rec[t3.R_TOUCH_SPEED]), "take_off_s": None})
+            ends = perched and t >= visits[-1]["touchdown_s"] + self._perch_s[i][self._at[i] % COURSE_LENGTH]
+            gives_up = not perched and t - self._aim_since[i] > GIVE_UP_S
+            if not (ends or gives_up):
+                continue
+            if gives_up:
+                visits.append({"flower": self._orders[i][self._at[i] % COURSE_LENGTH], "touchdown_s": None,
+                               "touchdown_speed_m_s": None, "take_off_s": None})
+            else:
+                visits[-1]["take_off_s"] = t
+                rec[t3.R_CLAP_UNTIL] = t + t3.CLAP_S
+                take_off_kinematics(self._datas[i].userdata, self._batch.base)
+            self._at[i] += 1
+            self._aim_since[i] = t
+            surface = landing_surface(self.blossoms[self._orders[i][self._at[i] % COURSE_LENGTH]])
+            tasks[i, t3.T_ROW0 : t3.T_ROW0 + 3] = surface
+            tasks[i, t3.T_KIND] = t3.TASK_LAND
+            rec[t3.R_LANDED_AT] = -1.0
+            rec[t3.R_WP] = np.inf
+
+    def visits(self) -> list[list[dict]]:
+        """Each butterfly's visits so far, in order (a landing garden): ``flower`` (index into :attr:`blossoms`),
+        ``touchdown_s`` and ``touchdown_speed_m_s`` (``None``: given up after :data:`GIVE_UP_S`), ``take_off_s``
+        (``None``: still perched)."""
+        return [[dict(v) for v in vs] for vs in self._visits]
 
     def sync(self) -> None:
         """Pose the drawing scene at the butterflies' current states (and add them to :attr:`track`)."""
@@ -198,10 +274,25 @@ class Garden(StepCounter):
 
     def state(self) -> dict[str, np.ndarray]:
         """``position_m`` ``(n, 3)``, ``attitude_rad`` ``(n, 3)`` (roll, pitch, yaw), ``waypoints_passed`` ``(n,)``
-        (:data:`STATE_UNITS`)."""
+        (flowers passed, or landed on), ``perched`` ``(n,)`` (:data:`STATE_UNITS`)."""
         pos = np.array([d.qpos[0:3] for d in self._datas])
         att = np.array([attitude(d.qpos[3:7]) for d in self._datas])
-        return {"position_m": pos, "attitude_rad": att, "waypoints_passed": self._recs[:, R_PASSED].copy()}
+        if self.land:
+            passed = np.array([sum(v["touchdown_s"] is not None for v in vs) for vs in self._visits], dtype=float)
+        else:
+            passed = self._recs[:, R_PASSED].copy()
+        return {"position_m": pos, "attitude_rad": att, "waypoints_passed": passed,
+                "perched": self._batch.tasks[:, t3.T_KIND] == t3.TASK_PERCH}
+
+
+def lands(controller: Controller3D) -> bool:
+    """Whether ``controller`` was evolved to land (on the ``garden`` task set, or started from one that was)."""
+    prov = controller.provenance or {}
+    while isinstance(prov, dict) and prov:
+        if prov.get("task_set", (prov.get("parameters") or {}).get("task_set")) == "garden":
+            return True
+        prov = prov.get("started_from") or {}
+    return False
 
 
 def chase_camera(garden: Garden, butterfly: int = 0):

@@ -16,16 +16,21 @@ import numpy as np
 from numba import njit, prange
 
 from lifelike_mj.butterfly.flight3d import model as mj3d
+from lifelike_mj.butterfly.flight3d import tasks as _tasks
 from lifelike_mj.butterfly.flight3d.controllers import ALTITUDE_CLIP_M, INPUT_SCALE, N_ACT, N_OBS
 from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS, filter_at
 from lifelike_mj.butterfly.flight3d.tasks import (
+    R_AIM,
+    R_CLAP_UNTIL,
     R_DIVERGED,
     R_FIT,
     R_FLUTTER,
     R_GUST,
+    R_LANDED_AT,
     R_PASSED,
     R_STEPS,
     R_STYLE,
+    R_TOUCH_SPEED,
     R_TUMBLED,
     R_WP,
     STYLE_FROM_S,
@@ -41,10 +46,16 @@ from lifelike_mj.butterfly.flight3d.tasks import (
     T_SEED,
     T_SPEED,
     T_WIND,
+    TASK_LAND,
+    TASK_PERCH,
     TASK_SCHEDULE,
     TASK_TARGET,
 )
 from lifelike_mj.physics import mjabi
+
+LAND_ABOVE_M, LAND_GLIDE, LAND_HOLD_M = _tasks.LAND_ABOVE_M, _tasks.LAND_GLIDE, _tasks.LAND_HOLD_M
+TOUCH_MARGIN_M = _tasks.TOUCH_MARGIN_M
+PERCH_FLAP_RAD, CLAP_TOP_RAD = _tasks.PERCH_FLAP_RAD, _tasks.CLAP_TOP_RAD
 
 #: A roll or pitch beyond this (rad) is a tumble: the flight ends there (no more reward).
 TUMBLE_RAD = math.radians(80.0)
@@ -75,12 +86,14 @@ def attitude(q):
 
 
 @njit(cache=True)
-def observe(qpos, qvel, heading, altitude, speed, air, obs):
+def observe(qpos, qvel, heading, altitude, speed, air, obs, pitch_ref=0.0):
     """The observation (module docstring) of the free body whose root is at ``qpos[0:7]``, ``qvel[0:6]``,
     against the reference ``heading`` (rad), ``altitude`` (m) and forward ``speed`` (m/s). The forward and
     sideways speeds are taken relative to the horizontal velocity ``air[0:2]`` (m/s): zeros for speeds over
-    the ground, the wind for speeds through the air."""
+    the ground, the wind for speeds through the air. ``pitch_ref`` (rad, a landing's flare): the pitch is seen
+    relative to it, so that a network that holds its pitch flies that much more nose up."""
     roll, pitch, yaw = attitude(qpos[3:7])
+    pitch -= pitch_ref
     c, s = math.cos(yaw), math.sin(yaw)
     vx, vy = qvel[0] - air[0], qvel[1] - air[1]
     obs[0] = roll
@@ -152,7 +165,22 @@ def reference(task, t, pos, rec):
     distance per second (at least 1 m/s); ``rec[R_PASSED]`` then counts the steps spent within the radius and
     ``rec[R_WP]``, ``rec[R_WP + 1]`` hold the closest and the current distance."""
     rows = int(task[T_ROWS])
-    if int(task[T_KIND]) == TASK_TARGET:
+    kind = int(task[T_KIND])
+    if kind == TASK_LAND or kind == TASK_PERCH:
+        # a landing (tasks.land): aim at the flower, lower and slower the closer; a perch holds where it is
+        b = T_ROW0
+        dx, dy = task[b] - pos[0], task[b + 1] - pos[1]
+        dh = math.sqrt(dx * dx + dy * dy)
+        aim_z = task[b + 2] + task[b + 3]
+        dz = aim_z - pos[2]
+        rec[R_WP] = min(rec[R_WP], math.sqrt(dh * dh + dz * dz))
+        if kind == TASK_PERCH:
+            return rec[R_AIM], pos[2], 0.0
+        if dh > LAND_HOLD_M:
+            rec[R_AIM] = math.atan2(dy, dx)
+        return (rec[R_AIM], aim_z + min(LAND_ABOVE_M, LAND_GLIDE * dh) - task[b + 6],
+                min(task[T_SPEED], task[b + 7] * dh))
+    if kind == TASK_TARGET:
         # a moving target: on a circle (centre, radius; rate, phase) bobbing by the vertical amplitude
         b = T_ROW0
         w, ph, amp = task[b + 4], task[b + 5], task[b + 6]
@@ -167,7 +195,7 @@ def reference(task, t, pos, rec):
             rec[R_PASSED] += 1.0  # steps spent within the radius
         v_target = abs(w) * task[b + 3]
         return math.atan2(dy, dx), tz, min(task[T_SPEED], max(1.0, v_target + dist))
-    if int(task[T_KIND]) == TASK_SCHEDULE:
+    if kind == TASK_SCHEDULE:
         r = 0
         while r + 1 < rows and task[T_ROW0 + 4 * (r + 1)] <= t:
             r += 1
@@ -228,10 +256,62 @@ def reward(obs):
 
 
 @njit(cache=True)
-def _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, path, path_every, n_path, tumble_rad):
+def touched_down(task, qpos):
+    """Whether the butterfly landing on ``task`` (``TASK_LAND``) touches down now (:func:`~lifelike_mj.butterfly.
+    flight3d.tasks.land`): its thorax within the task's radius of the flower's axis, above the landing surface and
+    less than ``TOUCH_MARGIN_M`` above its standing height there."""
+    b = T_ROW0
+    dx, dy = task[b] - qpos[0], task[b + 1] - qpos[1]
+    return (dx * dx + dy * dy < task[T_RADIUS] * task[T_RADIUS] and task[b + 2] < qpos[2]
+            < task[b + 2] + task[b + 3] + TOUCH_MARGIN_M)
+
+
+@njit(cache=True)
+def flare(task, qpos):
+    """A landing's flare (rad, nose up): from the task's flare distance out to the flower's axis the pitch the network
+    is shown is lowered by up to the task's flare pitch (:func:`~lifelike_mj.butterfly.flight3d.tasks.land`), so that
+    it holds its body that much more nose up and slows down, as a butterfly does before it lands."""
+    b = T_ROW0
+    dx, dy = task[b] - qpos[0], task[b + 1] - qpos[1]
+    dh = math.sqrt(dx * dx + dy * dy)
+    return task[b + 4] * max(0.0, 1.0 - dh / task[b + 5])
+
+
+@njit(cache=True)
+def perch_command(base, target):
+    """The kinematics of a perched butterfly (``target``, :class:`KinematicsCommand`'s order): the wings closed over
+    the back (:data:`~lifelike_mj.butterfly.flight3d.tasks.PERCH_FLAP_RAD`), no stroke, no feathering, the abdomen
+    held at ``base``'s mean; the flap frequency stays ``base``'s (the phase runs on, nothing moves with it)."""
+    for i in range(N_PARAMS):
+        target[i] = base[i]
+    target[1] = PERCH_FLAP_RAD
+    target[2] = PERCH_FLAP_RAD
+    target[3] = 0.0
+    target[4] = 0.0
+    target[5] = 0.0
+    target[6] = 0.0
+    target[7] = 0.0
+    target[8] = 0.0
+    target[11] = 0.0
+
+
+def take_off_kinematics(ud: np.ndarray, base: np.ndarray) -> None:
+    """A perched butterfly's kinematics at take-off (its ``userdata`` ``ud``): the wings open to ``base``'s top of
+    the stroke, from where the first downstroke starts (the parameters at ``base``, still; the flap phase at the next
+    whole beat): the state every flight of an evolution starts from."""
+    n = N_PARAMS
+    ud[mj3d.U_P0 : mj3d.U_P0 + n] = base
+    ud[mj3d.U_DP0 : mj3d.U_DP0 + n] = 0.0
+    ud[mj3d.U_TARGET : mj3d.U_TARGET + n] = base
+    ud[mj3d.U_PSI0] = 2.0 * math.pi * math.ceil(ud[mj3d.U_PSI0] / (2.0 * math.pi))
+
+
+@njit(cache=True)
+def _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, path, path_every, n_path, tumble_rad, base):
     """The first half of a step: the gusts advance, the air is set, the reference is taken and the observation made
     (into ``obs``), the path sampled. Returns ``(tumbled, n_path)``: a roll or pitch beyond ``tumble_rad`` ends the
-    flight here (recorded in ``rec``)."""
+    flight here (recorded in ``rec``). A landing that touches down now becomes a perch (recorded in ``rec``: the time
+    and the speed), its kinematics :func:`perch_command` of ``base``."""
     step = int(rec[R_STEPS])
     seed = int(task[T_SEED])
     if task[T_GUST] > 0.0 or task[T_GUST_W] > 0.0:
@@ -241,7 +321,17 @@ def _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, path, 
     for i in range(3):
         ud[mj3d.U_AIR + i] = task[T_WIND + i] + rec[R_GUST + i]
     heading, altitude, speed = reference(task, time[0], qpos[0:3], rec)
-    observe(qpos, qvel, heading, altitude, speed, ud[mj3d.U_AIR : mj3d.U_AIR + 3] if air_inputs else ground, obs)
+    if int(task[T_KIND]) == TASK_LAND and touched_down(task, qpos):
+        task[T_KIND] = TASK_PERCH
+        rec[R_PASSED] += 1.0
+        rec[R_LANDED_AT] = time[0]
+        rec[R_TOUCH_SPEED] = math.sqrt(qvel[0] * qvel[0] + qvel[1] * qvel[1] + qvel[2] * qvel[2])
+        perch_command(base, ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS])
+    pitch_ref = 0.0
+    if int(task[T_KIND]) == TASK_LAND:
+        pitch_ref = flare(task, qpos)
+    observe(qpos, qvel, heading, altitude, speed, ud[mj3d.U_AIR : mj3d.U_AIR + 3] if air_inputs else ground, obs,
+            pitch_ref)
     if path_every > 0 and step % path_every == 0 and n_path < path.shape[0]:
         path[n_path, 0] = time[0]
         for i in range(3):
@@ -258,8 +348,10 @@ def _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, path, 
 
 
 @njit(cache=True)
-def _act(u, dt, every, base, scale, task, rec, ud):
-    """The action ``u`` (changed in place by the flutter, if the task has any) becomes the kinematics' new target."""
+def _act(u, dt, every, base, scale, task, rec, ud, t):
+    """The action ``u`` (changed in place by the flutter, if the task has any) becomes the kinematics' new target; until
+    ``rec[R_CLAP_UNTIL]`` (a take-off, at time ``t`` now) each wing's amplitude puts the top of its stroke at
+    ``CLAP_TOP_RAD``, about the offset asked: the wings clap, with a larger stroke."""
     step = int(rec[R_STEPS])
     if task[T_FLUTTER] > 0.0:
         seed = int(task[T_SEED])
@@ -268,12 +360,15 @@ def _act(u, dt, every, base, scale, task, rec, ud):
                                          normal(seed, step, 3 + i))
             u[i] = max(-1.0, min(1.0, u[i] + rec[R_FLUTTER + i]))
     command(base, scale, u, ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS])
+    if t < rec[R_CLAP_UNTIL]:
+        ud[mj3d.U_TARGET + 3] = CLAP_TOP_RAD - ud[mj3d.U_TARGET + 1]
+        ud[mj3d.U_TARGET + 4] = CLAP_TOP_RAD - ud[mj3d.U_TARGET + 2]
 
 
 @njit(cache=True)
-def _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp):
+def _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
     """The second half of a step: one ``mj_step``, the kinematics advanced exactly, the reward of the observation
-    ``obs`` added. Returns ``False`` if the flight diverged (recorded in ``rec``)."""
+    ``obs`` added (none while perched). Returns ``False`` if the flight diverged (recorded in ``rec``)."""
     step = int(rec[R_STEPS])
     ud[mj3d.U_T0] = time[0]
     t0 = time[0]
@@ -288,6 +383,8 @@ def _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp):
     if abs(time[0] - (t0 + dt)) > 0.5 * dt or not (abs(qvel[0]) + abs(qvel[1]) + abs(qvel[2]) < 1e3):
         rec[R_DIVERGED] = step + 1
         return False
+    if int(task[T_KIND]) == TASK_PERCH:
+        return True
     rec[R_FIT] += reward(obs) * dt
     if t0 >= STYLE_FROM_S:
         style(ud, qpos, qvel, obs, p, dt, rec)
@@ -355,13 +452,13 @@ def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, base
         if rec[R_DIVERGED] >= 0 or rec[R_TUMBLED] >= 0:
             return
         tumbled, n_path = _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, path, path_every,
-                                  n_path, tumble_rad)
+                                  n_path, tumble_rad, base)
         if tumbled:
             return
-        if int(rec[R_STEPS]) % every == 0 and len(weights) > 0:
+        if int(rec[R_STEPS]) % every == 0 and len(weights) > 0 and int(task[T_KIND]) != TASK_PERCH:
             network(layers, weights, obs, u, scratch)
-            _act(u, dt, every, base, scale, task, rec, ud)
-        if not _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp):
+            _act(u, dt, every, base, scale, task, rec, ud, time[0])
+        if not _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
             return
 
 
@@ -386,18 +483,20 @@ def to_decision(mptr, dptr, off, nq, nv, n_max, dt, every, action, act, base, sc
     if rec[R_DIVERGED] >= 0 or rec[R_TUMBLED] >= 0:
         return False
     if act:
-        u = action.copy()
-        _act(u, dt, every, base, scale, task, rec, ud)
-        if not _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp):
+        if int(task[T_KIND]) != TASK_PERCH:
+            u = action.copy()
+            _act(u, dt, every, base, scale, task, rec, ud, time[0])
+        if not _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
             return False
     while True:
-        tumbled, _ = _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, none, 0, 0, tumble_rad)
+        tumbled, _ = _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, none, 0, 0, tumble_rad,
+                             base)
         if tumbled:
             return False
         step = int(rec[R_STEPS])
         if step >= n_max or step % every == 0:
             return True
-        if not _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp):
+        if not _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
             return False
 
 

@@ -571,12 +571,21 @@ def model_path():
 
 
 def build_model(params: ButterflyParams | None = None, masses: str = "animal", animal: str = "swallowtail",
-                contact: bool = False) -> mujoco.MjModel:
+                contact: bool = False, flowers=None, ground_m: float | None = None) -> mujoco.MjModel:
     """Compile the 3D model of ``animal`` (one of :data:`~lifelike_mj.butterfly.flight3d.animals.ANIMALS`):
-    :func:`build_spec`, compiled; ``contact``: with legs that touch the ground (:func:`add_contact`)."""
+    :func:`build_spec`, compiled; ``contact``: with legs that touch the ground (:func:`add_contact`); ``flowers``:
+    blossoms' centres (``(n, 3)``, m) whose blossoms the legs touch too
+    (:func:`~lifelike_mj.butterfly.flight3d.flowers.add_flowers`; implies ``contact``); ``ground_m``: the ground's
+    height (m; default the model file's)."""
     spec = build_spec(params, masses, animal)
-    if contact:
+    if ground_m is not None:
+        spec.geom("ground").pos = [0.0, 0.0, float(ground_m)]
+    if contact or flowers is not None:
         add_contact(spec)
+    if flowers is not None:
+        from lifelike_mj.butterfly.flight3d.flowers import add_flowers
+
+        add_flowers(spec, flowers, float(spec.geom("ground").pos[2]), contact=True)
     return spec.compile()
 
 
@@ -599,20 +608,44 @@ def add_contact(spec: mujoco.MjSpec) -> None:
     ground = spec.geom("ground")
     ground.contype, ground.conaffinity = 1, 1
     ground.friction = list(LEG_FRICTION)
-    thorax = spec.geom("thorax")
+    add_legs(spec)
+
+
+def add_legs(spec: mujoco.MjSpec, prefix: str = "") -> None:
+    """The legs of :func:`add_contact` on the butterfly ``{prefix}butterfly`` of ``spec`` (capsules that touch
+    whatever has ``contype=conaffinity=1``, when contact is on)."""
+    thorax = spec.geom(f"{prefix}thorax")
     if thorax.type == mujoco.mjtGeom.mjGEOM_ELLIPSOID:
         half, width = float(thorax.size[0]), 2.0 * float(thorax.size[1])
     else:
         half, width = 0.5 * float(np.linalg.norm(np.subtract(thorax.fromto[3:], thorax.fromto[:3]))), 2.0 * float(
             thorax.size[0])
-    body = spec.body("butterfly")
+    body = spec.body(f"{prefix}butterfly")
     for k, (fx, fy) in enumerate(FEET):
         for side, sign in (("left", 1.0), ("right", -1.0)):
             top = [fx * 2.0 * half, sign * 0.25 * width, -0.35 * width]
             foot = [fx * 2.0 * half * 1.2, sign * fy * width, -FOOT_DEPTH * width]
-            body.add_geom(name=f"leg_{k}_{side}", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=top + foot,
+            body.add_geom(name=f"{prefix}leg_{k}_{side}", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=top + foot,
                           size=[LEG_RADIUS_M, 0.0, 0.0], mass=0.0, contype=1, conaffinity=1, condim=3,
                           friction=list(LEG_FRICTION), rgba=[0.1, 0.08, 0.06, 1.0], group=0)
+
+
+@functools.cache
+def standing_height_m(animal: str = "swallowtail") -> float:
+    """How high the thorax's origin stands above a level surface on the legs of :func:`add_contact` (m), the body
+    level: the lowest point of the feet, below the origin."""
+    m = build_model(animal=animal, contact=True)
+    d = mujoco.MjData(m)
+    d.qpos[0:7] = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
+    mujoco.mj_kinematics(m, d)
+    low = math.inf
+    for g in range(m.ngeom):
+        if m.geom(g).name.startswith("leg_"):
+            half = float(m.geom_size[g, 1])
+            for sign in (-1.0, 1.0):
+                low = min(low, float(d.geom_xpos[g, 2] + sign * half * d.geom_xmat[g].reshape(3, 3)[2, 2])
+                          - float(m.geom_size[g, 0]))
+    return -low
 
 
 def build_spec(params: ButterflyParams | None = None, masses: str = "animal", animal: str = "swallowtail"

@@ -18,8 +18,10 @@ import numpy as np
 from lifelike_mj import checks
 from lifelike_mj.errors import UserError
 
-# task array: kind, then either a schedule (rows of t_start, heading, altitude, speed) or waypoints
-TASK_SCHEDULE, TASK_WAYPOINTS, TASK_TARGET = 0, 1, 2
+# task array: kind, then either a schedule (rows of t_start, heading, altitude, speed) or waypoints; a landing is two
+# rows, (x, y, surface z, standing height) and how it is flown (flare pitch, flare distance, sink, slowing), and turns
+# into a perch (kept by the loop) when the butterfly touches down
+TASK_SCHEDULE, TASK_WAYPOINTS, TASK_TARGET, TASK_LAND, TASK_PERCH = 0, 1, 2, 3, 4
 #: Task header: kind, rows, pass radius (m), cruise speed (m/s), mean wind (3, m/s), gusts' standard deviation
 #: (m/s, horizontal) and correlation time (s), flutter's standard deviation (action units) and correlation time
 #: (s), the seed of both, the vertical gusts' standard deviation (m/s); then 4 numbers per row.
@@ -44,7 +46,31 @@ STYLE_NAMES = ("roll", "pitch", "amplitude_difference", "offset_difference", "st
 #: The style integrals leave out the flight's first second: the start from rest, not the way it flies.
 STYLE_FROM_S = 1.0
 N_STYLE = len(STYLE_NAMES)
-R_WP = R_STYLE + N_STYLE
+#: A landing's bookkeeping: when it touched down (s; -1: not yet), at what speed (m/s, over the ground), the heading
+#: aimed at last (rad: kept when right above the flower), and until when the wings clap (s; a take-off's first beats).
+R_LANDED_AT = R_STYLE + N_STYLE
+R_TOUCH_SPEED, R_AIM, R_CLAP_UNTIL = R_LANDED_AT + 1, R_LANDED_AT + 2, R_LANDED_AT + 3
+R_WP = R_LANDED_AT + 4
+
+#: How a landing is flown (:func:`land`; the loop's reference): the butterfly aims at the flower from at most
+#: ``LAND_ABOVE_M`` above the point where it will stand, coming down ``LAND_GLIDE`` m per m it closes; within
+#: ``LAND_HOLD_M`` of the flower's axis it keeps its heading. It **touches down** when its thorax is within the task's
+#: radius of the flower's axis and less than ``TOUCH_MARGIN_M`` above its standing height over the flower.
+LAND_ABOVE_M, LAND_GLIDE, LAND_HOLD_M, TOUCH_MARGIN_M = 0.3, 0.5, 0.03, 0.004
+#: A landing's own settings (:func:`land`'s defaults, each in the task): the flare, the body raised by up to
+#: ``flare_deg`` over the flower from ``flare_m`` out (:func:`~lifelike_mj.butterfly.flight3d.loop.flare`); the
+#: altitude asked ending ``sink_m`` below the standing point (the flower is a floor the butterfly settles on); the
+#: speed asked, ``slow_per_s`` m/s per m of horizontal distance (at most the task's speed).
+LANDING = {"flare_deg": 40.0, "flare_m": 0.5, "sink_m": 0.02, "slow_per_s": 1.5}
+#: The touchdown speed a landing keeps within (m/s, chosen: no measured landing speed of butterflies was found). A
+#: monarch's legs (about 7 mm) stop 0.5 m/s within their length at 1.8 g, below the 10 g a butterfly's legs and
+#: wings give it at take-off (Sunada et al. 1993).
+TOUCHDOWN_M_S = 0.5
+#: A perch: the wings closed over the back (each flap angle, rad; 90 deg is upright), still; a take-off claps the wings
+#: for ``CLAP_S`` s: about the offset the network asks, each wing's stroke amplitude is raised so that the top of its
+#: stroke is ``CLAP_TOP_RAD`` (the wings meet over the back), as butterflies taking off do (Johansson and
+#: Henningsson 2021; Sunada et al. 1993 measured larger strokes at take-off).
+PERCH_FLAP_RAD, CLAP_TOP_RAD, CLAP_S = math.radians(85.0), math.radians(88.0), 0.3
 
 #: A task's most rows, and the largest number in a row (m, s, rad, m/s): far beyond a garden, finite in the loop.
 MAX_TASK_ROWS = 10_000
@@ -105,9 +131,12 @@ class Task3D:
         return self.wind_to_m_s
 
     def __post_init__(self) -> None:
-        if self.kind not in ("schedule", "waypoints", "target"):
-            raise UserError(f"a task is a schedule, waypoints or a target, got {self.kind!r}.")
+        if self.kind not in KINDS:
+            raise UserError(f"a task is a schedule, waypoints, a target or a landing, got {self.kind!r}.")
         width = 3 if self.kind == "waypoints" else 4
+        if self.kind == "land" and len(self.rows) != 2:
+            raise UserError("a landing task has two rows: the flower's x, y, its surface's z and the standing height; "
+                            "the flare's pitch (rad) and distance (m), the sink (m) and the slowing (1/s).")
         if not self.rows or len(self.rows) > MAX_TASK_ROWS or any(len(r) != width for r in self.rows):
             raise UserError(f"a {self.kind} task needs 1 to {MAX_TASK_ROWS:,} rows of {width} numbers.")
         for r in self.rows:
@@ -149,7 +178,7 @@ class Task3D:
         """The compiled loop's task array (layout ``T_*`` above), padded to
         ``max_rows`` rows."""
         out = np.zeros(T_ROW0 + 4 * max_rows)
-        out[T_KIND] = {"schedule": TASK_SCHEDULE, "waypoints": TASK_WAYPOINTS, "target": TASK_TARGET}[self.kind]
+        out[T_KIND] = KINDS[self.kind]
         out[T_ROWS] = len(self.rows)
         out[T_RADIUS] = self.radius_m
         out[T_SPEED] = self.speed_m_s
@@ -159,6 +188,10 @@ class Task3D:
         for i, r in enumerate(self.rows):
             out[T_ROW0 + 4 * i : T_ROW0 + 4 * i + len(r)] = r
         return out
+
+
+#: The task kinds and their codes in the task array (a perch is the loop's own, after a landing).
+KINDS = {"schedule": TASK_SCHEDULE, "waypoints": TASK_WAYPOINTS, "target": TASK_TARGET, "land": TASK_LAND}
 
 
 #: The vertical gusts' standard deviation over the horizontal ones near the ground: the low-altitude Dryden
@@ -204,10 +237,31 @@ def moving_target(centre_m=(3.0, 0.0, 0.0), radius_m: float = 2.0, speed_m_s: fl
                   radius_m=0.3, speed_m_s=cruise_m_s, name=f"moving target {speed_m_s:g} m/s")
 
 
+def land(flower_m, standing_m: float, radius_m: float = 0.03, speed_m_s: float = 1.0, name: str = "", *,
+         flare_deg: float = LANDING["flare_deg"], flare_m: float = LANDING["flare_m"], sink_m: float = LANDING["sink_m"],
+         slow_per_s: float = LANDING["slow_per_s"]) -> Task3D:
+    """Land on the flower whose landing surface is at ``flower_m`` (x, y, z in m: its centre's top), standing
+    ``standing_m`` above it (the thorax's height on its legs: :func:`~lifelike_mj.butterfly.flight3d.model.standing_height_m`),
+    touching down within ``radius_m`` of its axis, approaching at up to ``speed_m_s``. The loop's reference lowers and
+    slows the butterfly as it closes and raises its body (:data:`LANDING`: ``flare_deg``, ``flare_m``, ``sink_m``,
+    ``slow_per_s``); at touchdown it perches: the network stops and the wings close over the back
+    (:data:`PERCH_FLAP_RAD`) until a take-off (:meth:`~lifelike_mj.butterfly.flight3d.flight.Flight3D.take_off`)."""
+    x, y, z = checks.vector("flower_m", flower_m, 3, "m")
+    checks.number("standing_m", standing_m, 0.0, 0.1, unit="m")
+    checks.number("flare_deg", flare_deg, 0.0, 80.0, unit="deg")
+    checks.number("flare_m", flare_m, 0.0, 10.0, lo_open=True, unit="m")
+    checks.number("sink_m", sink_m, 0.0, 1.0, unit="m")
+    checks.number("slow_per_s", slow_per_s, 0.0, 100.0, lo_open=True, unit="1/s")
+    return Task3D("land", ((float(x), float(y), float(z), float(standing_m)),
+                           (math.radians(flare_deg), float(flare_m), float(sink_m), float(slow_per_s))),
+                  radius_m=radius_m, speed_m_s=speed_m_s, name=name or f"land at {x:.2f}, {y:.2f}, {z:.2f} m")
+
+
 def new_record(n: int, max_rows: int) -> np.ndarray:
     """Empty run records (layout ``R_*`` above) for ``n`` flights."""
     rec = np.zeros((n, R_WP + max_rows))  # the gusts and the flutter start from zero
     rec[:, R_DIVERGED] = -1.0
     rec[:, R_TUMBLED] = -1.0
+    rec[:, R_LANDED_AT] = -1.0
     rec[:, R_WP :] = np.inf
     return rec
