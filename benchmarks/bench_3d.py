@@ -104,7 +104,7 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--copies", type=int, default=64)
     ap.add_argument("--steps", type=int, default=600)
-    ap.add_argument("--controller", default="cruise")
+    ap.add_argument("--controller", default="wind")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "butterfly3d.json"))
     args = ap.parse_args()
     m = mj3d.build_model()

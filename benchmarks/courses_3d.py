@@ -25,7 +25,7 @@ from lifelike_mj.provenance import provenance
 
 MAX_S = 40.0
 FALL_M = 1.0
-CONTROLLERS = ("monarch", "steer", "wind", "cruise")
+CONTROLLERS = ("monarch", "steer", "wind")
 
 
 def fly(controller: str, seed: int) -> dict:

@@ -37,7 +37,7 @@ INTEGRATORS = {"RK4": mujoco.mjtIntegrator.mjINT_RK4, "implicitfast": mujoco.mjt
 REFERENCE = (Fraction(1, 4800), "RK4")
 OPEN_S = 1.0
 SAMPLE_S = 0.01
-CONTROLLERS = ("steer", "cruise", "wind")
+CONTROLLERS = ("steer", "wind")
 FLUTTER_SEEDS = range(5)
 MM_PER_S = 1.0
 

@@ -68,8 +68,6 @@ CASES: dict[str, tuple[list[str], list[str]]] = {
     "fly3d_wind_course": (["butterfly", "fly3d", "--controller", "wind", "--task", "course", "--seed", "3",
                            "--wind-to", "1,0.5,0", "--gusts", "0.5", "--flutter", "0.1", "--duration", "4", "--dt",
                            "1/1200", "--out", "{out}"], ["path.npz"]),
-    "fly3d_cruise_level": (["butterfly", "fly3d", "--controller", "cruise", "--speed", "2", "--duration", "3", "--dt",
-                            "1/1200"], []),
     "evolve3d_cmaes": (["butterfly", "evolve3d", "--population", "4", "--generations", "2", "--duration", "0.5",
                         "--dt", "1/1200", "--quiet", "--out", "{out}/c3.json"], ["c3.json"]),
     "assess3d_wind": (["butterfly", "assess3d", "--controller", "wind", "--duration", "6", "--courses", "100",

@@ -140,7 +140,7 @@ CASES = [
     (["butterfly", "fly3d", "--vertical-gusts", "-1"], "--vertical-gusts", {}),
     (["butterfly", "assess3d", "--wind", "1,0"], "three numbers", {}),
     (["butterfly", "evolve3d", "--hidden", "0,x"], "--hidden", {}),
-    (["butterfly", "evolve3d", "--start", "cruise", "--hidden", "8"], "--hidden does not apply", {}),
+    (["butterfly", "evolve3d", "--start", "wind", "--hidden", "8"], "--hidden does not apply", {}),
     (["butterfly", "evolve3d", "--out", "c.json"], "already exists", {"c.json": "{}"}),
     (["butterfly", "evolve3d", "--population", "1"], "--population", {}),
     (["butterfly", "garden", "--n", "0"], "--n", {}),

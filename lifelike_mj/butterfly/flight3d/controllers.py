@@ -10,7 +10,7 @@ Observation (:data:`OBS_NAMES`; SI units, in the heading frame: forward, left, u
 roll, pitch, heading error (reference less yaw, wrapped to ``(-pi, pi]``), the thorax's angular
 velocity (roll, pitch, yaw rates in its own axes), forward-speed error, sideways speed, climb rate and
 altitude error (clipped to +-1 m). A controller's ``inputs`` say what the forward and sideways speeds are
-measured against: ``"ground"`` (the shipped ``steer`` and ``cruise``) or ``"air"`` (the air around the
+measured against: ``"ground"`` (the shipped ``steer`` and ``monarch``) or ``"air"`` (the air around the
 butterfly, wind and gusts included, as a butterfly's antennae sense it; the speed reference is then an air
 speed). The climb rate and the altitude are always the ground's.
 

@@ -21,7 +21,7 @@ def test_flowers_and_courses_are_drawn_by_seed():
 
 def test_each_garden_butterfly_flies_what_its_own_flight_flies():
     """The garden's threaded batch gives every butterfly the flight a Flight3D on the same task gives it."""
-    ctl = flight3d.load_controller("cruise")
+    ctl = flight3d.load_controller("wind")
     g = Garden(3, ctl, seed=2, flutter=0.1, gust_m_s=0.3)
     starts = [d.qpos[:7].copy() for d in g._datas]
     g.step(240)
