@@ -1,4 +1,4 @@
-"""``lifelike-mj butterfly fly3d | evolve3d | assess3d | measure3d | strobe3d``: the butterfly in three
+"""``lifelike-mj butterfly fly3d | evolve3d | assess3d | measure3d | strobe3d | land3d``: the butterfly in three
 dimensions."""
 
 from __future__ import annotations
@@ -182,6 +182,36 @@ def cmd_strobe3d(args) -> None:
          f"{args.n} moments of one wing beat after {args.settle:g} s, {args.views}: written to {args.out}")
 
 
+def cmd_land3d(args) -> None:
+    from lifelike_mj.butterfly.flight3d.controllers import load_controller
+    from lifelike_mj.butterfly.flight3d.flowers import place_flowers
+    from lifelike_mj.butterfly.flight3d.landing import visit_flowers
+
+    check_outputs(args, files={"--picture": (".png",)})
+    if args.picture:
+        from lifelike_mj.render.video import check_size
+
+        check_size(args.width, args.height, "panel")
+    ctrl = load_controller(args.controller)
+    blossoms = place_flowers(args.seed, args.flowers, args.size)
+    with stage(f"visiting {args.flowers} flowers by landing, perched {args.perch:g} s on each"):
+        res = visit_flowers(ctrl, blossoms, args.perch)
+    out = {"controller": ctrl.name or args.controller, "seed": args.seed, "garden_size_m": args.size,
+           "blossoms_m": blossoms.tolist(), **res}
+    if args.picture:
+        from lifelike_mj.butterfly.flight3d.strobe import landing_strobe
+        from lifelike_mj.render.video import write_png
+
+        with stage("the landing and take-off picture"):
+            img, what = landing_strobe(ctrl, blossoms[:2], width=args.width, height=args.height)
+        write_png(args.picture, img)
+        out["picture"] = {"out": str(args.picture), **what}
+    ok = sum(v["within_bound"] and v["still"] for v in res["visits"])
+    emit(args, out, f"landed on {res['landed']} of {args.flowers - 1} flowers, {ok} within "
+                    f"{res['touchdown_bound_m_s']:g} m/s and still while perched"
+                    + (f"; picture written to {args.picture}" if args.picture else ""))
+
+
 def cmd_garden(args) -> None:
     import numpy as np
 
@@ -288,14 +318,15 @@ def add_commands(bf) -> None:
     p = bf.add_parser("evolve3d", help="evolve a 3D controller (CMA-ES or the paper's GA) on the MuJoCo batch")
     p.add_argument("--optimizer", default="cmaes", choices=("cmaes", "rcga", "crs2", "esch", "isres"),
                    help="cmaes, rcga (the paper's GA) or an nlopt method")
-    p.add_argument("--tasks", default="steer", choices=("steer", "cruise", "wind", "natural", "garden"),
+    p.add_argument("--tasks", default="steer", choices=("steer", "cruise", "wind", "natural", "garden", "agile"),
                    help="the task set: steer (level at 1 and 2 m/s, turns of 90 and -180 deg), cruise (level at 1.5 "
                         "and 2 m/s, the turns, and two flights in 1 m/s wind with 0.5 m/s gusts) or wind (courses "
                         "1-4 in 1 m/s wind from four sides with gusts of 0.5 m/s, 0.25 m/s vertically, course 5 and "
                         "the -180 deg turn in still air, level flight in wind) or natural (level at 1, 1.5 and 2 m/s, "
                         "the turns, course 5, and course 1 in 1 m/s wind with gusts of 0.5 m/s on every axis) or garden "
                         "(the monarch's: level at 1, 2 and 2.5 m/s, the turns, course 5, course 1 in 1 m/s wind "
-                        "with gusts on every axis, course 3 in a 1.5 m/s wind, and three landings on flowers)")
+                        "with gusts on every axis, course 3 in a 1.5 m/s wind, and three landings on flowers) or agile "
+                        "(the steer set and calm courses 1-3)")
     p.add_argument("--inputs", default=None, choices=("ground", "air"),
                    help="the network's speeds over the ground or through the air (default: the start's, else ground)")
     p.add_argument("--start", default=None, help="a 3D controller to start from (its network; genes are its changes)")
@@ -371,6 +402,21 @@ def add_commands(bf) -> None:
     add_overwrite(p)
     add_json(p)
     p.set_defaults(func=cmd_strobe3d)
+    p = bf.add_parser("land3d", help="one butterfly visits flowers by landing on each in turn (touchdown speed, perch, "
+                                     "take-off), with a picture of a landing and a take-off")
+    p.add_argument("--controller", default="monarch", help="a 3D controller evolved to land (default: monarch)")
+    p.add_argument("--flowers", type=count(2, 200), default=11, help="flowers, 2 to 200: perched on the first, it "
+                   "visits each other once")
+    add_seed(p)
+    p.add_argument("--size", type=num(2.0, 100.0), default=6.0, help="the flowers' square, m")
+    p.add_argument("--perch", type=num(0.0, 600.0), default=2.0, help="seconds perched on each flower")
+    p.add_argument("--picture", default=None, help="a picture (.png) of the landing on the second flower and the "
+                   "take-off from it")
+    p.add_argument("--width", type=count(16, 1920), default=640, help="width of each panel, pixels")
+    p.add_argument("--height", type=count(16, 1080), default=420, help="height, pixels")
+    add_overwrite(p)
+    add_json(p)
+    p.set_defaults(func=cmd_land3d)
 
 
 HELP = "the butterfly in three dimensions: one on a task, or a garden of them"

@@ -156,6 +156,11 @@ CASES = [
     (["butterfly", "strobe3d", "--out", "s.gif"], ".png", {}),
     (["butterfly", "strobe3d", "--out", "s.png"], "already exists", {"s.png": "x"}),
     (["butterfly", "strobe3d", "--out", "s.png", "--n", "1"], "--n", {}),
+    (["butterfly", "land3d", "--flowers", "1"], "--flowers", {}),
+    (["butterfly", "land3d", "--perch", "-1"], "--perch", {}),
+    (["butterfly", "land3d", "--picture", "l.jpg"], ".png", {}),
+    (["butterfly", "land3d", "--picture", "l.png"], "already exists", {"l.png": "x"}),
+    (["butterfly", "land3d", "--controller", "nosuch"], "nosuch", {}),
     (["butterfly", "evolve3d", "--force-law", "tip"], "invalid choice", {}),
     # --- fish
     (SWIM + ["--fish", "0"], "--fish", {}),

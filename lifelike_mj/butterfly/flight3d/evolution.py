@@ -291,6 +291,9 @@ TASK_SETS = {
     # a calm course and one in 1 m/s wind with gusts of 0.5 m/s on every axis
     "natural": lambda: (level(1.0), level(1.5), level(2.0), turn(90.0, 1.5, 1.5), turn(-180.0, 1.5, 1.5, 0.3), course(5),
                         course(1).with_weather((1.0, 0.0, 0.0), gust_m_s=0.5, gust_vertical_m_s=0.5, seed=1)),
+    # the steer set and three calm courses, whose sharp turns teach a controller to bank without tumbling
+    "agile": lambda: (level(1.0), level(2.0), turn(90.0, 1.5, 1.5), turn(-180.0, 1.5, 1.5, 0.3), course(1), course(2),
+                      course(3)),
     # everything a monarch in a garden does, with --natural: straight flight from slow to fast (2.5 m/s, where J passes
     # 0.9), the turns, a calm course, a course in 1 m/s wind with gusts of 0.5 m/s on every axis and one in a steady
     # 1.5 m/s wind, and three landings on flowers (scored by landing_score)

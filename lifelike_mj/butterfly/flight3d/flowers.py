@@ -40,3 +40,15 @@ def add_flowers(spec: mujoco.MjSpec, blossoms, ground_m: float, contact: bool = 
         spec.worldbody.add_geom(name=f"heart_{k}", type=mujoco.mjtGeom.mjGEOM_ELLIPSOID, size=[0.015, 0.015, 0.003],
                                 pos=[b[0], b[1], b[2] + BLOSSOM_SIZE_M[2] - 0.0025], rgba=_HEART, contype=0,
                                 conaffinity=0)
+
+
+def place_flowers(seed: int, n: int = 12, size_m: float = 8.0, heights_m: float = 0.5) -> np.ndarray:
+    """``(n, 3)``: the blossoms (m) of a garden drawn by ``seed``: spread over a ``size_m`` square at least
+    1.2 m apart, at altitudes within ``+-heights_m / 2`` of the flight altitude 0."""
+    rng = np.random.default_rng([seed, 1])
+    pts: list[np.ndarray] = []
+    while len(pts) < n:
+        p = np.array([*rng.uniform(-size_m / 2, size_m / 2, 2), rng.uniform(-heights_m / 2, heights_m / 2)])
+        if all(np.linalg.norm(p[:2] - q[:2]) >= 1.2 for q in pts):
+            pts.append(p)
+    return np.array(pts)

@@ -24,7 +24,7 @@ from lifelike_mj.butterfly.flight3d import model as mj3d
 from lifelike_mj.butterfly.flight3d import tasks as t3
 from lifelike_mj.butterfly.flight3d.controllers import Controller3D, load_controller
 from lifelike_mj.butterfly.flight3d.flight import DT_S
-from lifelike_mj.butterfly.flight3d.flowers import add_flowers, landing_surface
+from lifelike_mj.butterfly.flight3d.flowers import add_flowers, landing_surface, place_flowers
 from lifelike_mj.butterfly.flight3d.kinematics import Kinematics
 from lifelike_mj.butterfly.flight3d.loop import Batch, attitude, take_off_kinematics
 from lifelike_mj.butterfly.flight3d.tasks import R_DIVERGED, R_PASSED, Task3D, new_record
@@ -52,16 +52,8 @@ STATE_UNITS = {
 }
 
 
-def flowers(seed: int, n: int = 12, size_m: float = 8.0, heights_m: float = 0.5) -> np.ndarray:
-    """``(n, 3)``: the blossoms (m) of a garden drawn by ``seed``: spread over a ``size_m`` square at least
-    1.2 m apart, at altitudes within ``+-heights_m / 2`` of the flight altitude 0."""
-    rng = np.random.default_rng([seed, 1])
-    pts: list[np.ndarray] = []
-    while len(pts) < n:
-        p = np.array([*rng.uniform(-size_m / 2, size_m / 2, 2), rng.uniform(-heights_m / 2, heights_m / 2)])
-        if all(np.linalg.norm(p[:2] - q[:2]) >= 1.2 for q in pts):
-            pts.append(p)
-    return np.array(pts)
+#: The garden's flower placement (:func:`~lifelike_mj.butterfly.flight3d.flowers.place_flowers`).
+flowers = place_flowers
 
 
 def visiting_order(n_flowers: int, seed: int, length: int = COURSE_LENGTH) -> list[int]:

@@ -7,7 +7,8 @@ chronophotograph shows it.
   dorsal gap at the top and the wings' lowest reach.
 
 :func:`strobe` flies a :class:`~lifelike_mj.butterfly.flight3d.flight.Flight3D` on through one beat and returns
-the image; ``lifelike-mj butterfly strobe3d`` writes it.
+the image; ``lifelike-mj butterfly strobe3d`` writes it. :func:`landing_strobe` draws a landing on a flower and the
+take-off from it the same way, seen from the side (``lifelike-mj butterfly land3d --picture``).
 """
 
 from __future__ import annotations
@@ -51,7 +52,7 @@ def strobe(flight, n: int = 8, views=("side", "front"), width: int = 480, height
     root = int(m.jnt_qposadr[m.joint("root").id])
     first = states[0].qpos[root : root + 3].copy()
     path = np.array([d.qpos[root : root + 3] for d in states])
-    span = float(np.max(m.geom_rbound)) if m.ngeom else 0.06
+    span = float(np.max(m.geom_rbound[m.geom_bodyid > 0])) if m.ngeom else 0.06
     panels = []
     dress(m)
     with Offscreen(m, width, height) as r:
@@ -67,13 +68,82 @@ def strobe(flight, n: int = 8, views=("side", "front"), width: int = 480, height
                     shown.append(e)
             centre = path.mean(axis=0) if view == "side" else first
             reach = float(np.ptp(path[:, 0])) if view == "side" else 0.0
-            cam = mujoco.MjvCamera()
-            cam.type = mujoco.mjtCamera.mjCAMERA_FREE
-            cam.lookat[:] = centre
-            cam.azimuth, cam.elevation = VIEWS[view]
-            cam.distance = 1.6 * max(reach, 2.2 * span) / math.tan(math.radians(m.vis.global_.fovy) / 2.0) / 2.0
-            r.update(m, shown[0], cam)
-            for e in shown[1:]:
-                r.add(m, e)
-            panels.append(r.draw().copy())
+            panels.append(_exposures(r, m, shown, centre, *VIEWS[view], 1.6 * max(reach, 2.2 * span)))
     return np.concatenate(panels, axis=1)
+
+
+def _exposures(r, m, states, centre, azimuth: float, elevation: float, extent_m: float) -> np.ndarray:
+    """One picture of all ``states`` of model ``m`` at once (a multiple exposure) with the renderer ``r``, a free
+    camera looking at ``centre`` from ``azimuth``, ``elevation`` (deg), far enough to see ``extent_m`` across."""
+    import mujoco
+
+    cam = mujoco.MjvCamera()
+    cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+    cam.lookat[:] = centre
+    cam.azimuth, cam.elevation = azimuth, elevation
+    cam.distance = extent_m / math.tan(math.radians(m.vis.global_.fovy) / 2.0) / 2.0
+    r.update(m, states[0], cam)
+    for e in states[1:]:
+        r.add(m, e)
+    return r.draw().copy()
+
+
+def landing_strobe(controller, flowers=((0.0, 0.0, -0.1), (1.2, 0.4, -0.25)), every_s: float = 0.04,
+                   before_s: float = 0.6, after_s: float = 0.4, perch_s: float = 1.0, width: int = 640,
+                   height: int = 420) -> tuple[np.ndarray, dict]:
+    """A landing and a take-off, each in one picture of moments ``every_s`` apart, seen from the side of the path:
+    the butterfly ``controller`` starts perched on ``flowers[0]``, takes off and lands on ``flowers[1]``; the left
+    panel shows its last ``before_s`` before touchdown and the perch after ``perch_s`` (the wings closed), the right
+    panel the take-off back towards ``flowers[0]``, its first ``after_s``. Returns the ``(height, 2 width, 3)`` image
+    and what happened (``touchdown``: time and speed; ``landed``)."""
+    from collections import deque
+
+    import mujoco
+
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
+    from lifelike_mj.butterfly.flight3d.landing import MAX_LANDING_S
+    from lifelike_mj.butterfly.render import dress
+    from lifelike_mj.render.offscreen import Offscreen
+
+    f = Flight3D(controller=controller, flowers=flowers)
+    m = f.model
+    f.perch_on(0)
+    f.step(int(round(0.3 / f.dt)))
+    every = max(1, int(round(checks.positive("every_s", every_s, "s") / f.dt)))
+
+    def copy():
+        d = mujoco.MjData(m)
+        mujoco.mj_copyData(d, m, f.data)
+        mujoco.mj_kinematics(m, d)
+        return d
+
+    f.take_off(f.land_on(1))
+    t0 = f.time
+    before: deque = deque(maxlen=max(1, int(round(before_s / every_s))))
+    while not f.perched and f.time - t0 < MAX_LANDING_S:
+        f.step(every)
+        before.append(copy())
+    touchdown = f.touchdown
+    if touchdown is None:
+        from lifelike_mj.errors import UserError
+
+        raise UserError(f"the butterfly did not land on the flower within {MAX_LANDING_S:g} s: its controller "
+                        "was not evolved to land (the garden task set).")
+    f.step(int(round(perch_s / f.dt)))
+    perched = copy()
+    f.take_off(f.land_on(0))
+    after = [perched]
+    for _ in range(max(1, int(round(after_s / every_s)))):
+        f.step(every)
+        after.append(copy())
+    root = int(m.jnt_qposadr[m.joint("root").id])
+    a, b = np.asarray(flowers[0], dtype=float), np.asarray(flowers[1], dtype=float)
+    heading = math.degrees(math.atan2(b[1] - a[1], b[0] - a[0]))
+    dress(m)
+    panels = []
+    with Offscreen(m, width, height) as r:
+        for states in (list(before) + [perched], after):
+            path = np.array([d.qpos[root : root + 3] for d in states])
+            reach = float(np.max(np.ptp(path, axis=0)))
+            panels.append(_exposures(r, m, states, path.mean(axis=0), heading + 90.0, -5.0, 1.3 * max(reach, 0.12)))
+    return np.concatenate(panels, axis=1), {"touchdown": touchdown, "landed": touchdown is not None}

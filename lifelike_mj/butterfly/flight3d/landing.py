@@ -1,0 +1,86 @@
+"""A butterfly that visits flowers by landing on them, one after another: :func:`visit_flowers`, and its picture,
+:func:`landing_picture` (``lifelike-mj butterfly land3d``).
+
+The butterfly starts perched on the first flower. For each next flower it takes off (the wings open and clap,
+:meth:`~lifelike_mj.butterfly.flight3d.flight.Flight3D.take_off`), flies the landing task
+(:func:`~lifelike_mj.butterfly.flight3d.tasks.land`: lower, slower and more nose up as it closes), touches down on
+the blossom, and perches there with its wings closed for ``perch_s``, held by its legs' contact alone. Each visit is
+measured: the touchdown's speed against :data:`~lifelike_mj.butterfly.flight3d.tasks.TOUCHDOWN_M_S`, how far the
+butterfly moved while perched, and whether it left the flower again.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from lifelike_mj import checks
+from lifelike_mj.butterfly.flight3d.tasks import TOUCHDOWN_M_S
+
+#: A visit's bounds: the most a landing may take (s), and the most the thorax may move while perched (m) for the
+#: butterfly to count as sitting still.
+MAX_LANDING_S, STILL_M = 20.0, 0.005
+
+
+def visit_flowers(controller, flowers, perch_s: float = 2.0, *, dt_s: float | None = None, record_every_s: float = 0.0,
+                  ground_m: float | None = None) -> dict:
+    """Fly ``controller`` (a 3D controller evolved to land) from perched on ``flowers[0]`` to each next flower in
+    turn (``(n, 3)`` blossom centres, m), landing on each and perching ``perch_s`` s. Returns ``visits`` (one per
+    flower after the first: ``flower``, ``landed``, ``flight_s`` (take-off to touchdown), ``touchdown_speed_m_s``,
+    ``within_bound`` (:data:`TOUCHDOWN_M_S`), ``perch_moved_m``, ``still`` (:data:`STILL_M`), ``tilt_max_deg`` (the
+    largest roll or pitch in flight)), ``landed`` (how many), and with ``record_every_s`` the path: ``t_s``,
+    ``position_m``, ``attitude_rad``, ``perched`` and the flight itself (``flight``)."""
+    from lifelike_mj.butterfly.flight3d.flight import DT_S, Flight3D
+
+    perch_s = checks.number("perch_s", perch_s, 0.0, 600.0, unit="s")
+    kw = {} if ground_m is None else {"ground_m": ground_m}
+    f = Flight3D(controller=controller, flowers=flowers, dt_s=DT_S if dt_s is None else dt_s, **kw)
+    n = len(f.flowers)
+    if n < 2:
+        from lifelike_mj.errors import UserError
+
+        raise UserError("visiting flowers needs at least two flowers.")
+    f.perch_on(0)
+    every = max(1, int(round(0.01 / f.dt)))
+    rec_every = max(1, int(round(record_every_s / f.dt))) if record_every_s > 0 else 0
+    path: list[tuple] = []
+
+    def fly(steps: int) -> tuple[float, float]:
+        tilt, start = 0.0, f.state()["position_m"]
+        moved = 0.0
+        k = 0
+        while k < steps:
+            f.step(every)
+            k += every
+            s = f.state()
+            tilt = max(tilt, float(np.abs(s["attitude_rad"][:2]).max()))
+            moved = max(moved, float(np.linalg.norm(s["position_m"] - start)))
+            if rec_every and (f.steps % rec_every) < every:
+                path.append((f.time, s["position_m"], s["attitude_rad"], f.perched))
+        return tilt, moved
+
+    f.step(int(round(min(perch_s, 0.5) / f.dt)))
+    visits = []
+    for k in range(1, n):
+        t0 = f.time
+        f.take_off(f.land_on(k))
+        tilt = 0.0
+        while not f.perched and f.time - t0 < MAX_LANDING_S:
+            t, _ = fly(every * 5)
+            tilt = max(tilt, t)
+        td = f.touchdown
+        v = {"flower": k, "landed": td is not None, "flight_s": None if td is None else td["time_s"] - t0,
+             "touchdown_speed_m_s": None if td is None else td["speed_m_s"],
+             "within_bound": td is not None and td["speed_m_s"] <= TOUCHDOWN_M_S, "tilt_max_deg": math.degrees(tilt)}
+        if td is None:
+            visits.append(v | {"perch_moved_m": None, "still": False})
+            break
+        _, moved = fly(int(round(perch_s / f.dt)))
+        visits.append(v | {"perch_moved_m": moved, "still": moved <= STILL_M and f.perched})
+    out = {"visits": visits, "landed": sum(v["landed"] for v in visits), "flowers": n, "perch_s": perch_s,
+           "touchdown_bound_m_s": TOUCHDOWN_M_S}
+    if rec_every:
+        out.update(t_s=np.array([p[0] for p in path]), position_m=np.array([p[1] for p in path]),
+                   attitude_rad=np.array([p[2] for p in path]), perched=np.array([p[3] for p in path]), flight=f)
+    return out
