@@ -142,7 +142,8 @@ class FlightProblem3D:
     fitness is the mean over the tasks of the mean reward per second (``[0, 1]``, larger is better). With
     ``take_off`` every flight starts standing on a flower at the start (:func:`start_blossom`), its wings at the top
     of the stroke, and takes off clapping, as a garden's perched butterflies do
-    (:meth:`~lifelike_mj.butterfly.flight3d.flight.Flight3D.take_off`)."""
+    (:meth:`~lifelike_mj.butterfly.flight3d.flight.Flight3D.take_off`); the flowers of the landing tasks are in its
+    world too, touched by its legs (:meth:`flowers`)."""
 
     tasks: tuple[Task3D, ...]
     template: c3.Controller3D
@@ -226,10 +227,19 @@ class FlightProblem3D:
         if self._model is None:
             from lifelike_mj.butterfly.flight3d import model as mj3d
 
-            flowers = [start_blossom(self.template.animal)] if self.take_off else None
-            self._model = mj3d.build_model(self.params, animal=self.template.animal, flowers=flowers)
+            self._model = mj3d.build_model(self.params, animal=self.template.animal, flowers=self.flowers())
             self._model.opt.timestep = self.dt_s
         return self._model
+
+    def flowers(self) -> list[tuple[float, float, float]] | None:
+        """The flowers of the training flights' world (blossom centres, m): with ``take_off``, the one they start
+        on and those the landing tasks land on, which their legs touch as in a garden; else none."""
+        if not self.take_off:
+            return None
+        from lifelike_mj.butterfly.flight3d.flowers import BLOSSOM_SIZE_M
+
+        return [start_blossom(self.template.animal)] + [(t.rows[0][0], t.rows[0][1], t.rows[0][2] - BLOSSOM_SIZE_M[2])
+                                                        for t in self.tasks if t.kind == "land"]
 
     def fly(self, W: np.ndarray) -> np.ndarray:
         """Run records ``(n, len(tasks), ...)`` of the weights ``W`` (rows) on every task."""

@@ -352,7 +352,7 @@ class Flight3D(StepCounter):
 
     # ---- landing, perching and take-off -----------------------------------------------------------
 
-    def land_on(self, flower: int, radius_m: float = 0.03, speed_m_s: float = 1.0):
+    def land_on(self, flower: int, radius_m: float = 0.035, speed_m_s: float = 1.0):
         """The landing task (:func:`~lifelike_mj.butterfly.flight3d.tasks.land`) on this flight's flower ``flower``
         (an index into :attr:`flowers`): its blossom's top, at this butterfly's standing height."""
         from lifelike_mj.butterfly.flight3d.flowers import landing_surface

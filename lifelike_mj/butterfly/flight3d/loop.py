@@ -256,14 +256,27 @@ def reward(obs):
 
 
 @njit(cache=True)
-def touched_down(task, qpos):
+def lowest_foot(qpos, feet):
+    """The height (m) of the lowest of the feet ``feet`` (``(4, 3)``, m, in the thorax's frame: the userdata's
+    ``U_FEET``) of the body at ``qpos[0:7]``."""
+    w, x, y, z = qpos[3], qpos[4], qpos[5], qpos[6]
+    r0, r1, r2 = 2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)  # the frame's z row
+    low = math.inf
+    for k in range(4):
+        low = min(low, r0 * feet[3 * k] + r1 * feet[3 * k + 1] + r2 * feet[3 * k + 2])
+    return qpos[2] + low
+
+
+@njit(cache=True)
+def touched_down(task, qpos, feet):
     """Whether the butterfly landing on ``task`` (``TASK_LAND``) touches down now (:func:`~lifelike_mj.butterfly.
-    flight3d.tasks.land`): its thorax within the task's radius of the flower's axis, above the landing surface and
-    less than ``TOUCH_MARGIN_M`` above its standing height there."""
+    flight3d.tasks.land`): its thorax within the task's radius of the flower's axis and its lowest foot
+    (:func:`lowest_foot`) within ``TOUCH_MARGIN_M`` of the landing surface (above it, or through it by as much)."""
     b = T_ROW0
     dx, dy = task[b] - qpos[0], task[b + 1] - qpos[1]
-    return (dx * dx + dy * dy < task[T_RADIUS] * task[T_RADIUS] and task[b + 2] < qpos[2]
-            < task[b + 2] + task[b + 3] + TOUCH_MARGIN_M)
+    foot = lowest_foot(qpos, feet)
+    return (dx * dx + dy * dy < task[T_RADIUS] * task[T_RADIUS]
+            and task[b + 2] - TOUCH_MARGIN_M < foot < task[b + 2] + TOUCH_MARGIN_M)
 
 
 @njit(cache=True)
@@ -321,7 +334,7 @@ def _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, path, 
     for i in range(3):
         ud[mj3d.U_AIR + i] = task[T_WIND + i] + rec[R_GUST + i]
     heading, altitude, speed = reference(task, time[0], qpos[0:3], rec)
-    if int(task[T_KIND]) == TASK_LAND and touched_down(task, qpos):
+    if int(task[T_KIND]) == TASK_LAND and touched_down(task, qpos, ud[mj3d.U_FEET : mj3d.U_FEET + 12]):
         task[T_KIND] = TASK_PERCH
         rec[R_PASSED] += 1.0
         rec[R_LANDED_AT] = time[0]

@@ -115,7 +115,8 @@ U_NTRI = U_DSCR + 48  # triangles of the wing's outline (exact law)
 U_RC = U_NTRI + 1  # span of the wing's area centroid (m): where the exact law splits its force into parts
 U_TRI = U_RC + 1  # per triangle: three vertices (chord, span) of the left wing (m)
 MAX_TRIS = 64
-N_USERDATA = U_TRI + 6 * MAX_TRIS
+U_FEET = U_TRI + 6 * MAX_TRIS  # 12: the four feet's lowest points in the thorax's frame (m), legs or not (add_legs)
+N_USERDATA = U_FEET + 12
 
 _O_TIME, _O_QPOS, _O_QVEL, _O_QFRC, _O_UD = mjabi.O_TIME, mjabi.O_QPOS, mjabi.O_QVEL, mjabi.O_QFRC, mjabi.O_UD
 _O_XPOS, _O_XMAT, _O_XIPOS = mjabi.O_XPOS, mjabi.O_XMAT, mjabi.O_XIPOS
@@ -611,41 +612,53 @@ def add_contact(spec: mujoco.MjSpec) -> None:
     add_legs(spec)
 
 
+def legs(half_m: float, width_m: float) -> list[tuple[str, list[float], list[float]]]:
+    """The legs under a thorax ``2 half_m`` long and ``width_m`` wide: ``(name, top, foot)`` per leg, the points in
+    the thorax's frame (m; :data:`FEET`, :data:`FOOT_DEPTH`)."""
+    out = []
+    for k, (fx, fy) in enumerate(FEET):
+        for side, sign in (("left", 1.0), ("right", -1.0)):
+            out.append((f"leg_{k}_{side}", [fx * 2.0 * half_m, sign * 0.25 * width_m, -0.35 * width_m],
+                        [fx * 2.0 * half_m * 1.2, sign * fy * width_m, -FOOT_DEPTH * width_m]))
+    return out
+
+
+def _thorax_size(type_: int, size, fromto=None) -> tuple[float, float]:
+    """Half the length and the width (m) of a thorax geom: an ellipsoid (semi-axes) or a capsule (radius, and its
+    ``fromto`` or, compiled, its half-length)."""
+    if type_ == mujoco.mjtGeom.mjGEOM_ELLIPSOID:
+        return float(size[0]), 2.0 * float(size[1])
+    if fromto is not None:
+        return 0.5 * float(np.linalg.norm(np.subtract(fromto[3:], fromto[:3]))), 2.0 * float(size[0])
+    return float(size[1]), 2.0 * float(size[0])
+
+
+def feet_m(m: mujoco.MjModel) -> np.ndarray:
+    """``(4, 3)``: the lowest points of the butterfly's feet in its thorax's frame (m), whether the model has legs or
+    not: each leg's foot end less its radius (:func:`legs`)."""
+    g = m.geom("thorax")
+    half, width = _thorax_size(int(g.type[0]), g.size)
+    return np.array([[foot[0], foot[1], foot[2] - LEG_RADIUS_M] for _, _, foot in legs(half, width)])
+
+
 def add_legs(spec: mujoco.MjSpec, prefix: str = "") -> None:
     """The legs of :func:`add_contact` on the butterfly ``{prefix}butterfly`` of ``spec`` (capsules that touch
     whatever has ``contype=conaffinity=1``, when contact is on)."""
     thorax = spec.geom(f"{prefix}thorax")
-    if thorax.type == mujoco.mjtGeom.mjGEOM_ELLIPSOID:
-        half, width = float(thorax.size[0]), 2.0 * float(thorax.size[1])
-    else:
-        half, width = 0.5 * float(np.linalg.norm(np.subtract(thorax.fromto[3:], thorax.fromto[:3]))), 2.0 * float(
-            thorax.size[0])
+    fromto = None if thorax.type == mujoco.mjtGeom.mjGEOM_ELLIPSOID else thorax.fromto
+    half, width = _thorax_size(thorax.type, thorax.size, fromto)
     body = spec.body(f"{prefix}butterfly")
-    for k, (fx, fy) in enumerate(FEET):
-        for side, sign in (("left", 1.0), ("right", -1.0)):
-            top = [fx * 2.0 * half, sign * 0.25 * width, -0.35 * width]
-            foot = [fx * 2.0 * half * 1.2, sign * fy * width, -FOOT_DEPTH * width]
-            body.add_geom(name=f"{prefix}leg_{k}_{side}", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=top + foot,
-                          size=[LEG_RADIUS_M, 0.0, 0.0], mass=0.0, contype=1, conaffinity=1, condim=3,
-                          friction=list(LEG_FRICTION), rgba=[0.1, 0.08, 0.06, 1.0], group=0)
+    for name, top, foot in legs(half, width):
+        body.add_geom(name=f"{prefix}{name}", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=top + foot,
+                      size=[LEG_RADIUS_M, 0.0, 0.0], mass=0.0, contype=1, conaffinity=1, condim=3,
+                      friction=list(LEG_FRICTION), rgba=[0.1, 0.08, 0.06, 1.0], group=0)
 
 
 @functools.cache
 def standing_height_m(animal: str = "swallowtail") -> float:
     """How high the thorax's origin stands above a level surface on the legs of :func:`add_contact` (m), the body
-    level: the lowest point of the feet, below the origin."""
-    m = build_model(animal=animal, contact=True)
-    d = mujoco.MjData(m)
-    d.qpos[0:7] = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
-    mujoco.mj_kinematics(m, d)
-    low = math.inf
-    for g in range(m.ngeom):
-        if m.geom(g).name.startswith("leg_"):
-            half = float(m.geom_size[g, 1])
-            for sign in (-1.0, 1.0):
-                low = min(low, float(d.geom_xpos[g, 2] + sign * half * d.geom_xmat[g].reshape(3, 3)[2, 2])
-                          - float(m.geom_size[g, 0]))
-    return -low
+    level: the lowest point of the feet, below the origin (:func:`feet_m`)."""
+    return -float(feet_m(build_model(animal=animal))[:, 2].min())
 
 
 def build_spec(params: ButterflyParams | None = None, masses: str = "animal", animal: str = "swallowtail"
@@ -898,6 +911,7 @@ def setup_data(m: mujoco.MjModel, kinematics: Kinematics, params: ButterflyParam
         raise UserError(f"a wing outline has at most {MAX_TRIS} triangles, the {a.name}'s has {len(tris)}.")
     ud[U_NTRI], ud[U_RC] = len(tris), rc
     ud[U_TRI : U_TRI + tris.size] = tris.ravel()
+    ud[U_FEET : U_FEET + 12] = feet_m(m).ravel()
     if a.measured:
         ud[U_L] = a.span_m
     d.qpos[m.jnt_qposadr[m.joint("root").id] + 3] = 1.0

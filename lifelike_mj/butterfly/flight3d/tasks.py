@@ -55,8 +55,8 @@ R_WP = R_LANDED_AT + 4
 #: How a landing is flown (:func:`land`; the loop's reference): the butterfly aims at the flower from at most
 #: ``LAND_ABOVE_M`` above the point where it will stand, coming down ``LAND_GLIDE`` m per m it closes; within
 #: ``LAND_HOLD_M`` of the flower's axis it keeps its heading. It **touches down** when its thorax is within the task's
-#: radius of the flower's axis and less than ``TOUCH_MARGIN_M`` above its standing height over the flower.
-LAND_ABOVE_M, LAND_GLIDE, LAND_HOLD_M, TOUCH_MARGIN_M = 0.3, 0.5, 0.03, 0.004
+#: radius of the flower's axis and its lowest foot within ``TOUCH_MARGIN_M`` of the landing surface.
+LAND_ABOVE_M, LAND_GLIDE, LAND_HOLD_M, TOUCH_MARGIN_M = 0.3, 0.5, 0.03, 0.003
 #: A landing's own settings (:func:`land`'s defaults, each in the task): the flare, the body raised by up to
 #: ``flare_deg`` over the flower from ``flare_m`` out (:func:`~lifelike_mj.butterfly.flight3d.loop.flare`); the
 #: altitude asked ending ``sink_m`` below the standing point (the flower is a floor the butterfly settles on); the
@@ -237,7 +237,7 @@ def moving_target(centre_m=(3.0, 0.0, 0.0), radius_m: float = 2.0, speed_m_s: fl
                   radius_m=0.3, speed_m_s=cruise_m_s, name=f"moving target {speed_m_s:g} m/s")
 
 
-def land(flower_m, standing_m: float, radius_m: float = 0.03, speed_m_s: float = 1.0, name: str = "", *,
+def land(flower_m, standing_m: float, radius_m: float = 0.035, speed_m_s: float = 1.0, name: str = "", *,
          flare_deg: float = LANDING["flare_deg"], flare_m: float = LANDING["flare_m"], sink_m: float = LANDING["sink_m"],
          slow_per_s: float = LANDING["slow_per_s"]) -> Task3D:
     """Land on the flower whose landing surface is at ``flower_m`` (x, y, z in m: its centre's top), standing

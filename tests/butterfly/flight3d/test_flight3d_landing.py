@@ -11,7 +11,7 @@ from lifelike_mj.butterfly.flight3d import tasks as t3
 from lifelike_mj.butterfly.flight3d.evolution import landing_score
 from lifelike_mj.butterfly.flight3d.flight import Flight3D
 from lifelike_mj.butterfly.flight3d.flowers import BLOSSOM_SIZE_M, landing_surface
-from lifelike_mj.butterfly.flight3d.loop import flare, reference, touched_down
+from lifelike_mj.butterfly.flight3d.loop import flare, lowest_foot, reference, touched_down
 from lifelike_mj.errors import UserError
 
 FLOWERS = [(0.0, 0.0, -0.2), (1.0, 0.5, -0.1)]
@@ -58,13 +58,22 @@ def test_the_landing_reference_slows_and_lowers_the_butterfly_as_it_closes():
     assert rec[t3.R_WP] == pytest.approx(0.092, abs=0.001)  # the closest approach so far, to the standing point
 
 
-def test_touchdown_needs_the_thorax_over_the_blossom_and_at_standing_height():
-    task = t3.land((0.0, 0.0, 0.0), 0.008, radius_m=0.03).as_array(2)
-    q = np.zeros(7)
-    for xyz, expected in (((0.0, 0.0, 0.010), True), ((0.029, 0.0, 0.010), True), ((0.031, 0.0, 0.010), False),
-                          ((0.0, 0.0, 0.013), False), ((0.0, 0.0, -0.001), False)):
+def test_touchdown_needs_the_thorax_over_the_blossom_and_a_foot_on_it():
+    """Level, the feet are the standing height below the thorax; pitched nose up, the hind feet reach lower, so a
+    butterfly landing with its body raised touches down with its thorax higher."""
+    h = mj3d.standing_height_m("monarch")
+    feet = mj3d.feet_m(mj3d.build_model(animal="monarch")).ravel()
+    task = t3.land((0.0, 0.0, 0.0), h, radius_m=0.03).as_array(2)
+    q = np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
+    for xyz, expected in (((0.0, 0.0, h + 0.002), True), ((0.029, 0.0, h), True), ((0.031, 0.0, h), False),
+                          ((0.0, 0.0, h + 0.004), False), ((0.0, 0.0, h - 0.004), False)):
         q[0:3] = xyz
-        assert touched_down(task, q) is expected, xyz
+        assert touched_down(task, q, feet) is expected, xyz
+    assert lowest_foot(q, feet) == pytest.approx(q[2] - h)
+    pitch = math.radians(40.0)  # nose up: a rotation of -40 deg about the body's y axis (which points left)
+    q[3:7] = (math.cos(pitch / 2), 0.0, -math.sin(pitch / 2), 0.0)
+    q[0:3] = (0.0, 0.0, h + 0.005)
+    assert lowest_foot(q, feet) < 0.0 + t3.TOUCH_MARGIN_M and touched_down(task, q, feet)
 
 
 def test_a_butterfly_that_touches_down_perches_on_its_legs_with_its_wings_closed():
