@@ -84,3 +84,62 @@ def visit_flowers(controller, flowers, perch_s: float = 2.0, *, dt_s: float | No
         out.update(t_s=np.array([p[0] for p in path]), position_m=np.array([p[1] for p in path]),
                    attitude_rad=np.array([p[2] for p in path]), perched=np.array([p[3] for p in path]), flight=f)
     return out
+
+
+def take_off_measures(controller, beats: int = 3, *, dt_s: float | None = None) -> dict:
+    """A take-off from a flower measured as Sunada et al. (1993) filmed butterflies taking off: the butterfly
+    ``controller`` perches on a flower, then takes off for another 1.2 m ahead. Over its first ``beats`` wing beats,
+    every time step: the whole butterfly's centre of mass (wings and abdomen included) and its acceleration, and
+    the force of the air and the legs (the total force less the weight). Returns ``peak_acceleration_m_s2`` and
+    ``peak_at_beat`` (when it peaks, in beats from the first downstroke's start: 0.25 is the first downstroke's
+    middle), ``lift_off_s`` (the legs' last contact), and per half-stroke (``downstroke``, ``upstroke``: the flap
+    angle falling or rising) the mean force's ``vertical_N`` and ``horizontal_N`` components and its angle above
+    the horizontal (``angle_deg``), over the beats after lift-off."""
+    import mujoco
+
+    from lifelike_mj.butterfly.flight3d.flight import DT_S, Flight3D
+    from lifelike_mj.butterfly.flight3d.model import standing_height_m
+
+    beats = checks.whole("beats", beats, 1, 100)
+    start = (0.0, 0.0, -standing_height_m("monarch") - 0.015)
+    f = Flight3D(controller=controller, flowers=[start, (1.2, 0.0, start[2])], dt_s=DT_S if dt_s is None else dt_s)
+    f.perch_on(0)
+    f.step(int(round(0.3 / f.dt)))
+    m, d = f.model, f.data
+    root = m.joint("root").id
+    body = int(m.jnt_bodyid[root])
+    mass = float(m.body_subtreemass[body])
+    g = np.array(m.opt.gravity, dtype=float)
+    f.take_off(f.land_on(1))
+    t0 = f.time
+    n = int(round(beats / float(f.kinematics.p[0]) / f.dt))
+    rows = []
+    mujoco.mj_subtreeVel(m, d)
+    v_prev = d.subtree_linvel[body].copy()
+    for _ in range(n):
+        f.step(1)
+        mujoco.mj_subtreeVel(m, d)
+        v = d.subtree_linvel[body].copy()
+        a = (v - v_prev) / f.dt
+        v_prev = v
+        rows.append((f.time - t0, *a, *(mass * (a - g)), float(f.state()["joints_rad"][0]), d.ncon))
+    r = np.array(rows)
+    t, acc, force, flap, ncon = r[:, 0], r[:, 1:4], r[:, 4:7], r[:, 7], r[:, 8]
+    period = 1.0 / float(f.kinematics.p[0])
+    k = int(np.argmax(np.linalg.norm(acc, axis=1)))
+    touching = np.nonzero(ncon > 0)[0]
+    lift = float(t[touching[-1]]) if len(touching) else 0.0
+    airborne = t > lift
+    falling = np.gradient(flap) < 0
+    out = {"peak_acceleration_m_s2": float(np.linalg.norm(acc[k])), "peak_at_beat": float(t[k] / period),
+           "lift_off_s": lift, "beats": beats, "mass_kg": mass}
+    heading = np.array([1.0, 0.0])
+    for name, sel in (("downstroke", falling & airborne), ("upstroke", ~falling & airborne)):
+        if not sel.any():
+            out[name] = None
+            continue
+        mean = force[sel].mean(axis=0)
+        horizontal = float(mean[:2] @ heading)
+        out[name] = {"vertical_N": float(mean[2]), "horizontal_N": horizontal,
+                     "angle_deg": math.degrees(math.atan2(float(mean[2]), horizontal))}
+    return out

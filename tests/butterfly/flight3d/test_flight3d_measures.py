@@ -127,6 +127,11 @@ def test_unnatural_flight_costs_and_natural_flight_does_not():
     assert E.unnatural(dict(natural, stroke_top_deg=80.0), level(1.5)) == pytest.approx(0.3)
     assert E.body_angle_target_deg(1.0) == 20.0 and E.body_angle_target_deg(2.0) == 10.0
     assert E.body_angle_target_deg(3.0) == 5.0
+    # slow flight (before a landing) is asked for level wings and even strokes only: no cruise power, gap or body angle
+    slow = dict(natural, power_W_kg=40.2, stroke_top_deg=88.0, pitch_deg=50.0)
+    assert E.unnatural(slow, level(0.4)) == 0.0
+    assert E.unnatural(dict(slow, roll_deg=13.0), level(0.4)) == pytest.approx(0.5)
+    assert E.unnatural(slow, level(1.0)) > 1.0
 
 
 def test_falling_is_no_way_out_of_looking_unnatural():
