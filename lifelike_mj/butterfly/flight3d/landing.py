@@ -21,6 +21,8 @@ from lifelike_mj.butterfly.flight3d.tasks import TOUCHDOWN_M_S
 #: A visit's bounds: the most a landing may take (s), and the most the thorax may move while perched (m) for the
 #: butterfly to count as sitting still.
 MAX_LANDING_S, STILL_M = 20.0, 0.005
+#: A take-off's acceleration is averaged over this long (s), as a film at 200 frames per second resolves it.
+SMOOTH_S = 0.005
 
 
 def visit_flowers(controller, flowers, perch_s: float = 2.0, *, dt_s: float | None = None, record_every_s: float = 0.0,
@@ -89,12 +91,12 @@ def visit_flowers(controller, flowers, perch_s: float = 2.0, *, dt_s: float | No
 def take_off_measures(controller, beats: int = 3, *, dt_s: float | None = None) -> dict:
     """A take-off from a flower measured as Sunada et al. (1993) filmed butterflies taking off: the butterfly
     ``controller`` perches on a flower, then takes off for another 1.2 m ahead. Over its first ``beats`` wing beats,
-    every time step: the whole butterfly's centre of mass (wings and abdomen included) and its acceleration, and
-    the force of the air and the legs (the total force less the weight). Returns ``peak_acceleration_m_s2`` and
-    ``peak_at_beat`` (when it peaks, in beats from the first downstroke's start: 0.25 is the first downstroke's
-    middle), ``lift_off_s`` (the legs' last contact), and per half-stroke (``downstroke``, ``upstroke``: the flap
-    angle falling or rising) the mean force's ``vertical_N`` and ``horizontal_N`` components and its angle above
-    the horizontal (``angle_deg``), over the beats after lift-off."""
+    every time step: the whole butterfly's centre of mass (wings and abdomen included) and its acceleration
+    (averaged over :data:`SMOOTH_S`), and the force of the air and the legs (the total force less the weight).
+    Returns ``peak_acceleration_m_s2`` and ``peak_at_beat`` (when it peaks, in beats from the first downstroke's
+    start: 0.25 is the first downstroke's middle), ``lift_off_s`` (the legs' last contact), and per half-stroke
+    (``downstroke``, ``upstroke``: the flap angle falling or rising) the mean force's ``vertical_N`` and
+    ``horizontal_N`` components and its angle above the horizontal (``angle_deg``), over the beats after lift-off."""
     import mujoco
 
     from lifelike_mj.butterfly.flight3d.flight import DT_S, Flight3D
@@ -126,12 +128,14 @@ def take_off_measures(controller, beats: int = 3, *, dt_s: float | None = None) 
     r = np.array(rows)
     t, acc, force, flap, ncon = r[:, 0], r[:, 1:4], r[:, 4:7], r[:, 7], r[:, 8]
     period = 1.0 / float(f.kinematics.p[0])
-    k = int(np.argmax(np.linalg.norm(acc, axis=1)))
+    window = max(1, int(round(SMOOTH_S / f.dt)))  # as film resolves it: the acceleration over 5 ms
+    smooth = np.array([np.convolve(acc[:, i], np.ones(window) / window, mode="same") for i in range(3)]).T
+    k = int(np.argmax(np.linalg.norm(smooth, axis=1)))
     touching = np.nonzero(ncon > 0)[0]
     lift = float(t[touching[-1]]) if len(touching) else 0.0
     airborne = t > lift
     falling = np.gradient(flap) < 0
-    out = {"peak_acceleration_m_s2": float(np.linalg.norm(acc[k])), "peak_at_beat": float(t[k] / period),
+    out = {"peak_acceleration_m_s2": float(np.linalg.norm(smooth[k])), "peak_at_beat": float(t[k] / period),
            "lift_off_s": lift, "beats": beats, "mass_kg": mass}
     heading = np.array([1.0, 0.0])
     for name, sel in (("downstroke", falling & airborne), ("upstroke", ~falling & airborne)):

@@ -171,3 +171,23 @@ def test_the_blossom_touched_is_the_blossom_drawn():
     g = f.model.geom("blossom_1")
     assert tuple(g.size) == BLOSSOM_SIZE_M and g.contype == 1
     assert f.model.geom("stem_1").contype == 0
+
+
+def test_a_landing_garden_logs_its_visits_and_gives_up_a_flower_it_cannot_reach(monkeypatch):
+    """A garden told to land: each butterfly aims at its first flower; one that has not touched down within
+    GIVE_UP_S logs a missed visit and aims at its next flower in its order (the shipped monarch was not evolved to
+    land, so it circles its flowers); the scene draws legs."""
+    from lifelike_mj.butterfly.flight3d import garden as G
+
+    monkeypatch.setattr(G, "GIVE_UP_S", 2.0)
+    g = G.Garden(2, "monarch", seed=3, n_flowers=4, land=True, flutter=0.0)
+    assert g.land and g.model.geom("b0_leg_0_left") is not None
+    first = [int(np.argmin(np.linalg.norm(g.blossoms[:, :2] - t.rows[0][:2], axis=1))) for t in g.tasks]
+    g.step(round(2.5 / g.dt))
+    visits = g.visits()
+    for i in range(2):
+        assert visits[i][0] == {"flower": first[i], "touchdown_s": None, "touchdown_speed_m_s": None,
+                                "take_off_s": None}
+        assert g._batch.tasks[i, t3.T_ROW0 : t3.T_ROW0 + 2] == pytest.approx(g.blossoms[g._orders[i][1], :2])
+    assert not g.state()["perched"].any() and (g.state()["waypoints_passed"] == 0).all()
+    assert not G.Garden(2, "monarch", seed=3, n_flowers=4).land  # not evolved to land: it passes the flowers by
