@@ -192,6 +192,13 @@ def cmd_land3d(args) -> None:
         from lifelike_mj.render.video import check_size
 
         check_size(args.width, args.height, "panel")
+    from lifelike_mj import checks
+    from lifelike_mj.butterfly.flight3d.flight import DT_S
+    from lifelike_mj.butterfly.flight3d.landing import MAX_LANDING_S
+
+    checks.work(f"visiting {args.flowers} flowers, perched {args.perch:g} s on each",
+                (args.flowers - 1) * checks.steps_of(MAX_LANDING_S + args.perch, DT_S), checks.MAX_BODY_STEPS,
+                "time steps", "fewer flowers or a shorter perch")
     ctrl = load_controller(args.controller)
     blossoms = place_flowers(args.seed, args.flowers, args.size)
     with stage(f"visiting {args.flowers} flowers by landing, perched {args.perch:g} s on each"):
@@ -202,8 +209,9 @@ def cmd_land3d(args) -> None:
         from lifelike_mj.butterfly.flight3d.strobe import landing_strobe
         from lifelike_mj.render.video import write_png
 
-        with stage("the landing and take-off picture"):
-            img, what = landing_strobe(ctrl, blossoms[:2], width=args.width, height=args.height)
+        landed = bool(res["visits"]) and res["visits"][0]["landed"]
+        with stage("the landing and take-off picture" if landed else "the take-off picture (it did not land)"):
+            img, what = landing_strobe(ctrl, blossoms[:2], width=args.width, height=args.height, land=landed)
         write_png(args.picture, img)
         out["picture"] = {"out": str(args.picture), **what}
     ok = sum(v["within_bound"] and v["still"] for v in res["visits"])
@@ -318,7 +326,7 @@ def add_commands(bf) -> None:
     p = bf.add_parser("evolve3d", help="evolve a 3D controller (CMA-ES or the paper's GA) on the MuJoCo batch")
     p.add_argument("--optimizer", default="cmaes", choices=("cmaes", "rcga", "crs2", "esch", "isres"),
                    help="cmaes, rcga (the paper's GA) or an nlopt method")
-    p.add_argument("--tasks", default="steer", choices=("steer", "cruise", "wind", "natural", "garden", "agile"),
+    p.add_argument("--tasks", default="steer", choices=("steer", "cruise", "wind", "natural", "garden", "agile", "fast"),
                    help="the task set: steer (level at 1 and 2 m/s, turns of 90 and -180 deg), cruise (level at 1.5 "
                         "and 2 m/s, the turns, and two flights in 1 m/s wind with 0.5 m/s gusts) or wind (courses "
                         "1-4 in 1 m/s wind from four sides with gusts of 0.5 m/s, 0.25 m/s vertically, course 5 and "
@@ -326,7 +334,8 @@ def add_commands(bf) -> None:
                         "the turns, course 5, and course 1 in 1 m/s wind with gusts of 0.5 m/s on every axis) or garden "
                         "(the monarch's: level at 1, 2 and 2.5 m/s, the turns, course 5, course 1 in 1 m/s wind "
                         "with gusts on every axis, course 3 in a 1.5 m/s wind, and three landings on flowers) or agile "
-                        "(the steer set and calm courses 1-3)")
+                        "(the steer set and calm courses 1-3) or fast (level at 1 to 3 m/s, the 90 deg turn, course 5, "
+                        "course 1 in gusty 1 m/s wind, course 3 in 1.5 m/s wind)")
     p.add_argument("--inputs", default=None, choices=("ground", "air"),
                    help="the network's speeds over the ground or through the air (default: the start's, else ground)")
     p.add_argument("--start", default=None, help="a 3D controller to start from (its network; genes are its changes)")
@@ -411,7 +420,7 @@ def add_commands(bf) -> None:
     p.add_argument("--size", type=num(2.0, 100.0), default=6.0, help="the flowers' square, m")
     p.add_argument("--perch", type=num(0.0, 600.0), default=2.0, help="seconds perched on each flower")
     p.add_argument("--picture", default=None, help="a picture (.png) of the landing on the second flower and the "
-                   "take-off from it")
+                   "take-off from it (of the take-off from the first, if it did not land)")
     p.add_argument("--width", type=count(16, 1920), default=640, help="width of each panel, pixels")
     p.add_argument("--height", type=count(16, 1080), default=420, help="height, pixels")
     add_overwrite(p)

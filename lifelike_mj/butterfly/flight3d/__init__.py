@@ -21,18 +21,21 @@ Evolve a controller of your own (``lifelike-mj butterfly evolve3d`` does the sam
 What is here, one layer on the next:
 
 * :mod:`~lifelike_mj.butterfly.flight3d.animals`: the butterflies, the paper's swallowtail and the monarch with
-  its measured wings (:data:`ANIMALS`, :func:`animal`);
+  its measured wings (:data:`ANIMALS`, :func:`animal`); :mod:`~lifelike_mj.butterfly.flight3d.flowers`: flowers
+  to land on (:func:`place_flowers`);
 * :mod:`~lifelike_mj.butterfly.flight3d.kinematics`: the flap, feathering and abdomen kinematics
   (:class:`KinematicsCommand`, :class:`Kinematics`);
 * :mod:`~lifelike_mj.butterfly.flight3d.model`: the MuJoCo model and its compiled air-force callback;
 * :mod:`~lifelike_mj.butterfly.flight3d.tasks`: what a flight is asked to do (:class:`Task3D`, :func:`level`,
-  :func:`turn`, :func:`course`, :func:`moving_target`) and the compiled loop's array layouts;
+  :func:`turn`, :func:`course`, :func:`moving_target`, :func:`land`) and the compiled loop's array layouts;
 * :mod:`~lifelike_mj.butterfly.flight3d.controllers`: the network's observation and action
   (:data:`OBS_NAMES`, :data:`ACTION_NAMES`), :class:`Controller3D` and its file (:func:`load_controller`);
 * :mod:`~lifelike_mj.butterfly.flight3d.loop`: the compiled loop and the one owner of its state,
   :class:`Batch` (a flight is a batch of one, a garden a batch of n, an evolution candidates x tasks);
 * :mod:`~lifelike_mj.butterfly.flight3d.flight`: the stepper :class:`Flight3D`;
 * :mod:`~lifelike_mj.butterfly.flight3d.measures`: how natural a flight is (:func:`level_measures`);
+  :mod:`~lifelike_mj.butterfly.flight3d.landing`: flowers visited by landing (:func:`visit_flowers`), a take-off
+  measured (``take_off_measures``);
 * :mod:`~lifelike_mj.butterfly.flight3d.garden`: :class:`Garden`, many butterflies among flowers;
 * :mod:`~lifelike_mj.butterfly.flight3d.strobe`: stroboscopic pictures of one wing beat;
 * :mod:`~lifelike_mj.butterfly.flight3d.evolution`: :class:`FlightProblem3D`, :data:`TASK_SETS`, :func:`evolve`;
@@ -58,4 +61,5 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "evolution": ".", "validate": ".", "figures": ".", "timing": ".", "view": ".", "view_flight3d": "view",
     "animals": ".", "measures": ".", "Animal": "animals", "ANIMALS": "animals", "animal": "animals",
     "level_measures": "measures", "default_base": "controllers", "strobe": ".",
+    "flowers": ".", "landing": ".", "land": "tasks", "visit_flowers": "landing", "place_flowers": "flowers",
 }, globals())

@@ -311,6 +311,11 @@ TASK_SETS = {
     # a calm course and one in 1 m/s wind with gusts of 0.5 m/s on every axis
     "natural": lambda: (level(1.0), level(1.5), level(2.0), turn(90.0, 1.5, 1.5), turn(-180.0, 1.5, 1.5, 0.3), course(5),
                         course(1).with_weather((1.0, 0.0, 0.0), gust_m_s=0.5, gust_vertical_m_s=0.5, seed=1)),
+    # the monarch's fast cruise, with --natural: level from 1 to 3 m/s (J passes 0.9 near 2.3 m/s), the turn, a calm
+    # course, one in 1 m/s wind with gusts on every axis, one in a steady 1.5 m/s wind
+    "fast": lambda: (level(1.0), level(1.5), level(2.0), level(2.5), level(3.0), turn(90.0, 1.5, 1.5), course(5),
+                     course(1).with_weather((1.0, 0.0, 0.0), gust_m_s=0.5, gust_vertical_m_s=0.5, seed=1),
+                     course(3).with_weather((-1.5, 0.0, 0.0), seed=3)),
     # the steer set and three calm courses, whose sharp turns teach a controller to bank without tumbling
     "agile": lambda: (level(1.0), level(2.0), turn(90.0, 1.5, 1.5), turn(-180.0, 1.5, 1.5, 0.3), course(1), course(2),
                       course(3)),

@@ -90,12 +90,13 @@ def _exposures(r, m, states, centre, azimuth: float, elevation: float, extent_m:
 
 def landing_strobe(controller, flowers=((0.0, 0.0, -0.1), (1.2, 0.4, -0.25)), every_s: float = 0.04,
                    before_s: float = 0.6, after_s: float = 0.4, perch_s: float = 1.0, width: int = 640,
-                   height: int = 420) -> tuple[np.ndarray, dict]:
+                   height: int = 420, land: bool = True) -> tuple[np.ndarray, dict]:
     """A landing and a take-off, each in one picture of moments ``every_s`` apart, seen from the side of the path:
     the butterfly ``controller`` starts perched on ``flowers[0]``, takes off and lands on ``flowers[1]``; the left
     panel shows its last ``before_s`` before touchdown and the perch after ``perch_s`` (the wings closed), the right
     panel the take-off back towards ``flowers[0]``, its first ``after_s``. Returns the ``(height, 2 width, 3)`` image
-    and what happened (``touchdown``: time and speed; ``landed``)."""
+    and what happened (``touchdown``: time and speed; ``landed``). Without ``land``: the take-off from ``flowers[0]``
+    towards ``flowers[1]`` only, its perch first (one panel)."""
     from collections import deque
 
     import mujoco
@@ -117,21 +118,23 @@ def landing_strobe(controller, flowers=((0.0, 0.0, -0.1), (1.2, 0.4, -0.25)), ev
         mujoco.mj_kinematics(m, d)
         return d
 
-    f.take_off(f.land_on(1))
-    t0 = f.time
     before: deque = deque(maxlen=max(1, int(round(before_s / every_s))))
-    while not f.perched and f.time - t0 < MAX_LANDING_S:
-        f.step(every)
-        before.append(copy())
-    touchdown = f.touchdown
-    if touchdown is None:
-        from lifelike_mj.errors import UserError
+    touchdown, back = None, 1
+    if land:
+        f.take_off(f.land_on(1))
+        t0 = f.time
+        while not f.perched and f.time - t0 < MAX_LANDING_S:
+            f.step(every)
+            before.append(copy())
+        touchdown, back = f.touchdown, 0
+        if touchdown is None:
+            from lifelike_mj.errors import UserError
 
-        raise UserError(f"the butterfly did not land on the flower within {MAX_LANDING_S:g} s: its controller "
-                        "was not evolved to land (the garden task set).")
-    f.step(int(round(perch_s / f.dt)))
+            raise UserError(f"the butterfly did not land on the flower within {MAX_LANDING_S:g} s, so there is no "
+                            "landing to draw; a controller that lands (evolved on the garden task set) draws one.")
+        f.step(int(round(perch_s / f.dt)))
     perched = copy()
-    f.take_off(f.land_on(0))
+    f.take_off(f.land_on(back))
     after = [perched]
     for _ in range(max(1, int(round(after_s / every_s)))):
         f.step(every)
@@ -142,8 +145,8 @@ def landing_strobe(controller, flowers=((0.0, 0.0, -0.1), (1.2, 0.4, -0.25)), ev
     dress(m)
     panels = []
     with Offscreen(m, width, height) as r:
-        for states in (list(before) + [perched], after):
+        for states in ((list(before) + [perched], after) if land else (after,)):
             path = np.array([d.qpos[root : root + 3] for d in states])
             reach = float(np.max(np.ptp(path, axis=0)))
             panels.append(_exposures(r, m, states, path.mean(axis=0), heading + 90.0, -5.0, 1.3 * max(reach, 0.12)))
-    return np.concatenate(panels, axis=1), {"touchdown": touchdown, "landed": touchdown is not None}
+    return np.concatenate(panels, axis=1), {"touchdown": touchdown, "landed": touchdown is not None, "drew_landing": land}
