@@ -36,3 +36,20 @@ def test_a_strobe_names_bad_views():
     f = Flight3D(default_base("monarch"), animal="monarch")
     with pytest.raises(UserError, match="unknown view 'back'"):
         strobe(f, 4, ("back",))
+
+
+def test_a_take_off_is_drawn_as_it_leaves_the_flower(gl_backend):
+    """The take-off picture (landing_strobe without a landing): the perched butterfly and its first moments in the air
+    in one panel; more orange (wing) than one butterfly alone, spread sideways along its path. A landing that does
+    not happen is one sentence."""
+    from lifelike_mj.butterfly.flight3d.strobe import landing_strobe
+    from lifelike_mj.errors import UserError
+
+    flowers = ((0.0, 0.0, -0.1), (1.2, 0.4, -0.25))
+    img, what = landing_strobe("monarch", flowers, land=False, every_s=0.04, after_s=0.3, width=320, height=240)
+    assert img.shape == (240, 320, 3) and not what["landed"] and not what["drew_landing"]
+    wings = _orange(img)
+    cols = np.nonzero(wings.any(axis=0))[0]
+    assert wings.sum() > 0 and np.ptp(cols) > 0.3 * 320
+    with pytest.raises(UserError, match="did not land"):
+        landing_strobe("monarch", flowers, width=64, height=48)
