@@ -218,7 +218,8 @@ class Flight3D(StepCounter):
         self._data = mj3d.setup_data(self._model, kin, self.params, air_m_s=self.wind_to_m_s, **self.options)
         self._data.qpos[self._root_q : self._root_q + 3] = self.start_m
         net = self.network
-        self._batch = Batch(self._model, [self._data], self._task, net, dt_s=self.dt,
+        # the task afresh: a landing turns its array's kind into a perch
+        self._batch = Batch(self._model, [self._data], self.task.as_array(self._n_rows), net, dt_s=self.dt,
                             records=new_record(1, self._n_rows), base=None if net else self.command.as_array(),
                             tumble_rad=TUMBLE_RAD if self.end_on_tumble else math.inf)
         self._task = self._batch.tasks[0]
@@ -393,18 +394,22 @@ class Flight3D(StepCounter):
         if not isinstance(task, Task3D):
             raise UserError(f"a task is a Task3D (flight3d.level, course, land), got {task!r}.")
         clap = t3.CLAP_S if clap_s is None else checks.number("clap_s", clap_s, 0.0, 10.0, unit="s")
-        n_rows = len(task.rows)
-        rec = new_record(1, n_rows)
+        rec = new_record(1, len(task.rows))
         keep = [i for i in range(t3.R_WP) if i not in (t3.R_PASSED, t3.R_LANDED_AT, t3.R_TOUCH_SPEED)]
         rec[0, keep] = self._rec[keep]
         rec[0, t3.R_CLAP_UNTIL] = self.time + clap
-        self.task, self._n_rows = task, n_rows
-        self._batch = Batch(self._model, [self._data], task.as_array(n_rows), self.network, dt_s=self.dt,
-                            records=rec, base=None if self.network else self.command.as_array(),
+        self._fly_task(task, rec)
+        take_off_kinematics(self._data.userdata, self._batch.base)
+
+    def _fly_task(self, task: Task3D, records: np.ndarray) -> None:
+        """Fly ``task`` from now on, with the run record ``records`` (``(1, ...)``): a fresh batch of one on the same
+        model and data."""
+        self.task, self._n_rows = task, len(task.rows)
+        self._batch = Batch(self._model, [self._data], task.as_array(self._n_rows), self.network, dt_s=self.dt,
+                            records=records, base=None if self.network else self.command.as_array(),
                             tumble_rad=self._batch.tumble_rad)
         self._task = self._batch.tasks[0]
         self._rec = self._batch.records[0]
-        take_off_kinematics(self._data.userdata, self._batch.base)
 
     def perch_on(self, flower: int) -> None:
         """Put the butterfly at rest on flower ``flower`` (an index into :attr:`flowers`), standing, facing its
@@ -415,12 +420,7 @@ class Flight3D(StepCounter):
         task = self.land_on(flower)
         row = task.rows[0]
         yaw = float(euler_from_quat(self._data.qpos[self._root_q + 3 : self._root_q + 7])[2])
-        self.task, self._n_rows = task, len(task.rows)
-        self._batch = Batch(self._model, [self._data], task.as_array(self._n_rows), self.network, dt_s=self.dt,
-                            records=new_record(1, self._n_rows),
-                            base=None if self.network else self.command.as_array(), tumble_rad=self._batch.tumble_rad)
-        self._task = self._batch.tasks[0]
-        self._rec = self._batch.records[0]
+        self._fly_task(task, new_record(1, len(task.rows)))
         self._task[T_KIND] = t3.TASK_PERCH
         self._rec[t3.R_LANDED_AT], self._rec[t3.R_AIM] = self.time, yaw
         d, rq = self._data, self._root_q

@@ -187,7 +187,7 @@ class Garden(StepCounter):
             d.qpos[0:3] = start
             d.qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
             self._datas.append(d)
-        self._batch = Batch(self._phys, self._datas, self._task_arr, ctl, dt_s=self.dt,
+        self._batch = Batch(self._phys, self._datas, self._task_arr.copy(), ctl, dt_s=self.dt,  # a landing changes it
                             records=new_record(self.n, self._rows))
         self._recs = self._batch.records
         # each butterfly's visits: (flower, touchdown time s, touchdown speed m/s, take-off time s or None), and

@@ -106,13 +106,15 @@ def test_without_its_legs_touching_a_perched_butterfly_falls():
     assert f.perched and f.state()["position_m"][2] < top[2] - 0.5
 
 
-def test_a_butterfly_put_on_a_flower_perches_there():
+def test_a_butterfly_put_on_a_flower_perches_there_until_a_reset():
     f = Flight3D(controller="monarch", flowers=FLOWERS, ground_m=-1.0)
     f.perch_on(1)
     assert f.perched and f.touchdown == {"time_s": 0.0, "speed_m_s": 0.0}
     f.step(round(1.0 / f.dt))
     top = landing_surface(FLOWERS[1])
     assert f.state()["position_m"] == pytest.approx(top + (0.0, 0.0, mj3d.standing_height_m("monarch")), abs=0.002)
+    f.reset()  # back to the start, flying its landing task afresh
+    assert not f.perched and f.touchdown is None and f.time == 0.0
 
 
 def test_a_take_off_claps_and_leaves_the_flower():
@@ -190,4 +192,6 @@ def test_a_landing_garden_logs_its_visits_and_gives_up_a_flower_it_cannot_reach(
                                 "take_off_s": None}
         assert g._batch.tasks[i, t3.T_ROW0 : t3.T_ROW0 + 2] == pytest.approx(g.blossoms[g._orders[i][1], :2])
     assert not g.state()["perched"].any() and (g.state()["waypoints_passed"] == 0).all()
+    g.reset()  # every butterfly aims at its first flower again
+    assert g._batch.tasks[0, t3.T_ROW0] == pytest.approx(g.blossoms[first[0], 0]) and g.visits() == [[], []]
     assert not G.Garden(2, "monarch", seed=3, n_flowers=4).land  # not evolved to land: it passes the flowers by
