@@ -125,10 +125,10 @@ def unnatural(st: dict, task: Task3D) -> float:
 def start_blossom(animal: str) -> tuple[float, float, float]:
     """The centre of the flower a :class:`FlightProblem3D` with ``take_off`` starts on (m): right under the start, its
     butterfly's thorax at the origin standing on it."""
-    from lifelike_mj.butterfly.flight3d.flowers import BLOSSOM_SIZE_M
+    from lifelike_mj.butterfly.flight3d.flowers import blossom_under
     from lifelike_mj.butterfly.flight3d.model import standing_height_m
 
-    return (0.0, 0.0, -standing_height_m(animal) - BLOSSOM_SIZE_M[2])
+    return tuple(float(v) for v in blossom_under((0.0, 0.0, -standing_height_m(animal))))
 
 
 #: How a landing is scored (:func:`landing_score`): the closest approach's scale (m) before touchdown, and the scale of
@@ -246,9 +246,9 @@ class FlightProblem3D:
         on and those the landing tasks land on, which their legs touch as in a garden; else none."""
         if not self.take_off:
             return None
-        from lifelike_mj.butterfly.flight3d.flowers import BLOSSOM_SIZE_M
+        from lifelike_mj.butterfly.flight3d.flowers import blossom_under
 
-        return [start_blossom(self.template.animal)] + [(t.rows[0][0], t.rows[0][1], t.rows[0][2] - BLOSSOM_SIZE_M[2])
+        return [start_blossom(self.template.animal)] + [tuple(float(v) for v in blossom_under(t.rows[0][:3]))
                                                         for t in self.tasks if t.kind == "land"]
 
     def fly(self, W: np.ndarray) -> np.ndarray:

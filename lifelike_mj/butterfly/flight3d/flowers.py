@@ -26,6 +26,11 @@ def landing_surface(blossom) -> np.ndarray:
     return np.asarray(blossom, dtype=float) + np.array([0.0, 0.0, BLOSSOM_SIZE_M[2]])
 
 
+def blossom_under(surface) -> np.ndarray:
+    """The centre of the blossom whose landing surface is at ``surface`` (m): :func:`landing_surface`'s inverse."""
+    return np.asarray(surface, dtype=float) - np.array([0.0, 0.0, BLOSSOM_SIZE_M[2]])
+
+
 def add_flowers(spec: mujoco.MjSpec, blossoms, ground_m: float, contact: bool = False) -> None:
     """Add a flower per row of ``blossoms`` (``(n, 3)``, m) to ``spec``'s world: ``stem_k`` from the ground at
     ``ground_m`` (m) up to the blossom, ``blossom_k`` (touching the butterfly's legs when ``contact``) and
