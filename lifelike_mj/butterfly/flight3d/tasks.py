@@ -63,13 +63,13 @@ LAND_ABOVE_M, LAND_GLIDE, LAND_HOLD_M, TOUCH_MARGIN_M = 0.3, 0.5, 0.03, 0.003
 #: speed asked, ``slow_per_s`` m/s per m of horizontal distance (at most the task's speed).
 LANDING = {"flare_deg": 40.0, "flare_m": 0.5, "sink_m": 0.02, "slow_per_s": 1.5}
 #: The touchdown speed a landing keeps within (m/s, chosen: no measured landing speed of butterflies was found). A
-#: monarch's legs (about 7 mm) stop 0.5 m/s within their length at 1.8 g, below the 10 g a butterfly's legs and
-#: wings give it at take-off (Sunada et al. 1993).
+#: monarch's legs (about 7 mm) stop 0.5 m/s within their length at 1.8 g, a third of the 5-6 g its own take-offs reach
+#: (:func:`~lifelike_mj.butterfly.flight3d.landing.take_off_measures`).
 TOUCHDOWN_M_S = 0.5
 #: A perch: the wings closed over the back (each flap angle, rad; 90 deg is upright), still; a take-off claps the wings
 #: for ``CLAP_S`` s: about the offset the network asks, each wing's stroke amplitude is raised so that the top of its
 #: stroke is ``CLAP_TOP_RAD`` (the wings meet over the back), as butterflies taking off do (Johansson and
-#: Henningsson 2021; Sunada et al. 1993 measured larger strokes at take-off).
+#: Henningsson 2021). The larger stroke is our choice: raising the offset instead turns this model's body over.
 PERCH_FLAP_RAD, CLAP_TOP_RAD, CLAP_S = math.radians(85.0), math.radians(88.0), 0.3
 
 #: A task's most rows, and the largest number in a row (m, s, rad, m/s): far beyond a garden, finite in the loop.
