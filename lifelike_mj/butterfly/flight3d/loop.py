@@ -169,8 +169,7 @@ def reference(task, t, pos, rec):
     if kind == TASK_LAND or kind == TASK_PERCH:
         # a landing (tasks.land): aim at the flower, lower and slower the closer; a perch holds where it is
         b = T_ROW0
-        dx, dy = task[b] - pos[0], task[b + 1] - pos[1]
-        dh = math.sqrt(dx * dx + dy * dy)
+        dx, dy, dh = to_flower(task, pos)
         aim_z = task[b + 2] + task[b + 3]
         dz = aim_z - pos[2]
         rec[R_WP] = min(rec[R_WP], math.sqrt(dh * dh + dz * dz))
@@ -256,6 +255,13 @@ def reward(obs):
 
 
 @njit(cache=True)
+def to_flower(task, pos):
+    """``(dx, dy, dh)``: from ``pos`` (m) to a landing task's flower axis, horizontally (m), and that distance."""
+    dx, dy = task[T_ROW0] - pos[0], task[T_ROW0 + 1] - pos[1]
+    return dx, dy, math.sqrt(dx * dx + dy * dy)
+
+
+@njit(cache=True)
 def lowest_foot(qpos, feet):
     """The height (m) of the lowest of the feet ``feet`` (``(4, 3)``, m, in the thorax's frame: the userdata's
     ``U_FEET``) of the body at ``qpos[0:7]``."""
@@ -272,11 +278,9 @@ def touched_down(task, qpos, feet):
     """Whether the butterfly landing on ``task`` (``TASK_LAND``) touches down now (:func:`~lifelike_mj.butterfly.
     flight3d.tasks.land`): its thorax within the task's radius of the flower's axis and its lowest foot
     (:func:`lowest_foot`) within ``TOUCH_MARGIN_M`` of the landing surface (above it, or through it by as much)."""
-    b = T_ROW0
-    dx, dy = task[b] - qpos[0], task[b + 1] - qpos[1]
+    surface = task[T_ROW0 + 2]
     foot = lowest_foot(qpos, feet)
-    return (dx * dx + dy * dy < task[T_RADIUS] * task[T_RADIUS]
-            and task[b + 2] - TOUCH_MARGIN_M < foot < task[b + 2] + TOUCH_MARGIN_M)
+    return to_flower(task, qpos)[2] < task[T_RADIUS] and surface - TOUCH_MARGIN_M < foot < surface + TOUCH_MARGIN_M
 
 
 @njit(cache=True)
@@ -284,10 +288,7 @@ def flare(task, qpos):
     """A landing's flare (rad, nose up): from the task's flare distance out to the flower's axis the pitch the network
     is shown is lowered by up to the task's flare pitch (:func:`~lifelike_mj.butterfly.flight3d.tasks.land`), so that
     it holds its body that much more nose up and slows down, as a butterfly does before it lands."""
-    b = T_ROW0
-    dx, dy = task[b] - qpos[0], task[b + 1] - qpos[1]
-    dh = math.sqrt(dx * dx + dy * dy)
-    return task[b + 4] * max(0.0, 1.0 - dh / task[b + 5])
+    return task[T_ROW0 + 4] * max(0.0, 1.0 - to_flower(task, qpos)[2] / task[T_ROW0 + 5])
 
 
 @njit(cache=True)
@@ -336,7 +337,6 @@ def _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, path, 
     heading, altitude, speed = reference(task, time[0], qpos[0:3], rec)
     if int(task[T_KIND]) == TASK_LAND and touched_down(task, qpos, ud[mj3d.U_FEET : mj3d.U_FEET + 12]):
         task[T_KIND] = TASK_PERCH
-        rec[R_PASSED] += 1.0
         rec[R_LANDED_AT] = time[0]
         rec[R_TOUCH_SPEED] = math.sqrt(qvel[0] * qvel[0] + qvel[1] * qvel[1] + qvel[2] * qvel[2])
         perch_command(base, ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS])
