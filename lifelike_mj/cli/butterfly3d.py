@@ -101,6 +101,10 @@ def cmd_evolve3d(args) -> None:
     start = load_controller(args.start) if args.start else None
     if start is not None and args.hidden:
         raise UserError("--hidden does not apply with --start (the network is the start controller's).")
+    if args.mode is not None and start is None:
+        raise UserError("--mode evolves a behaviour of a controller: give the controller with --start.")
+    if args.reach is not None and args.mode is None:
+        raise UserError("--reach applies to the behaviour evolved with --mode.")
     out = Path(args.out or f"butterfly3d_{args.optimizer}_{args.tasks}_s{args.seed}.json")
     res, ctrl = evolve(TASK_SETS[args.tasks](), out, optimizer=args.optimizer, seed=args.seed, layers=layers,
                        population=args.population, generations=args.generations, duration_s=args.duration,
@@ -108,7 +112,7 @@ def cmd_evolve3d(args) -> None:
                        overwrite=args.overwrite, task_set=args.tasks, start=start, gene_bound=args.gene_bound,
                        inputs=args.inputs, executor=args.executor, workers=args.workers, ray_address=args.ray_address,
                        dt_s=args.dt, animal=args.animal, natural=args.natural, force_law=args.force_law,
-                       take_off=args.take_off)
+                       take_off=args.take_off, mode=args.mode, reach=args.reach)
     if ctrl is None:
         raise KeyboardInterrupt("stopped before the first generation was evaluated; nothing was written")
     state = "stopped early (Ctrl-C); best so far" if res.interrupted else "done"
@@ -326,7 +330,8 @@ def add_commands(bf) -> None:
     p = bf.add_parser("evolve3d", help="evolve a 3D controller (CMA-ES or the paper's GA) on the MuJoCo batch")
     p.add_argument("--optimizer", default="cmaes", choices=("cmaes", "rcga", "crs2", "esch", "isres"),
                    help="cmaes, rcga (the paper's GA) or an nlopt method")
-    p.add_argument("--tasks", default="steer", choices=("steer", "cruise", "wind", "natural", "garden", "agile", "fast"),
+    p.add_argument("--tasks", default="steer", choices=("steer", "cruise", "wind", "natural", "garden", "agile", "fast",
+                                                         "landings"),
                    help="the task set: steer (level at 1 and 2 m/s, turns of 90 and -180 deg), cruise (level at 1.5 "
                         "and 2 m/s, the turns, and two flights in 1 m/s wind with 0.5 m/s gusts) or wind (courses "
                         "1-4 in 1 m/s wind from four sides with gusts of 0.5 m/s, 0.25 m/s vertically, course 5 and "
@@ -335,7 +340,8 @@ def add_commands(bf) -> None:
                         "(the monarch's: level at 1, 2 and 2.5 m/s, the turns, course 5, course 1 in 1 m/s wind "
                         "with gusts on every axis, course 3 in a 1.5 m/s wind, and three landings on flowers) or agile "
                         "(the steer set and calm courses 1-3) or fast (level at 1 to 3 m/s, the 90 deg turn, course 5, "
-                        "course 1 in gusty 1 m/s wind, course 3 in 1.5 m/s wind)")
+                        "course 1 in gusty 1 m/s wind, course 3 in 1.5 m/s wind) or landings (six flowers all round, "
+                        "0.9-3.5 m away: for --mode land, or with --take-off for --mode take_off)")
     p.add_argument("--inputs", default=None, choices=("ground", "air"),
                    help="the network's speeds over the ground or through the air (default: the start's, else ground)")
     p.add_argument("--start", default=None, help="a 3D controller to start from (its network; genes are its changes)")
@@ -351,6 +357,13 @@ def add_commands(bf) -> None:
                         "flight, a dorsal gap of 35-50 deg, at most 20.2 W/kg, the body angle falling with speed")
     p.add_argument("--take-off", action="store_true",
                    help="every training flight starts perched on a flower, its wings closed, and takes off clapping")
+    p.add_argument("--mode", default=None, choices=("land", "take_off"),
+                   help="evolve the --start controller's behaviour network of that name (a landing's last metres, a "
+                        "take-off's first second), starting from its own, else from its flight network; the rest "
+                        "is flown by its other networks as they are")
+    p.add_argument("--reach", type=num(0, 100, lo_open=True), default=None,
+                   help="where the --mode network flies: land, within this many m of the flower (default 0.6); "
+                        "take_off, for this many s (default 1)")
     p.add_argument("--gene-bound", type=num(0, 10, lo_open=True), default=0.4,
                    help="bound of each gene (a weight's change from the start)")
     p.add_argument("--hidden", type=_hidden, default=[], help="hidden layer sizes, e.g. 16 (default: none, a linear network)")

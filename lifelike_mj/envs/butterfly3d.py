@@ -155,9 +155,8 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
             flight3d.load_controller(controller) if controller is not None else
             flight3d.Controller3D([flight3d.N_OBS, flight3d.N_ACT], np.zeros(flight3d.n_weights([10, 9]))))
         if every is not None or inputs is not None or animal is not None:
-            ctl = flight3d.Controller3D(ctl.layers, ctl.weights, ctl.base, dict(zip(flight3d.ACTION_NAMES, ctl.scale)),
-                                        ctl.every if every is None else every, ctl.omega_c_rad_s, ctl.provenance,
-                                        ctl.name, inputs or ctl.inputs, animal or ctl.animal, ctl.force_law)
+            ctl = ctl.replace(every=ctl.every if every is None else every, inputs=inputs or ctl.inputs,
+                              animal=animal or ctl.animal)
         self.controller = ctl
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise UserError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}.")

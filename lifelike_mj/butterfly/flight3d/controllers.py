@@ -22,6 +22,11 @@ and the flap frequency. The kinematics follow each
 new command smoothly (the filter of :mod:`~lifelike_mj.butterfly.flight3d.kinematics`).
 
 Networks: ``layers = [10, ..., 9]``, hidden neurons ``tanh``; ``[10, 9]`` is a linear policy.
+
+Behaviours (:data:`MODES`): beside its flight network a controller may carry networks of the same shape for the parts
+of a flight that ask for another way of flying, as an animal's motor patterns change between cruising, landing and
+taking off: ``land`` flies a landing's last ``from_m`` (m, horizontally from the flower's axis), ``take_off`` the
+first ``for_s`` (s) after a take-off. Where a controller has none, its flight network flies throughout.
 """
 
 from __future__ import annotations
@@ -58,6 +63,12 @@ INPUTS = ("ground", "air")
 #: The wing-force laws a controller can be evolved with and fly (those of the model's callback that act over the
 #: wing's area: :data:`~lifelike_mj.butterfly.flight3d.model.FORCE_LAWS` less ``none`` and the paper's ``tip``).
 FORCE_LAWS_FLOWN = ("exact", "strip", "quasi_steady")
+#: The behaviour networks a controller may carry (module docstring), each with the name of its reach: ``land`` from
+#: ``from_m`` (m) out, ``take_off`` for ``for_s`` (s); and the reach a new one gets.
+MODES = {"land": "from_m", "take_off": "for_s"}
+MODE_REACH = {"land": 0.6, "take_off": 1.0}
+#: The largest reach of a behaviour network (m or s).
+MAX_REACH = 100.0
 #: Default ``scale`` of the actions (rad; Hz for the frequency).
 DEFAULT_SCALE = {"offset_sym": 0.3, "offset_asym": 0.3, "amplitude_sym": 0.3, "amplitude_asym": 0.3, "feather_sym": 0.5,
                  "feather_asym": 0.3, "feather_amplitude": 0.3, "abdomen_mean": 0.8, "frequency": 3.0}
@@ -97,7 +108,8 @@ class Controller3D:
 
     def __init__(self, layers, weights, base=None, scale: dict | None = None, every: int = 1,
                  omega_c_rad_s: float = 2.0 * math.pi * 10.0, provenance: dict | None = None, name: str = "",
-                 inputs: str = "ground", animal: str = "swallowtail", force_law: str = "exact") -> None:
+                 inputs: str = "ground", animal: str = "swallowtail", force_law: str = "exact",
+                 modes: dict | None = None) -> None:
         from lifelike_mj import checks
         from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
         from lifelike_mj.errors import UserError
@@ -147,6 +159,28 @@ class Controller3D:
             raise UserError(f"{where}: force_law is {', '.join(repr(v) for v in FORCE_LAWS_FLOWN)}, got {force_law!r}.")
         self.force_law = force_law
         self.provenance = dict(provenance or {})
+        if modes is not None and not isinstance(modes, dict):
+            raise UserError(f"{where}: modes is a mapping of behaviours to networks, got {modes!r}.")
+        #: The behaviour networks (module docstring): name -> ``{"weights": array, reach name: float}``.
+        self.modes = {}
+        for mode, spec in (modes or {}).items():
+            if mode not in MODES:
+                from lifelike_mj.errors import unknown_name
+
+                raise unknown_name(f"{where}: unknown behaviour", mode, tuple(MODES), "in modes")
+            reach = MODES[mode]
+            if not isinstance(spec, dict) or set(spec) - {"weights", reach}:
+                raise UserError(f"{where}: the {mode} behaviour is a mapping of weights and {reach}, got {spec!r}.")
+            try:
+                w = np.ascontiguousarray(spec.get("weights"), dtype=np.float64).reshape(-1)
+            except (TypeError, ValueError):
+                raise UserError(f"{where}: the {mode} behaviour's weights must be numbers.") from None
+            if len(w) != len(self.weights) or not np.all(np.abs(w) <= MAX_WEIGHT):
+                raise UserError(f"{where}: the {mode} behaviour needs {len(self.weights)} finite weights (its network "
+                                f"is the flight network's shape), each within +-{MAX_WEIGHT:g}.")
+            self.modes[mode] = {"weights": w, reach: checks.number(f"{where}: the {mode} behaviour's {reach}",
+                                                                    spec.get(reach, MODE_REACH[mode]), 0.0, MAX_REACH,
+                                                                    lo_open=True, unit="m" if mode == "land" else "s")}
 
     def to_dict(self) -> dict:
         from dataclasses import asdict
@@ -155,18 +189,50 @@ class Controller3D:
                 "weights": [float(v) for v in self.weights], "base": asdict(self.base),
                 "scale": dict(zip(ACTION_NAMES, (float(v) for v in self.scale))), "every": self.every,
                 "omega_c_rad_s": self.omega_c_rad_s, "inputs": self.inputs, "animal": self.animal,
-                "force_law": self.force_law, "provenance": self.provenance}
+                "force_law": self.force_law, "provenance": self.provenance,
+                **({"modes": {k: {"weights": [float(v) for v in m["weights"]], MODES[k]: m[MODES[k]]}
+                              for k, m in self.modes.items()}} if self.modes else {})}
 
     @property
     def air_inputs(self) -> bool:
         """Whether the network's speeds are through the air (the compiled loop's flag)."""
         return self.inputs == "air"
 
+    def replace(self, **changes) -> Controller3D:
+        """The same controller with the given constructor arguments changed (each checked as by the constructor)."""
+        kw = {"layers": self.layers, "weights": self.weights, "base": self.base,
+              "scale": dict(zip(ACTION_NAMES, self.scale)), "every": self.every, "omega_c_rad_s": self.omega_c_rad_s,
+              "provenance": self.provenance, "name": self.name, "inputs": self.inputs, "animal": self.animal,
+              "force_law": self.force_law, "modes": self.modes}
+        unknown = set(changes) - set(kw)
+        if unknown:
+            raise TypeError(f"replace: unknown argument {sorted(unknown)[0]!r}")
+        kw.update(changes)
+        return Controller3D(**kw)
+
     def with_weights(self, weights, inputs: str | None = None) -> Controller3D:
-        """The same controller with other weights (and, given ``inputs``, other inputs)."""
-        return Controller3D(self.layers, weights, self.base, dict(zip(ACTION_NAMES, self.scale)), self.every,
-                            self.omega_c_rad_s, self.provenance, self.name, inputs or self.inputs, self.animal,
-                            self.force_law)
+        """The same controller with other weights of its flight network (and, given ``inputs``, other inputs)."""
+        return self.replace(weights=weights, inputs=inputs or self.inputs)
+
+    def with_mode(self, mode: str, weights, reach: float | None = None) -> Controller3D:
+        """The same controller with the behaviour network ``mode`` (:data:`MODES`) set to ``weights`` and its reach
+        (m or s; default: the one it has, else :data:`MODE_REACH`)."""
+        old = self.modes.get(mode, {})
+        reach = reach if reach is not None else old.get(MODES.get(mode, ""), MODE_REACH.get(mode))
+        return self.replace(modes={**self.modes, mode: {"weights": weights, MODES.get(mode, "reach"): reach}})
+
+    def mode_weights(self, mode: str) -> np.ndarray:
+        """The weights that fly behaviour ``mode`` (:data:`MODES`): its own network's, else the flight network's."""
+        return self.modes[mode]["weights"] if mode in self.modes else self.weights
+
+    def all_weights(self) -> np.ndarray:
+        """The weights the compiled loop takes: the flight network's, then each behaviour's in the order of
+        :data:`MODES` (a behaviour without a network of its own repeats the flight network's)."""
+        return np.concatenate([self.weights, *(self.mode_weights(m) for m in MODES)])
+
+    def mode_reach(self) -> np.ndarray:
+        """Each behaviour's reach in the order of :data:`MODES` (m, s): 0 where it has no network of its own."""
+        return np.array([self.modes[m][r] if m in self.modes else 0.0 for m, r in MODES.items()])
 
 
 def json_schema() -> dict:
@@ -197,6 +263,14 @@ def json_schema() -> dict:
         "force_law": {"enum": list(FORCE_LAWS_FLOWN), "description": "the wing-force law it was evolved "
                       "with and flies with (module lifelike_mj.butterfly.flight3d.model); missing: exact"},
         "provenance": {"type": "object"},
+        "modes": {"type": "object", "additionalProperties": False, "description": "behaviour networks of the flight "
+                  "network's shape: land flies a landing's last from_m (m), take_off the first for_s (s) of a take-off",
+                  "properties": {m: {"type": "object", "additionalProperties": False, "required": ["weights"],
+                                     "properties": {"weights": {"type": "array", "maxItems": max_weights,
+                                                                "items": number("", -MAX_WEIGHT, MAX_WEIGHT)},
+                                                    r: number("m" if m == "land" else "s", maximum=MAX_REACH,
+                                                              exclusive_minimum=0.0)}}
+                                 for m, r in MODES.items()}},
     }
     return document_schema(FORMAT, "lifelike-mj 3D butterfly controller", props, ["layers", "weights"],
                            "A network from the 3D butterfly's attitude and motion to changes of its wing and abdomen "
@@ -217,7 +291,7 @@ def controller_from_dict(data: object, name: str = "") -> Controller3D:
         base = KinematicsCommand(**{k: float(v) for k, v in base.items()})
     return Controller3D(d["layers"], d["weights"], base, d.get("scale"), d.get("every", 1),
                         d.get("omega_c_rad_s", 2.0 * math.pi * 10.0), d.get("provenance"), name, d.get("inputs", "ground"),
-                        d.get("animal", "swallowtail"), d.get("force_law", "exact"))
+                        d.get("animal", "swallowtail"), d.get("force_law", "exact"), d.get("modes"))
 
 
 def load_controller(name_or_path) -> Controller3D:

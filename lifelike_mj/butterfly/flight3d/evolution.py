@@ -26,14 +26,14 @@ from lifelike_mj.butterfly.flight3d import controllers as c3
 from lifelike_mj.butterfly.flight3d.flight import DT_S
 from lifelike_mj.butterfly.flight3d.loop import TUMBLE_RAD, Batch
 from lifelike_mj.butterfly.flight3d.tasks import (
-    CLAP_S,
     DRYDEN_VERTICAL_RATIO,
     N_STYLE,
-    R_CLAP_UNTIL,
     R_FIT,
     R_LANDED_AT,
+    R_NEAR_SPEED,
     R_STYLE,
     R_TOUCH_SPEED,
+    R_TUMBLED,
     R_WP,
     TOUCHDOWN_M_S,
     Task3D,
@@ -41,6 +41,7 @@ from lifelike_mj.butterfly.flight3d.tasks import (
     land,
     level,
     new_record,
+    start_take_off,
     turn,
 )
 from lifelike_mj.butterfly.params import ButterflyParams
@@ -131,19 +132,28 @@ def start_blossom(animal: str) -> tuple[float, float, float]:
     return tuple(float(v) for v in blossom_under((0.0, 0.0, -standing_height_m(animal))))
 
 
-#: How a landing is scored (:func:`landing_score`): the closest approach's scale (m) before touchdown, and the scale of
-#: the touchdown speed beyond :data:`~lifelike_mj.butterfly.flight3d.tasks.TOUCHDOWN_M_S` (m/s).
-LANDING_SCALES_M = (0.1, 0.25)
+#: How a landing is scored (:func:`landing_score`): the scale (m) of the closest approach short of a touchdown, and the
+#: scale (m/s) of the speed beyond :data:`~lifelike_mj.butterfly.flight3d.tasks.TOUCHDOWN_M_S` at the touchdown or,
+#: short of one, at the closest approach.
+LANDING_SCALES_M = (0.1, 0.5)
 
 
 def landing_score(rec: np.ndarray) -> float:
-    """A landing flight's score in ``[0, 1]`` from its run record: a touchdown scores at least 0.5, all of 1 within the
-    touchdown speed bound (``TOUCHDOWN_M_S``), falling off beyond it; a flight that does not touch down scores at most
-    0.5, by its closest approach to the point where it would stand (:data:`LANDING_SCALES_M`)."""
+    """A landing flight's score in ``[0, 1]`` from its run record. A touchdown scores at least 0.5, all of 1 within the
+    touchdown speed bound ``TOUCHDOWN_M_S`` and less the faster beyond it (a crash at 2 m/s: 0.53); one that then
+    tips over on the flower (a tumble while perched) only 0.5. A flight that
+    does not touch down scores at most 0.5: by its closest approach to the point where it would stand, and half of
+    that by its speed there (none after a tumble, which stops it dead), so that closing slowly pays before a
+    touchdown does (:data:`LANDING_SCALES_M`)."""
     near, fast = LANDING_SCALES_M
+
+    def slow(v: float) -> float:
+        return float(np.exp(-max(0.0, v - TOUCHDOWN_M_S) / fast)) if np.isfinite(v) else 0.0
+
     if rec[R_LANDED_AT] >= 0.0:
-        return 0.5 + 0.5 * float(np.exp(-max(0.0, rec[R_TOUCH_SPEED] - TOUCHDOWN_M_S) / fast))
-    return 0.5 * float(np.exp(-rec[R_WP] / near))
+        return 0.5 + (0.0 if rec[R_TUMBLED] >= 0 else 0.5 * slow(rec[R_TOUCH_SPEED]))
+    near_speed = np.inf if rec[R_TUMBLED] >= 0 else rec[R_NEAR_SPEED]
+    return 0.5 * float(np.exp(-rec[R_WP] / near)) * (0.5 + 0.5 * slow(near_speed))
 
 
 @dataclass
@@ -153,7 +163,9 @@ class FlightProblem3D:
     ``take_off`` every flight starts standing on a flower at the start (:func:`start_blossom`), its wings at the top
     of the stroke, and takes off clapping, as a garden's perched butterflies do
     (:meth:`~lifelike_mj.butterfly.flight3d.flight.Flight3D.take_off`); the flowers of the landing tasks are in its
-    world too, touched by its legs (:meth:`flowers`)."""
+    world too, touched by its legs (:meth:`flowers`). With ``mode`` (a behaviour,
+    :data:`~lifelike_mj.butterfly.flight3d.controllers.MODES`) the genes are that behaviour network's weights (less the
+    prior: the template's own for it, else its flight network's), the template's other networks flying as they are."""
 
     tasks: tuple[Task3D, ...]
     template: c3.Controller3D
@@ -167,17 +179,21 @@ class FlightProblem3D:
     prior: tuple[float, ...] = ()
     natural: bool = False
     take_off: bool = False
+    mode: str = ""
 
     def __post_init__(self) -> None:
         if not self.tasks:
             raise UserError("an evolution needs at least one task.")
+        if self.mode and self.mode not in self.template.modes:
+            raise UserError(f"the {self.mode} behaviour to evolve is not in the controller (give it with_mode first).")
         checks.number("duration_s", self.duration_s, 0.0, 3600.0, lo_open=True, unit="s")
         checks.number("dt_s", self.dt_s, 0.0, 0.01, lo_open=True, unit="s")
         checks.number("gene_bound", self.gene_bound, 0.0, 1e6, lo_open=True)
         checks.work(f"a training flight of {self.duration_s:g} s at {self.dt_s:g} s", checks.steps_of(self.duration_s,
                     self.dt_s), checks.MAX_BODY_STEPS, "time steps")
         if not self.prior:
-            self.prior = tuple(float(v) for v in self.template.weights)
+            self.prior = tuple(float(v) for v in (self.template.mode_weights(self.mode) if self.mode
+                                                  else self.template.weights))
         if len(self.prior) != self.dim:
             raise UserError(f"the prior has {len(self.prior)} weights, the network {self.dim}.")
         self._model = None
@@ -223,6 +239,9 @@ class FlightProblem3D:
                 # the butterfly and the naturalness asked, named where they are new (earlier fingerprints hold)
                 **({"animal": self.template.animal} if self.template.animal != "swallowtail" else {}),
                 **({"take_off": True} if self.take_off else {}),
+                **({"mode": self.mode, "reach": self.template.modes[self.mode][c3.MODES[self.mode]],
+                    "all_weights_sha256": hashlib.sha256(self.template.all_weights().tobytes()).hexdigest()}
+                   if self.mode else {}),
                 **({"natural": {k: list(v) if isinstance(v, tuple) else v for k, v in NATURAL.items()}}
                    if self.natural else {})}
 
@@ -230,8 +249,22 @@ class FlightProblem3D:
         return hashlib.sha256(json.dumps(self.describe(), sort_keys=True).encode()).hexdigest()
 
     def weights(self, x: np.ndarray) -> np.ndarray:
-        """The network weights of the genes ``x``."""
+        """The network weights of the genes ``x`` (of the behaviour ``mode``, with one)."""
         return np.asarray(self.prior) + np.asarray(x, dtype=np.float64)
+
+    def controller(self, x: np.ndarray) -> c3.Controller3D:
+        """The controller of the genes ``x``: the template with the evolved network's weights."""
+        w = self.weights(x)
+        return self.template.with_mode(self.mode, w) if self.mode else self.template.with_weights(w)
+
+    def all_weights(self, W: np.ndarray) -> np.ndarray:
+        """The compiled loop's weights (the template's ``all_weights`` layout), one row per row of network weights
+        ``W`` (of the behaviour ``mode``, with one)."""
+        k = 1 + list(c3.MODES).index(self.mode) if self.mode else 0
+        n = self.dim
+        rows = np.tile(self.template.all_weights(), (len(W), 1))
+        rows[:, k * n : (k + 1) * n] = W
+        return rows
 
     def model(self):
         if self._model is None:
@@ -267,8 +300,8 @@ class FlightProblem3D:
                                  n_strips=self.n_strips, n_chord=self.n_chord, animal=ctl.animal) for _ in range(n)]
         records = new_record(n, max_rows)
         if self.take_off:
-            records[:, R_CLAP_UNTIL] = CLAP_S
-        batch = Batch(m, datas, tasks, ctl, weights=np.repeat(W, k, axis=0), dt_s=self.dt_s,
+            start_take_off(records, 0.0)
+        batch = Batch(m, datas, tasks, ctl, weights=np.repeat(self.all_weights(W), k, axis=0), dt_s=self.dt_s,
                       records=records, tumble_rad=TUMBLE_RAD)
         batch.advance(int(round(self.duration_s / self.dt_s)))
         return batch.records.reshape(len(W), k, -1)
@@ -327,15 +360,20 @@ TASK_SETS = {
                        course(1).with_weather((1.0, 0.0, 0.0), gust_m_s=0.5, gust_vertical_m_s=0.5, seed=1),
                        course(3).with_weather((-1.5, 0.0, 0.0), seed=3),
                        *_landings()),
+    # a landing behaviour's (evolve3d --mode land; with --take-off, a take-off's): six flowers all round the start,
+    # three near (0.9-1.4 m) and three far (2.7-3.5 m, reached at cruising speed), from 0.15 m below to 0.2 m above it
+    "landings": lambda: _landings(((1.2, 0.3, -0.15), (0.7, -0.6, 0.05), (-0.8, 0.6, 0.0), (2.5, 1.0, -0.1),
+                                   (-1.5, -2.5, 0.1), (3.5, -0.5, 0.2))),
 }
 
 
-def _landings() -> tuple[Task3D, ...]:
-    """The ``garden`` set's landings: three flowers ahead, left and right, below and above the start, 0.9-1.4 m away."""
+def _landings(points=((1.2, 0.3, -0.15), (0.7, -0.6, 0.05), (0.4, 1.0, -0.3))) -> tuple[Task3D, ...]:
+    """Monarch landings on flowers whose landing surfaces are at ``points`` (m); by default the ``garden`` set's three,
+    ahead, left and right, below and above the start, 0.9-1.4 m away."""
     from lifelike_mj.butterfly.flight3d.model import standing_height_m
 
     h = standing_height_m("monarch")
-    return tuple(land(p, h) for p in ((1.2, 0.3, -0.15), (0.7, -0.6, 0.05), (0.4, 1.0, -0.3)))
+    return tuple(land(p, h) for p in points)
 
 
 def pd_prior(layers, animal: str = "swallowtail") -> np.ndarray:
@@ -369,7 +407,8 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
            overwrite: bool = False, task_set: str = "custom", on_generation=None, start: c3.Controller3D | None = None,
            inputs: str | None = None, executor: str = "serial", workers: int | None = None,
            ray_address: str | None = None, dt_s: float = DT_S, animal: str | None = None, natural: bool = False,
-           force_law: str | None = None, take_off: bool = False):
+           force_law: str | None = None, take_off: bool = False, mode: str | None = None,
+           reach: float | None = None):
     """Evolve a 3D controller on ``tasks`` (default: the ``steer`` set) with ``optimizer`` and write it to
     ``out`` with its provenance (the problem, the optimiser, the budget, the time it took, the fitness
     history). Returns ``(result, controller)``; nothing is overwritten unasked (the checks and locks of the
@@ -387,7 +426,10 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     (:func:`~lifelike_mj.butterfly.flight3d.controllers.default_base`) and prior (:func:`pd_prior`). ``natural``:
     the fitness also asks for :data:`NATURAL` (module docstring). ``force_law``: the wing-force law of the training
     flights, recorded in the controller (default the start's, else ``"exact"``). ``take_off``: every training flight
-    starts perched on a flower and takes off (:class:`FlightProblem3D`)."""
+    starts perched on a flower and takes off (:class:`FlightProblem3D`). ``mode``: evolve the start's behaviour network
+    of that name (:data:`~lifelike_mj.butterfly.flight3d.controllers.MODES`; it starts from the start's own, else
+    from its flight network) with the reach ``reach`` (m or s; default: the start's, else
+    :data:`~lifelike_mj.butterfly.flight3d.controllers.MODE_REACH`); its other networks fly as they are."""
     from lifelike_mj import provenance as _prov
     from lifelike_mj.evolve import make_evaluator, optimize
     from lifelike_mj.evolve.checkpoint import guarded_run_files
@@ -397,13 +439,18 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     if tasks is None:
         task_set = "steer"
         tasks = TASK_SETS["steer"]()
+    if mode is not None and (start is None or mode not in c3.MODES):
+        raise UserError(f"a behaviour to evolve ({' or '.join(c3.MODES)}) needs a controller to start from, whose "
+                        f"flight network flies the rest, got mode {mode!r}" + (" and no start." if start is None
+                                                                              else "."))
     if start is not None:
         template = start
         layers = [int(v) for v in start.layers]
         if inputs is not None or animal is not None or force_law is not None:
-            template = c3.Controller3D(start.layers, start.weights, start.base, dict(zip(c3.ACTION_NAMES, start.scale)),
-                                       start.every, start.omega_c_rad_s, start.provenance, start.name,
-                                       inputs or start.inputs, animal or start.animal, force_law or start.force_law)
+            template = start.replace(inputs=inputs or start.inputs, animal=animal or start.animal,
+                                     force_law=force_law or start.force_law)
+        if mode is not None:
+            template = template.with_mode(mode, template.mode_weights(mode), reach)
     else:
         layers = [int(v) for v in layers]
         animal = animal or "swallowtail"
@@ -411,7 +458,8 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
                                    else [], c3.default_base(animal), inputs=inputs or "ground", animal=animal,
                                    force_law=force_law or "exact")
     problem = FlightProblem3D(tuple(tasks), template, duration_s=duration_s, gene_bound=gene_bound, dt_s=dt_s,
-                              natural=bool(natural), force_law=template.force_law, take_off=bool(take_off))
+                              natural=bool(natural), force_law=template.force_law, take_off=bool(take_off),
+                              mode=mode or "")
     out = Path(out)
     with guarded_run_files(out, checkpoint, resume=resume, overwrite=overwrite) as ckpt:
         with make_evaluator(problem, executor=executor, workers=workers, ray_address=ray_address) as ev:
@@ -431,7 +479,7 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
                      "started_from": None if start is None else {
                          "name": start.name, **{k: v for k, v in start.provenance.items() if k != "fitness_history"}},
                      "fitness_history": [dict(h) for h in res.history]})
-        ctrl = template.with_weights(problem.weights(res.best_x))
+        ctrl = problem.controller(res.best_x)
         ctrl.name = ""
         ctrl.provenance = prov
         ctrl.name = out.stem

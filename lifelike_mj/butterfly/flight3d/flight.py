@@ -397,7 +397,7 @@ class Flight3D(StepCounter):
         rec = new_record(1, len(task.rows))
         keep = [i for i in range(t3.R_WP) if i not in (t3.R_PASSED, t3.R_LANDED_AT, t3.R_TOUCH_SPEED)]
         rec[0, keep] = self._rec[keep]
-        rec[0, t3.R_CLAP_UNTIL] = self.time + clap
+        t3.start_take_off(rec[0], self.time, clap)
         self._fly_task(task, rec)
         take_off_kinematics(self._data.userdata, self._batch.base)
 

@@ -115,8 +115,8 @@ class Garden(StepCounter):
     ``flutter``, ``gust_m_s``, ``gust_vertical_m_s``, ``wind_to_m_s`` (or ``wind_from_m_s``; ``wind_m_s``, the
     older spelling of ``wind_to_m_s``): each butterfly's flutter and the weather
     (:class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`); ``speed_m_s``: the cruise speed; ``dt_s`` the time step.
-    ``land``: the butterflies land on the flowers (module docstring); default: a controller evolved to land (the
-    ``garden`` task set, :mod:`~lifelike_mj.butterfly.flight3d.evolution`) lands, the others pass the flowers by.
+    ``land``: the butterflies land on the flowers (module docstring); default: a controller that lands (:func:`lands`:
+    one with a ``land`` network, or evolved on the ``garden`` task set) lands, the others pass the flowers by.
     """
 
     @checks.known_keywords
@@ -238,7 +238,7 @@ class Garden(StepCounter):
                                "touchdown_speed_m_s": None, "take_off_s": None})
             else:
                 visits[-1]["take_off_s"] = t
-                rec[t3.R_CLAP_UNTIL] = t + t3.CLAP_S
+                t3.start_take_off(rec, t)
                 take_off_kinematics(self._datas[i].userdata, self._batch.base)
             self._at[i] += 1
             self._aim_since[i] = t
@@ -278,7 +278,10 @@ class Garden(StepCounter):
 
 
 def lands(controller: Controller3D) -> bool:
-    """Whether ``controller`` was evolved to land (on the ``garden`` task set, or started from one that was)."""
+    """Whether ``controller`` lands: it has a ``land`` behaviour network, or was evolved on the ``garden`` task set (or
+    started from one that was)."""
+    if "land" in controller.modes:
+        return True
     prov = controller.provenance or {}
     while isinstance(prov, dict) and prov:
         if prov.get("task_set", (prov.get("parameters") or {}).get("task_set")) == "garden":

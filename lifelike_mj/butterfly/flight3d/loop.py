@@ -27,9 +27,11 @@ from lifelike_mj.butterfly.flight3d.tasks import (
     R_FLUTTER,
     R_GUST,
     R_LANDED_AT,
+    R_NEAR_SPEED,
     R_PASSED,
     R_STEPS,
     R_STYLE,
+    R_TOOK_OFF_AT,
     R_TOUCH_SPEED,
     R_TUMBLED,
     R_WP,
@@ -133,6 +135,18 @@ def network(layers, weights, x, out, scratch):
             a[j] = b[j]
     for j in range(layers[-1]):
         out[j] = a[j]
+
+
+@njit(cache=True)
+def behaviour(task, qpos, t, rec, reach):
+    """Which of a controller's networks flies now (:data:`~lifelike_mj.butterfly.flight3d.controllers.MODES`): 1
+    (``land``) within ``reach[0]`` (m) of a landing's flower axis, else 2 (``take_off``) within ``reach[1]`` (s) of the
+    last take-off, else 0 (the flight network). A reach of 0 never picks its behaviour."""
+    if int(task[T_KIND]) == TASK_LAND and to_flower(task, qpos)[2] < reach[0]:
+        return 1
+    if t < rec[R_TOOK_OFF_AT] + reach[1]:
+        return 2
+    return 0
 
 
 @njit(cache=True)
@@ -324,8 +338,9 @@ def take_off_kinematics(ud: np.ndarray, base: np.ndarray) -> None:
 def _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, path, path_every, n_path, tumble_rad, base):
     """The first half of a step: the gusts advance, the air is set, the reference is taken and the observation made
     (into ``obs``), the path sampled. Returns ``(tumbled, n_path)``: a roll or pitch beyond ``tumble_rad`` ends the
-    flight here (recorded in ``rec``). A landing that touches down now becomes a perch (recorded in ``rec``: the time
-    and the speed), its kinematics :func:`perch_command` of ``base``."""
+    flight here (recorded in ``rec``). A landing keeps its speed at its closest approach (``R_NEAR_SPEED``); one that
+    touches down now becomes a perch (recorded in ``rec``: the time and the speed), its kinematics
+    :func:`perch_command` of ``base``."""
     step = int(rec[R_STEPS])
     seed = int(task[T_SEED])
     if task[T_GUST] > 0.0 or task[T_GUST_W] > 0.0:
@@ -334,7 +349,10 @@ def _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, path, 
             rec[R_GUST + i] = ou_step(rec[R_GUST + i], sigma, task[T_GUST_TAU], dt, normal(seed, step, i))
     for i in range(3):
         ud[mj3d.U_AIR + i] = task[T_WIND + i] + rec[R_GUST + i]
+    closest = rec[R_WP]
     heading, altitude, speed = reference(task, time[0], qpos[0:3], rec)
+    if int(task[T_KIND]) == TASK_LAND and rec[R_WP] < closest:
+        rec[R_NEAR_SPEED] = math.sqrt(qvel[0] * qvel[0] + qvel[1] * qvel[1] + qvel[2] * qvel[2])
     if int(task[T_KIND]) == TASK_LAND and touched_down(task, qpos, ud[mj3d.U_FEET : mj3d.U_FEET + 12]):
         task[T_KIND] = TASK_PERCH
         rec[R_LANDED_AT] = time[0]
@@ -438,14 +456,16 @@ def style(ud, qpos, qvel, obs, p, dt, rec):
 
 
 @njit(cache=True)
-def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, base, scale, task, rec, path, path_every,
-              tumble_rad, air_inputs):
+def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, reach, base, scale, task, rec, path,
+              path_every, tumble_rad, air_inputs):
     """Fly one butterfly ``n_steps`` steps from its current state: every ``every`` steps the network turns
     the observation into a new command; after each ``mj_step`` the kinematics advance exactly in the
     userdata. ``rec``: the run record (``R_*``); ``path``: rows of (t, x, y, z, roll, pitch, yaw) every
     ``path_every`` steps (none when 0). A roll or pitch beyond ``tumble_rad`` (a tumble) or a runaway
-    ends the flight (recorded in ``rec``). Without weights the command in the userdata stays. ``air_inputs``:
-    the network's speeds are through the air (the controller's ``inputs == "air"``), else over the ground."""
+    ends the flight (recorded in ``rec``). ``weights``: the flight network's, then the behaviours' (the controller's
+    ``all_weights``), each network picked by :func:`behaviour` with ``reach``. Without weights the command in the
+    userdata stays. ``air_inputs``: the network's speeds are through the air (the controller's ``inputs == "air"``),
+    else over the ground."""
     ud = _f64(_ptr_at(dptr + off[_O_UD]), mj3d.N_USERDATA)
     qpos = _f64(_ptr_at(dptr + off[_O_QPOS]), nq)
     qvel = _f64(_ptr_at(dptr + off[_O_QVEL]), nv)
@@ -456,6 +476,9 @@ def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, base
     for k in range(len(layers)):
         width = max(width, layers[k])
     scratch = np.empty(2 * width)
+    n_w = 0
+    for k in range(1, len(layers)):
+        n_w += (layers[k - 1] + 1) * layers[k]
     p = np.empty(N_PARAMS)
     dp = np.empty(N_PARAMS)
     ddp = np.empty(N_PARAMS)
@@ -469,7 +492,8 @@ def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, base
         if tumbled:
             return
         if int(rec[R_STEPS]) % every == 0 and len(weights) > 0 and int(task[T_KIND]) != TASK_PERCH:
-            network(layers, weights, obs, u, scratch)
+            k = behaviour(task, qpos, time[0], rec, reach)
+            network(layers, weights[k * n_w : (k + 1) * n_w], obs, u, scratch)
             _act(u, dt, every, base, scale, task, rec, ud, time[0])
         if not _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
             return
@@ -524,14 +548,14 @@ def to_decisions(mptr, dptrs, off, nq, nv, n_max, dt, every, actions, act, base,
 
 
 @njit(cache=True, parallel=True)
-def fly_batch(mptr, dptrs, off, nq, nv, n_steps, dt, every, layers, weights, base, scale, tasks, recs, tumble_rad,
+def fly_batch(mptr, dptrs, off, nq, nv, n_steps, dt, every, layers, weights, reach, base, scale, tasks, recs, tumble_rad,
               air_inputs):
     """:func:`fly_steps` for many butterflies at once (one ``mjData`` each, ``weights[i]`` and
     ``tasks[i]`` per copy), threads over the copies; no paths are recorded."""
     none = np.empty((0, 7))
     for i in prange(len(dptrs)):
-        fly_steps(mptr, dptrs[i], off, nq, nv, n_steps, dt, every, layers, weights[i], base, scale, tasks[i], recs[i],
-                  none, 0, tumble_rad, air_inputs)
+        fly_steps(mptr, dptrs[i], off, nq, nv, n_steps, dt, every, layers, weights[i], reach, base, scale, tasks[i],
+                  recs[i], none, 0, tumble_rad, air_inputs)
 
 
 
@@ -544,8 +568,8 @@ class Batch:
 
     ``controller``: a :class:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D`, or ``None`` for flights
     that keep the command in their userdata (then ``base`` is that command's array); ``weights``: one row per
-    butterfly (default: the controller's own, for each); ``tumble_rad``: a roll or pitch beyond which a flight
-    ends (``inf``: never)."""
+    butterfly, laid out as the controller's ``all_weights`` (default: the controller's own, for each);
+    ``tumble_rad``: a roll or pitch beyond which a flight ends (``inf``: never)."""
 
     def __init__(self, model, datas, tasks: np.ndarray, controller=None, *, weights=None, dt_s: float,
                  records: np.ndarray, tumble_rad: float = math.inf, base: np.ndarray | None = None) -> None:
@@ -559,14 +583,16 @@ class Batch:
         self.observations = np.zeros((self.n, N_OBS))
         if controller is None:
             self.layers, self.scale, self.every, self.air_inputs = np.zeros(1, dtype=np.int64), np.zeros(N_ACT), 1, False
-            self.weights = np.zeros((self.n, 0))
+            self.weights, self.reach = np.zeros((self.n, 0)), np.zeros(2)
             self.base = np.asarray(base, dtype=np.float64)
         else:
             self.layers, self.scale = controller.layers, controller.scale
             self.every, self.air_inputs = controller.every, controller.air_inputs
             self.base = controller.base.as_array() if base is None else np.asarray(base, dtype=np.float64)
-            w = controller.weights if weights is None else weights
-            self.weights = np.ascontiguousarray(np.broadcast_to(w, (self.n, len(controller.weights))), dtype=np.float64)
+            w = controller.all_weights() if weights is None else weights
+            self.weights = np.ascontiguousarray(np.broadcast_to(w, (self.n, len(controller.all_weights()))),
+                                                dtype=np.float64)
+            self.reach = controller.mode_reach()
 
     def advance(self, n_steps: int, path: np.ndarray | None = None, path_every: int = 0) -> None:
         """Fly every butterfly ``n_steps`` steps (threads over the butterflies), with the model's compiled air
@@ -579,13 +605,13 @@ class Batch:
         with passive_callback(mj3d.COMPILED_PASSIVE), watching():
             if self.n == 1:
                 fly_steps(m._address, int(self.ptrs[0]), mjabi.offsets_tuple(), m.nq, m.nv, n_steps, self.dt,
-                          self.every, self.layers, self.weights[0], self.base, self.scale, self.tasks[0],
+                          self.every, self.layers, self.weights[0], self.reach, self.base, self.scale, self.tasks[0],
                           self.records[0], _NO_PATH if path is None else path, path_every, self.tumble_rad,
                           self.air_inputs)
             else:
                 fly_batch(m._address, self.ptrs, mjabi.offsets_tuple(), m.nq, m.nv, n_steps, self.dt, self.every,
-                          self.layers, self.weights, self.base, self.scale, self.tasks, self.records, self.tumble_rad,
-                          self.air_inputs)
+                          self.layers, self.weights, self.reach, self.base, self.scale, self.tasks, self.records,
+                          self.tumble_rad, self.air_inputs)
 
     def decide(self, actions: np.ndarray | None, n_max: int, act: np.ndarray | None = None) -> np.ndarray:
         """Fly every butterfly to its next decision (:func:`to_decision`) with ``actions`` (one row of ``N_ACT``

@@ -47,10 +47,14 @@ STYLE_NAMES = ("roll", "pitch", "amplitude_difference", "offset_difference", "st
 STYLE_FROM_S = 1.0
 N_STYLE = len(STYLE_NAMES)
 #: A landing's bookkeeping: when it touched down (s; -1: not yet), at what speed (m/s, over the ground), the heading
-#: aimed at last (rad: kept when right above the flower), and until when the wings clap (s; a take-off's first beats).
+#: aimed at last (rad: kept when right above the flower), until when the wings clap (s; a take-off's first beats) and
+#: when the last take-off began (s; ``-inf``: none, the flight began in the air).
 R_LANDED_AT = R_STYLE + N_STYLE
-R_TOUCH_SPEED, R_AIM, R_CLAP_UNTIL = R_LANDED_AT + 1, R_LANDED_AT + 2, R_LANDED_AT + 3
-R_WP = R_LANDED_AT + 4
+R_TOUCH_SPEED, R_AIM, R_CLAP_UNTIL, R_TOOK_OFF_AT = R_LANDED_AT + 1, R_LANDED_AT + 2, R_LANDED_AT + 3, R_LANDED_AT + 4
+R_WP = R_LANDED_AT + 5
+#: A landing keeps its closest approach to the point where it would stand (m) in ``R_WP`` and its speed over the ground
+#: then (m/s) in ``R_NEAR_SPEED`` (a landing task has two rows, so both are there).
+R_NEAR_SPEED = R_WP + 1
 
 #: How a landing is flown (:func:`land`; the loop's reference): the butterfly aims at the flower from at most
 #: ``LAND_ABOVE_M`` above the point where it will stand, coming down ``LAND_GLIDE`` m per m it closes; within
@@ -263,5 +267,14 @@ def new_record(n: int, max_rows: int) -> np.ndarray:
     rec[:, R_DIVERGED] = -1.0
     rec[:, R_TUMBLED] = -1.0
     rec[:, R_LANDED_AT] = -1.0
+    rec[:, R_TOOK_OFF_AT] = -np.inf
     rec[:, R_WP :] = np.inf
     return rec
+
+
+def start_take_off(rec: np.ndarray, t_s: float, clap_s: float = CLAP_S) -> None:
+    """Mark in the run record ``rec`` (one flight's, or ``(n, ...)``) that a take-off begins at ``t_s`` (s): the wings
+    clap until ``clap_s`` s later, and a controller's take-off network (if it has one) flies from now on for its
+    time."""
+    rec[..., R_CLAP_UNTIL] = t_s + clap_s
+    rec[..., R_TOOK_OFF_AT] = t_s

@@ -141,16 +141,26 @@ def test_a_take_off_claps_and_leaves_the_flower():
     assert f.data.ncon == 0
 
 
-def test_a_landing_is_scored_by_its_touchdown_speed_or_its_closest_approach():
+def test_a_landing_is_scored_by_its_touchdown_speed_or_how_near_and_slow_it_came():
+    """A touchdown scores at least 0.5, all of 1 within the bound (0.5 if it then tips over); short of one, at most
+    0.5: by the closest approach, half of it by the speed there (none after a tumble)."""
     rec = t3.new_record(1, 2)[0]
-    rec[t3.R_WP] = 0.0
-    assert landing_score(rec) == pytest.approx(0.5)
+    assert landing_score(rec) == 0.0  # never came near
+    rec[t3.R_WP], rec[t3.R_NEAR_SPEED] = 0.05, 0.3
+    hover = landing_score(rec)
+    assert hover == pytest.approx(0.5 * math.exp(-0.5))
+    rec[t3.R_NEAR_SPEED] = 0.5 + 0.5
+    assert landing_score(rec) == pytest.approx(hover * (0.5 + 0.5 * math.exp(-1.0)))
+    rec[t3.R_TUMBLED] = 100.0  # stopped dead by a tumble: no credit for the speed
+    assert landing_score(rec) == pytest.approx(hover / 2)
     rec[t3.R_WP] = 0.2
-    assert landing_score(rec) < 0.1
+    assert landing_score(rec) < hover / 2
     rec[t3.R_LANDED_AT], rec[t3.R_TOUCH_SPEED] = 1.0, t3.TOUCHDOWN_M_S
+    assert landing_score(rec) == 0.5  # tipped over on the flower (the tumble above)
+    rec[t3.R_TUMBLED] = -1.0
     assert landing_score(rec) == 1.0
-    rec[t3.R_TOUCH_SPEED] = t3.TOUCHDOWN_M_S + 0.5
-    assert 0.5 < landing_score(rec) < 0.6
+    rec[t3.R_TOUCH_SPEED] = 2.0
+    assert landing_score(rec) == pytest.approx(0.5 + 0.5 * math.exp(-3.0))
 
 
 def test_a_landing_task_refuses_bad_input():
