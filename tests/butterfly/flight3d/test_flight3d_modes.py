@@ -18,8 +18,13 @@ from lifelike_mj.errors import UserError
 FLOWERS = [(0.0, 0.0, -0.2), (0.9, 0.3, -0.25)]
 
 
+def _flight_only():
+    """The shipped monarch's flight network alone (no behaviour networks)."""
+    return c3.load_controller("monarch").replace(modes={})
+
+
 def _monarch(**modes):
-    ctl = c3.load_controller("monarch")
+    ctl = _flight_only()
     for name, (weights, reach) in modes.items():
         ctl = ctl.with_mode(name, weights, reach)
     return ctl
@@ -46,7 +51,7 @@ def _path(ctl, take_off=False, seconds=1.5):
 
 
 def test_a_controller_without_behaviours_flies_its_flight_network_everywhere():
-    ctl = c3.load_controller("monarch")
+    ctl = _flight_only()
     assert ctl.modes == {} and "modes" not in ctl.to_dict()
     assert np.array_equal(ctl.all_weights(), np.tile(ctl.weights, 1 + len(c3.MODES)))
     assert np.array_equal(ctl.mode_reach(), np.zeros(len(c3.MODES)))
@@ -72,8 +77,8 @@ def test_which_network_flies_is_picked_by_the_reach():
 def test_a_landing_network_takes_over_only_within_its_reach():
     """A land network that differs from the flight network leaves the path untouched until the butterfly comes within
     its reach of the flower, and changes it after; one that repeats the flight network changes nothing at all."""
-    base = _path(c3.load_controller("monarch"))
-    same = _path(_monarch(land=(c3.load_controller("monarch").weights, 0.3)))
+    base = _path(_flight_only())
+    same = _path(_monarch(land=(_flight_only().weights, 0.3)))
     assert np.array_equal(base, same)
     other = _path(_monarch(land=(np.zeros(c3.n_weights([10, 9])), 0.3)))
     n = min(len(base), len(other))
@@ -87,7 +92,7 @@ def test_a_landing_network_takes_over_only_within_its_reach():
 def test_a_take_off_network_flies_only_the_first_of_a_take_off():
     """A take-off network flies from the take-off on, for its reach: the path differs from the take-off on; a flight
     that begins in the air never uses it."""
-    ctl = c3.load_controller("monarch")
+    ctl = _flight_only()
     zero = np.zeros(c3.n_weights([10, 9]))
     base, other = _path(ctl, take_off=True, seconds=0.5), _path(_monarch(take_off=(zero, 1.0)), take_off=True,
                                                                seconds=0.5)
@@ -115,7 +120,7 @@ def test_behaviours_go_through_the_controller_file_and_bad_ones_are_refused():
 def test_a_behaviour_evolution_changes_only_that_behaviours_network():
     """The genes of a land evolution land in the land network's part of the loop's weights; the controller it makes
     keeps the flight network; a behaviour the template lacks is refused."""
-    ctl = _monarch(land=(c3.load_controller("monarch").weights, 0.6))
+    ctl = _monarch(land=(_flight_only().weights, 0.6))
     prob = FlightProblem3D(TASK_SETS["landings"](), ctl, duration_s=0.1, mode="land")
     n = prob.dim
     x = np.full(n, 0.01)
@@ -127,4 +132,33 @@ def test_a_behaviour_evolution_changes_only_that_behaviours_network():
     assert prob.describe()["mode"] == "land" and prob.fingerprint() != FlightProblem3D(
         TASK_SETS["landings"](), ctl, duration_s=0.1).fingerprint()
     with pytest.raises(UserError, match="not in the controller"):
-        FlightProblem3D(TASK_SETS["landings"](), c3.load_controller("monarch"), duration_s=0.1, mode="take_off")
+        FlightProblem3D(TASK_SETS["landings"](), _flight_only(), duration_s=0.1, mode="take_off")
+
+
+def _take_off_tilts(ctl, seeds=range(1, 9)):
+    """The largest roll or pitch (deg) and the height (m, from the perch) after 1 s, of ``ctl`` taking off from the
+    first flower of each garden ``seeds`` (two flowers, 6 m square) towards the second."""
+    from lifelike_mj.butterfly.flight3d.flowers import place_flowers
+
+    out = []
+    for seed in seeds:
+        f = Flight3D(controller=ctl, flowers=place_flowers(seed, 2, 6.0))
+        f.perch_on(0)
+        z0 = f.state()["position_m"][2]
+        f.take_off(f.land_on(1))
+        tilt = 0.0
+        while f.time < 1.0:
+            f.step(5)
+            tilt = max(tilt, float(np.degrees(np.abs(f.state()["attitude_rad"][:2]).max())))
+        out.append((tilt, f.state()["position_m"][2] - z0))
+    return np.array(out)
+
+
+def test_the_shipped_monarch_takes_off_upright_with_its_take_off_network():
+    """Gardens 1-8 (never flown in training): with its take_off network the shipped monarch stays within 85 deg of
+    upright and ends its first second within 0.4 m of its perch's height; its flight network alone tumbles on most."""
+    ctl = c3.load_controller("monarch")
+    assert set(ctl.modes) == {"take_off"}
+    r = _take_off_tilts(ctl)
+    assert r[:, 0].max() < 85.0 and np.abs(r[:, 1]).max() < 0.4, r
+    assert (_take_off_tilts(_flight_only())[:, 0] > 90.0).sum() >= 4
