@@ -373,6 +373,22 @@ class Flight3D(StepCounter):
         return int(self._task[T_KIND]) == TASK_PERCH
 
     @property
+    def behaviour(self) -> str:
+        """Which of the 3D controller's networks flies now: ``"flight"``, or a behaviour network's name (``"land"``,
+        ``"take_off"``: :data:`~lifelike_mj.butterfly.flight3d.controllers.MODES`) within its reach; ``"perched"``
+        while perched, ``"none"`` without a 3D controller."""
+        from lifelike_mj.butterfly.flight3d.controllers import MODES
+        from lifelike_mj.butterfly.flight3d.loop import behaviour
+
+        if self.network is None:
+            return "none"
+        if self.perched:
+            return "perched"
+        k = behaviour(self._task, self._data.qpos[self._root_q : self._root_q + 3], self.time, self._rec,
+                      self._batch.reach)
+        return "flight" if k == 0 else list(MODES)[k - 1]
+
+    @property
     def touchdown(self) -> dict | None:
         """The last touchdown of this landing: ``time_s`` and ``speed_m_s`` (over the ground), or ``None``."""
         from lifelike_mj.butterfly.flight3d.tasks import R_LANDED_AT, R_TOUCH_SPEED

@@ -96,6 +96,15 @@ def test_a_take_off_network_flies_only_the_first_of_a_take_off():
     zero = np.zeros(c3.n_weights([10, 9]))
     base, other = _path(ctl, take_off=True, seconds=0.5), _path(_monarch(take_off=(zero, 1.0)), take_off=True,
                                                                seconds=0.5)
+    f = Flight3D(controller=_monarch(take_off=(zero, 0.5)), flowers=FLOWERS, ground_m=-1.0)
+    assert f.behaviour == "flight"
+    f.perch_on(0)
+    assert f.behaviour == "perched"
+    f.take_off(f.land_on(1))
+    assert f.behaviour == "take_off"
+    f.step(round(0.6 / f.dt))
+    assert f.behaviour in ("flight", "land")
+    assert Flight3D(animal="monarch").behaviour == "none"
     assert not np.array_equal(base[: len(other)], other[: len(base)])
     assert np.array_equal(_path(ctl), _path(_monarch(take_off=(zero, 1.0))))
 
