@@ -362,8 +362,8 @@ def add_commands(bf) -> None:
                         "take-off's first second), starting from its own, else from its flight network; the rest "
                         "is flown by its other networks as they are")
     p.add_argument("--reach", type=num(0, 100, lo_open=True), default=None,
-                   help="where the --mode network flies: land, within this many m of the flower (default 0.6); "
-                        "take_off, for this many s (default 1)")
+                   help="where the --mode network flies: land, within this many m of the flower; take_off, for this "
+                        "many s after a take-off (unless given: the start's, else 0.6 m and 1 s)")
     p.add_argument("--gene-bound", type=num(0, 10, lo_open=True), default=0.4,
                    help="bound of each gene (a weight's change from the start)")
     p.add_argument("--hidden", type=_hidden, default=[], help="hidden layer sizes, e.g. 16 (default: none, a linear network)")
