@@ -67,6 +67,9 @@ FORCE_LAWS_FLOWN = ("exact", "strip", "quasi_steady")
 #: ``from_m`` (m) out, ``take_off`` for ``for_s`` (s); and the reach a new one gets.
 MODES = {"land": "from_m", "take_off": "for_s"}
 MODE_REACH = {"land": 0.6, "take_off": 1.0}
+#: A controller's networks in the compiled loop's order (:meth:`Controller3D.all_weights`,
+#: :func:`~lifelike_mj.butterfly.flight3d.loop.behaviour`'s answer indexes it): the flight network, then the behaviours.
+NETWORKS = ("flight", *MODES)
 #: The largest reach of a behaviour network (m or s).
 MAX_REACH = 100.0
 #: Default ``scale`` of the actions (rad; Hz for the frequency).

@@ -260,7 +260,7 @@ class FlightProblem3D:
     def all_weights(self, W: np.ndarray) -> np.ndarray:
         """The compiled loop's weights (the template's ``all_weights`` layout), one row per row of network weights
         ``W`` (of the behaviour ``mode``, with one)."""
-        k = 1 + list(c3.MODES).index(self.mode) if self.mode else 0
+        k = c3.NETWORKS.index(self.mode or "flight")
         n = self.dim
         rows = np.tile(self.template.all_weights(), (len(W), 1))
         rows[:, k * n : (k + 1) * n] = W
@@ -439,10 +439,11 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     if tasks is None:
         task_set = "steer"
         tasks = TASK_SETS["steer"]()
-    if mode is not None and (start is None or mode not in c3.MODES):
-        raise UserError(f"a behaviour to evolve ({' or '.join(c3.MODES)}) needs a controller to start from, whose "
-                        f"flight network flies the rest, got mode {mode!r}" + (" and no start." if start is None
-                                                                              else "."))
+    if mode is not None and mode not in c3.MODES:
+        raise UserError(f"the behaviour to evolve is {' or '.join(c3.MODES)}, got {mode!r}.")
+    if mode is not None and start is None:
+        raise UserError(f"evolving the {mode} behaviour needs a controller to start from, whose flight network flies "
+                        "the rest.")
     if start is not None:
         template = start
         layers = [int(v) for v in start.layers]

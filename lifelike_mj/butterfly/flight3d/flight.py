@@ -377,16 +377,15 @@ class Flight3D(StepCounter):
         """Which of the 3D controller's networks flies now: ``"flight"``, or a behaviour network's name (``"land"``,
         ``"take_off"``: :data:`~lifelike_mj.butterfly.flight3d.controllers.MODES`) within its reach; ``"perched"``
         while perched, ``"none"`` without a 3D controller."""
-        from lifelike_mj.butterfly.flight3d.controllers import MODES
+        from lifelike_mj.butterfly.flight3d.controllers import NETWORKS
         from lifelike_mj.butterfly.flight3d.loop import behaviour
 
         if self.network is None:
             return "none"
         if self.perched:
             return "perched"
-        k = behaviour(self._task, self._data.qpos[self._root_q : self._root_q + 3], self.time, self._rec,
-                      self._batch.reach)
-        return "flight" if k == 0 else list(MODES)[k - 1]
+        return NETWORKS[behaviour(self._task, self._data.qpos[self._root_q : self._root_q + 3], self.time, self._rec,
+                                  self._batch.reach)]
 
     @property
     def touchdown(self) -> dict | None:

@@ -139,7 +139,8 @@ def network(layers, weights, x, out, scratch):
 
 @njit(cache=True)
 def behaviour(task, qpos, t, rec, reach):
-    """Which of a controller's networks flies now (:data:`~lifelike_mj.butterfly.flight3d.controllers.MODES`): 1
+    """Which of a controller's networks flies now (an index into
+    :data:`~lifelike_mj.butterfly.flight3d.controllers.NETWORKS`): 1
     (``land``) within ``reach[0]`` (m) of a landing's flower axis, else 2 (``take_off``) within ``reach[1]`` (s) of the
     last take-off, else 0 (the flight network). A reach of 0 never picks its behaviour."""
     if int(task[T_KIND]) == TASK_LAND and to_flower(task, qpos)[2] < reach[0]:
@@ -589,9 +590,9 @@ class Batch:
             self.layers, self.scale = controller.layers, controller.scale
             self.every, self.air_inputs = controller.every, controller.air_inputs
             self.base = controller.base.as_array() if base is None else np.asarray(base, dtype=np.float64)
-            w = controller.all_weights() if weights is None else weights
-            self.weights = np.ascontiguousarray(np.broadcast_to(w, (self.n, len(controller.all_weights()))),
-                                                dtype=np.float64)
+            own = controller.all_weights()
+            w = own if weights is None else weights
+            self.weights = np.ascontiguousarray(np.broadcast_to(w, (self.n, len(own))), dtype=np.float64)
             self.reach = controller.mode_reach()
 
     def advance(self, n_steps: int, path: np.ndarray | None = None, path_every: int = 0) -> None:

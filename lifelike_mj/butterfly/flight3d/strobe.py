@@ -131,7 +131,8 @@ def landing_strobe(controller, flowers=((0.0, 0.0, -0.1), (1.2, 0.4, -0.25)), ev
             from lifelike_mj.errors import UserError
 
             raise UserError(f"the butterfly did not land on the flower within {MAX_LANDING_S:g} s, so there is no "
-                            "landing to draw; a controller that lands (evolved on the garden task set) draws one.")
+                            "landing to draw; a controller that lands (with a land network, or evolved on the garden "
+                            "task set) draws one.")
         f.step(int(round(perch_s / f.dt)))
     perched = copy()
     f.take_off(f.land_on(back))
