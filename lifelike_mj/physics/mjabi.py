@@ -176,15 +176,16 @@ def verify_offsets(d: mujoco.MjData, fields=USED_FIELDS) -> None:
 
 
 #: Positions of the fields in :func:`offsets_tuple`.
-O_TIME, O_QPOS, O_QVEL, O_QFRC, O_UD, O_XPOS, O_XMAT, O_XIPOS = range(8)
+O_TIME, O_QPOS, O_QVEL, O_QFRC, O_UD, O_XPOS, O_XMAT, O_XIPOS, O_CTRL = range(9)
 
 
 @functools.lru_cache(maxsize=1)
 def offsets_tuple() -> tuple[int, ...]:
-    """Byte offsets in ``mjData`` of ``time, qpos, qvel, qfrc_passive, userdata, xpos, xmat, xipos``
+    """Byte offsets in ``mjData`` of ``time, qpos, qvel, qfrc_passive, userdata, xpos, xmat, xipos, ctrl``
     (index with :data:`O_TIME` ...): the argument compiled kernels read ``mjData`` with."""
     o = data_offsets()
-    return tuple(int(o[k]) for k in ("time", "qpos", "qvel", "qfrc_passive", "userdata", "xpos", "xmat", "xipos"))
+    return tuple(int(o[k]) for k in ("time", "qpos", "qvel", "qfrc_passive", "userdata", "xpos", "xmat", "xipos",
+                                     "ctrl"))
 
 
 def _external(name: str, sig):

@@ -4,7 +4,7 @@
 The butterfly starts perched on the first flower. For each next flower it takes off (the wings open and clap,
 :meth:`~lifelike_mj.butterfly.flight3d.flight.Flight3D.take_off`), flies the landing task
 (:func:`~lifelike_mj.butterfly.flight3d.tasks.land`: lower, slower and more nose up as it closes), touches down on
-the blossom, and perches there with its wings closed for ``perch_s``, held by its legs' contact alone. Each visit is
+the blossom, and perches there with its wings closed for ``perch_s``, held by its legs' contact and grip. Each visit is
 measured: the touchdown's speed against :data:`~lifelike_mj.butterfly.flight3d.tasks.TOUCHDOWN_M_S`, how far the
 butterfly moved while perched, and whether it left the flower again.
 """

@@ -61,7 +61,7 @@ PERCH_FLAP_RAD, CLAP_TOP_RAD = _tasks.PERCH_FLAP_RAD, _tasks.CLAP_TOP_RAD
 
 #: A roll or pitch beyond this (rad) is a tumble: the flight ends there (no more reward).
 TUMBLE_RAD = math.radians(80.0)
-_O_TIME, _O_QPOS, _O_QVEL, _O_UD = mjabi.O_TIME, mjabi.O_QPOS, mjabi.O_QVEL, mjabi.O_UD
+_O_TIME, _O_QPOS, _O_QVEL, _O_UD, _O_CTRL = mjabi.O_TIME, mjabi.O_QPOS, mjabi.O_QVEL, mjabi.O_UD, mjabi.O_CTRL
 _mj_step = mjabi.mj_step
 _vp = mjabi.voidptr_from_int
 _ptr_at = mjabi.ptr_at
@@ -398,10 +398,23 @@ def _act(u, dt, every, base, scale, task, rec, ud, t):
 
 
 @njit(cache=True)
-def _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
-    """The second half of a step: one ``mj_step``, the kinematics advanced exactly, the reward of the observation
-    ``obs`` added (none while perched). Returns ``False`` if the flight diverged (recorded in ``rec``)."""
+def grip(dptr, off, ud, task):
+    """The legs hold on while the butterfly is perched, and let go when it takes off: the grip actuator of
+    :func:`~lifelike_mj.butterfly.flight3d.model.add_legs` (its index + 1 in ``ud[U_GRIP]``, 0 without one) gets
+    control 1 on a perch (``TASK_PERCH``), else 0."""
+    a = int(ud[mj3d.U_GRIP]) - 1
+    if a >= 0:
+        ctrl = _f64(_ptr_at(dptr + off[_O_CTRL]), a + 1)
+        ctrl[a] = 1.0 if int(task[T_KIND]) == TASK_PERCH else 0.0
+
+
+@njit(cache=True)
+def _after(mptr, dptr, off, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
+    """The second half of a step: the legs' grip set (:func:`grip`), one ``mj_step``, the kinematics advanced
+    exactly, the reward of the observation ``obs`` added (none while perched). Returns ``False`` if the flight
+    diverged (recorded in ``rec``)."""
     step = int(rec[R_STEPS])
+    grip(dptr, off, ud, task)
     ud[mj3d.U_T0] = time[0]
     t0 = time[0]
     _mj_step(_vp(mptr), _vp(dptr))
@@ -496,7 +509,7 @@ def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, reac
             k = behaviour(task, qpos, time[0], rec, reach)
             network(layers, weights[k * n_w : (k + 1) * n_w], obs, u, scratch)
             _act(u, dt, every, base, scale, task, rec, ud, time[0])
-        if not _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
+        if not _after(mptr, dptr, off, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
             return
 
 
@@ -534,7 +547,7 @@ def to_decision(mptr, dptr, off, nq, nv, n_max, dt, every, action, act, base, sc
         step = int(rec[R_STEPS])
         if step >= n_max or step % every == 0:
             return True
-        if not _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
+        if not _after(mptr, dptr, off, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
             return False
 
 

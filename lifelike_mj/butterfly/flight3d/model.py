@@ -116,7 +116,8 @@ U_RC = U_NTRI + 1  # span of the wing's area centroid (m): where the exact law s
 U_TRI = U_RC + 1  # per triangle: three vertices (chord, span) of the left wing (m)
 MAX_TRIS = 64
 U_FEET = U_TRI + 6 * MAX_TRIS  # 12: the four feet's lowest points in the thorax's frame (m), legs or not (add_legs)
-N_USERDATA = U_FEET + 12
+U_GRIP = U_FEET + 12  # the legs' grip actuator's index + 1 (add_legs), 0 without one
+N_USERDATA = U_GRIP + 1
 
 _O_TIME, _O_QPOS, _O_QVEL, _O_QFRC, _O_UD = mjabi.O_TIME, mjabi.O_QPOS, mjabi.O_QVEL, mjabi.O_QFRC, mjabi.O_UD
 _O_XPOS, _O_XMAT, _O_XIPOS = mjabi.O_XPOS, mjabi.O_XMAT, mjabi.O_XIPOS
@@ -587,7 +588,20 @@ def build_model(params: ButterflyParams | None = None, masses: str = "animal", a
         from lifelike_mj.butterfly.flight3d.flowers import add_flowers
 
         add_flowers(spec, flowers, float(spec.geom("ground").pos[2]), contact=True)
-    return spec.compile()
+    m = spec.compile()
+    set_grip(m)
+    return m
+
+
+def set_grip(m: mujoco.MjModel, prefix: str = "") -> None:
+    """Size the grip of the butterfly ``{prefix}butterfly`` of ``m`` (:func:`add_legs`; nothing without legs): its
+    full hold :data:`GRIP_BODY_WEIGHTS` times the butterfly's weight (N)."""
+    name = f"{prefix}grip"
+    if mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, name) < 0:
+        return
+    body = m.body(f"{prefix}butterfly").id
+    m.actuator(name).gainprm[0] = GRIP_BODY_WEIGHTS * float(m.body_subtreemass[body]) * float(
+        np.linalg.norm(m.opt.gravity))
 
 
 #: The legs' friction with what they stand on: sliding, torsional, rolling (a foot's claws grip).
@@ -598,6 +612,11 @@ LEG_FRICTION = (1.5, 0.01, 0.001)
 LEG_RADIUS_M = 0.0003
 FEET = ((0.3, 1.3), (-0.6, 1.4))
 FOOT_DEPTH = 1.3
+#: How hard a perched butterfly's feet hold on to the flower (its weight's multiple, pulled along the contact normal
+#: at full grip): a chosen value. Insects' tarsal claws and pads hold on with more than their weight (Gorb et al.
+#: 2004, J Exp Biol 207:2917: shear forces above body weight even for a bug's smooth pads); three weights keep a
+#: monarch on a blossom as it settles after a touchdown at up to about 1 m/s without it looking stuck.
+GRIP_BODY_WEIGHTS = 3.0
 
 
 def add_contact(spec: mujoco.MjSpec) -> None:
@@ -652,6 +671,10 @@ def add_legs(spec: mujoco.MjSpec, prefix: str = "") -> None:
         body.add_geom(name=f"{prefix}{name}", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=top + foot,
                       size=[LEG_RADIUS_M, 0.0, 0.0], mass=0.0, contype=1, conaffinity=1, condim=3,
                       friction=list(LEG_FRICTION), rgba=[0.1, 0.08, 0.06, 1.0], group=0)
+    # the feet's grip: MuJoCo's adhesion on the body's contacts (its gain set by set_grip once compiled), held while
+    # perched and let go at take-off (loop.grip)
+    spec.add_actuator(name=f"{prefix}grip", trntype=mujoco.mjtTrn.mjTRN_BODY, target=f"{prefix}butterfly",
+                      gainprm=[0.0] * 10, ctrlrange=[0.0, 1.0], ctrllimited=1)
 
 
 @functools.cache
@@ -912,6 +935,7 @@ def setup_data(m: mujoco.MjModel, kinematics: Kinematics, params: ButterflyParam
     ud[U_NTRI], ud[U_RC] = len(tris), rc
     ud[U_TRI : U_TRI + tris.size] = tris.ravel()
     ud[U_FEET : U_FEET + 12] = feet_m(m).ravel()
+    ud[U_GRIP] = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "grip") + 1
     if a.measured:
         ud[U_L] = a.span_m
     d.qpos[m.jnt_qposadr[m.joint("root").id] + 3] = 1.0

@@ -117,6 +117,40 @@ def test_a_butterfly_put_on_a_flower_perches_there_until_a_reset():
     assert not f.perched and f.touchdown is None and f.time == 0.0
 
 
+def _pull_up(f, body_weights: float, s: float = 0.5) -> float:
+    """Pull a perched butterfly straight up by ``body_weights`` times its weight for ``s`` s: how far it rose (m)."""
+    m = f.model
+    body = m.body("butterfly").id
+    weight = float(m.body_subtreemass[body]) * float(np.linalg.norm(m.opt.gravity))
+    z0 = f.state()["position_m"][2]
+    f.data.xfrc_applied[body, 2] = body_weights * weight
+    f.step(round(s / f.dt))
+    f.data.xfrc_applied[body, 2] = 0.0
+    return float(f.state()["position_m"][2] - z0)
+
+
+def test_a_perched_butterfly_grips_the_blossom_and_lets_go_at_take_off():
+    """While perched the feet hold on (MuJoCo's adhesion, GRIP_BODY_WEIGHTS times the weight, along the contact
+    normal): pulled up by twice its weight it stays on the blossom; with the grip's force set to zero, or once it
+    has taken off, the same pull lifts it away. A flight without legs has no grip at all."""
+    assert mj3d.GRIP_BODY_WEIGHTS > 2.0
+    f = Flight3D(controller="monarch", flowers=FLOWERS, ground_m=-1.0)
+    grip = f.model.actuator("grip").id
+    f.perch_on(0)
+    f.step(round(0.3 / f.dt))
+    assert f.data.ctrl[grip] == 1.0
+    assert abs(_pull_up(f, 2.0)) < 0.002 and f.data.ncon >= 4
+    loose = Flight3D(controller="monarch", flowers=FLOWERS, ground_m=-1.0)
+    loose.model.actuator("grip").gainprm[0] = 0.0
+    loose.perch_on(0)
+    loose.step(round(0.3 / loose.dt))
+    assert _pull_up(loose, 2.0) > 0.05
+    f.take_off(f.land_on(1))
+    f.step(1)
+    assert f.data.ctrl[grip] == 0.0
+    assert Flight3D(controller="monarch").model.nu == 0
+
+
 def test_a_take_off_claps_and_leaves_the_flower():
     """take_off: the wings open to the top of the stroke and the network flies again; for CLAP_S each stroke is
     enlarged so that its top is CLAP_TOP_RAD: the wings meet over the back (flap angles near 90 deg) at the end of
