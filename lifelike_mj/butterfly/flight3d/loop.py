@@ -537,7 +537,7 @@ def to_decision(mptr, dptr, off, nq, nv, n_max, dt, every, action, act, base, sc
         if int(task[T_KIND]) != TASK_PERCH:
             u = action.copy()
             _act(u, dt, every, base, scale, task, rec, ud, time[0])
-        if not _after(mptr, dptr, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
+        if not _after(mptr, dptr, off, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
             return False
     while True:
         tumbled, _ = _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, none, 0, 0, tumble_rad,
