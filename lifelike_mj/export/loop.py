@@ -3,8 +3,8 @@
 Two ways, by what the motion is:
 
 * **cut** (:func:`cut_loop`), for periodic motion such as a butterfly's level flight: the clip keeps a whole
-  number of wing beats and ends on the sample, near the length asked for, where the state comes back closest to
-  the first sample's (every body's turn relative to the root body, and the root's attitude); the root's travel
+  number of wing beats (the length asked for, or up to a fifth less) and ends on the sample where the state comes
+  back closest to the first sample's (every body's turn relative to the root body, and the root's attitude); the root's travel
   over the clip is taken off linearly (the creature flies in place, as a game engine's locomotion cycle does)
   and given as the clip's root motion, so that playing it again and again and moving the root by that much per
   loop gives the flight;
@@ -67,20 +67,17 @@ def seam(pos: np.ndarray, quat: np.ndarray) -> tuple[float, float]:
 def cut_loop(t: np.ndarray, pos: np.ndarray, quat: np.ndarray, period_s: float, duration_s: float,
              root: int = 0):
     """The cut (module docstring) of bodies ``pos`` ``(n, bodies, 3)``, ``quat`` ``(n, bodies, 4)`` sampled at
-    ``t``: a whole number of ``period_s`` near ``duration_s``, ending on the best-matching sample, the root
+    ``t``: a whole number of ``period_s`` from ``duration_s`` down to a fifth less, ending on the best-matching sample, the root
     body's (index ``root``) travel taken off. Returns ``(last sample index, positions, quaternions, travel
     (m, 3-vector), beats)``."""
     if not period_s > 0 or not math.isfinite(period_s):
         raise UserError(f"a looped cut needs a positive period, got {period_s!r} s.")
-    beats = max(1, int(round(duration_s / period_s)))
+    most = max(1, int(round(duration_s / period_s)))
     dt = float(np.median(np.diff(t)))
-    target = t[0] + beats * period_s
-    if target > t[-1] + dt / 2:
-        beats = int((t[-1] - t[0]) // period_s)
-        if beats < 1:
+    if t[0] + most * period_s > t[-1] + dt / 2:
+        most = int((t[-1] - t[0]) // period_s)
+        if most < 1:
             raise UserError(f"a looped clip needs at least one whole beat of {period_s:g} s; record longer.")
-        target = t[0] + beats * period_s
-    near = np.nonzero(np.abs(t - target) <= max(2.5 * dt, 0.1 * period_s))[0]
     rel = qmul(qconj(quat[:, root:root + 1]), quat)  # each body's turn in the root's frame (wings, abdomen)
 
     def mismatch(k: int) -> float:
@@ -88,7 +85,16 @@ def cut_loop(t: np.ndarray, pos: np.ndarray, quat: np.ndarray, period_s: float, 
         b = min(1.0, abs(float(np.sum(quat[k, root] * quat[0, root]))))
         return float(np.max(2.0 * np.arccos(a))) + 2.0 * math.acos(b)
 
-    end = int(min(near, key=mismatch)) if len(near) else int(np.argmin(np.abs(t - target)))
+    # the beat counts from a fifth fewer up to the length asked: a flight's slower swings (its body's, over a few
+    # beats) come back better after some counts than others; each ends on its best-matching sample
+    best = None
+    for n in range(most, max(1, most - most // 5) - 1, -1):
+        target = t[0] + n * period_s
+        near = np.nonzero(np.abs(t - target) <= max(2.5 * dt, 0.1 * period_s))[0]
+        k = int(min(near, key=mismatch)) if len(near) else int(np.argmin(np.abs(t - target)))
+        if best is None or mismatch(k) < best[0] - 1e-12:
+            best = (mismatch(k), k, n)
+    _, end, beats = best
     travel = pos[end, root] - pos[0, root]
     u = ((t[: end + 1] - t[0]) / (t[end] - t[0]))[:, None, None]
     p = pos[: end + 1] - u * travel

@@ -32,9 +32,9 @@ def _seam_in_file(gl, info):
 def test_a_level_flight_loops_at_whole_wing_beats_in_place(tmp_path, capsys):
     out, gl, info = _export(tmp_path, capsys, "butterfly3d", "--task", "level", "--start", "5", "--duration", "2")
     loop = info["loop"]
-    assert loop["mode"] == "cut" and loop["beats"] >= 15
+    assert loop["mode"] == "cut" and 0.8 * 2.0 / loop["period_s"] - 1 <= loop["beats"] <= 2.0 / loop["period_s"] + 1
     assert loop["span_s"] == pytest.approx(loop["beats"] * loop["period_s"], abs=1.5 * DT_S)  # whole beats
-    assert 1.0 / loop["period_s"] == pytest.approx(10.7, abs=1.0)  # the flap frequency
+    assert 1.0 / loop["period_s"] == pytest.approx(8.9, abs=0.5)  # the monarch's flap frequency (8.7-9.0 Hz, measure3d)
     assert np.linalg.norm(loop["root_motion_m"]) / loop["span_s"] == pytest.approx(1.5, rel=0.2)  # its speed
     m, deg = _seam_in_file(gl, info)
     assert m <= 0.002 and deg <= 1.0, (m, deg)
