@@ -104,12 +104,12 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--copies", type=int, default=64)
     ap.add_argument("--steps", type=int, default=600)
-    ap.add_argument("--controller", default="wind")
+    ap.add_argument("--controller", default=None, help="default: the (withdrawn) wind controller the table was measured with")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "butterfly3d.json"))
     args = ap.parse_args()
     m = mj3d.build_model()
     m.opt.timestep = DT
-    ctl = flight3d.load_controller(args.controller)
+    ctl = flight3d.load_controller(args.controller or flight3d.withdrawn_file("wind"))
     cases = {
         "floor: bare mj_step": lambda: stepped(m, args.copies, args.steps, False),
         "callback, no air (drive only)": lambda: stepped(m, args.copies, args.steps, True, force_law="none"),

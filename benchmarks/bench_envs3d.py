@@ -71,7 +71,7 @@ def vector(env: ButterflyFlight3DVectorEnv, n: int) -> float:
 
 def floor(n_envs: int, n_steps: int) -> float:
     m = flight3d.build_model()
-    c = flight3d.load_controller("steer")
+    c = flight3d.load_controller(flight3d.withdrawn_file("steer"))  # the swallowtail's (withdrawn) controller
     datas = [mj3d.setup_data(m, flight3d.Kinematics(c.base, c.omega_c_rad_s)) for _ in range(n_envs)]
     ptrs = np.array([d._address for d in datas], dtype=np.int64)
     with passive_callback(mj3d.COMPILED_PASSIVE), watching():

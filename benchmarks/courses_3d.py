@@ -25,12 +25,14 @@ from lifelike_mj.provenance import provenance
 
 MAX_S = 40.0
 FALL_M = 1.0
+#: The shipped controller and the two withdrawn after this benchmark (loaded from their kept files).
 CONTROLLERS = ("monarch", "steer", "wind")
 
 
 def fly(controller: str, seed: int) -> dict:
     task = flight3d.course(seed)
-    f = flight3d.Flight3D(controller=controller, task=task)
+    kept = controller in flight3d.WITHDRAWN
+    f = flight3d.Flight3D(controller=str(flight3d.withdrawn_file(controller)) if kept else controller, task=task)
     lowest = min(r[2] for r in task.rows)
     tumbled = fell = False
     every = max(1, round(0.01 / f.dt))

@@ -104,7 +104,7 @@ def main() -> None:
                        "bank_deg": {"median": float(np.median(np.concatenate(banks))),
                                     "p90": float(np.percentile(np.concatenate(banks), 90))},
                        "flap_hz_median": float(np.nanmedian(flap)), "glide_share_median": float(np.median(glide))}
-    flight = Flight3D(controller="steer", task=flight3d.course(103))
+    flight = Flight3D(controller=flight3d.withdrawn_file("steer"), task=flight3d.course(103))
     bp = record_poses(flight, 3.0)
     misses = {}
     with tempfile.TemporaryDirectory() as tmp:

@@ -64,7 +64,7 @@ def open_loop(dt: Fraction, integrator: str) -> np.ndarray:
 
 
 def fitness(name: str, dt: Fraction, integrator: str, flutter: float = 0.0, seed: int = 0) -> float:
-    ctl = flight3d.load_controller(name)
+    ctl = flight3d.load_controller(flight3d.withdrawn_file(name))  # the (since withdrawn) swallowtail controllers
     tasks = tuple(replace(t, flutter=flutter, seed=seed) if flutter else t for t in flight3d.TASK_SETS[name]())
     p = flight3d.FlightProblem3D(tasks, ctl, duration_s=4.0, dt_s=float(dt))
     p._model = _model(integrator)
@@ -74,7 +74,7 @@ def fitness(name: str, dt: Fraction, integrator: str, flutter: float = 0.0, seed
 
 def cost(dt: Fraction, integrator: str, n: int = 20, seconds: float = 2.0) -> float | None:
     """Seconds of wall time per second of flight of a garden of ``n`` (median of 3), this machine."""
-    g = flight3d.Garden(n, "steer", seed=1, dt_s=float(dt))
+    g = flight3d.Garden(n, str(flight3d.withdrawn_file("steer")), seed=1, dt_s=float(dt))
     g._phys.opt.integrator = INTEGRATORS[integrator]
     steps = int(round(seconds / float(dt)))
     walls = []

@@ -44,7 +44,7 @@ def envs() -> None:
     for _ in range(6000):  # 5 s: settled flight
         obs, *_ = env.step(policy(obs))
     write_png(OUT / "env_butterfly_pitch.png", env.render())
-    ctl = flight3d.load_controller("steer")
+    ctl = flight3d.load_controller("monarch")
     env = gym.make("lifelike_mj/ButterflyFlight3D-v0", controller=ctl, task="turn", duration_s=10.0,
                    render_mode="rgb_array", width=480, height=320)
     obs, _ = env.reset(seed=0)

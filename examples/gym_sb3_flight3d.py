@@ -105,8 +105,9 @@ def main() -> int:
     prov["fitness_steer"] = fitness(ctl)
     ctl.provenance = prov
     write_json(args.out, ctl.to_dict())
+    steer = fitness(flight3d.load_controller(flight3d.withdrawn_file("steer")))
     print(f"trained {args.steps} steps ({args.steps * args.every:,} time steps) in {wall:.0f} s; fitness on the steer "
-          f"tasks {prov['fitness_steer']:.3f} (evolve3d's shipped steer: {fitness(flight3d.load_controller('steer')):.3f}); "
+          f"tasks {prov['fitness_steer']:.3f} (evolve3d's steer, since withdrawn: {steer:.3f}); "
           f"controller written to {args.out} (fly it: lifelike-mj butterfly fly3d --controller {args.out})")
     return 0
 

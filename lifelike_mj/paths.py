@@ -52,7 +52,7 @@ def shipped_names(creature: str) -> list[str]:
 def resolve(creature: str, name_or_path: str | Path, what: str) -> Path:
     """The file that ``name_or_path`` means: a path (anything ending in ``.json`` or that exists) or
     the name of a file shipped in ``controllers/<creature>/``. A folder is never a file, so a folder that
-    happens to have a shipped file's name (``wind/`` in the working folder) does not hide it. ``what`` names
+    happens to have a shipped file's name (``monarch/`` in the working folder) does not hide it. ``what`` names
     the kind of file in the :class:`UserError` raised when there is no such file ("boids preset")."""
     text = str(name_or_path)
     path = Path(text)

@@ -120,7 +120,7 @@ def _fresh(creature: str):
         from lifelike_mj.butterfly import flight3d
         from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
-        return Flight3D(controller="steer", task=flight3d.course(100)), 30.0, 1.0, 1.0
+        return Flight3D(controller=flight3d.withdrawn_file("steer"), task=flight3d.course(100)), 30.0, 1.0, 1.0
     if creature == "butterfly2d":
         from lifelike_mj.butterfly import Flight
 

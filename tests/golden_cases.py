@@ -7,7 +7,8 @@ every controller file it writes. ``tests/data/golden_cli.json`` holds the record
 ``python tests/golden_cases.py record`` on version 0.1.0 before the library reorganisation (issue
 12), and the 3D butterfly's cases (``fly3d_*``, ``evolve3d_*``, ``assess3d_*``) on commit 0e7f3e6, before the 3D
 flight became a slice of its own (issue 26); they pin ``--dt 1/1200``, the default then.
-``tests/cli/test_unchanged.py`` recomputes them and compares.
+``tests/cli/test_unchanged.py`` recomputes them and compares. The 3D cases of the controllers `steer` and `wind`, since
+withdrawn, fly their kept files (``{withdrawn}``: :func:`~lifelike_mj.butterfly.flight3d.controllers.withdrawn_file`).
 
 Run as a script::
 
@@ -63,14 +64,14 @@ CASES: dict[str, tuple[list[str], list[str]]] = {
                              "--executor", "serial", "--quiet", "--out", "{out}/cmaes.json"], ["cmaes.json"]),
     "evolve_mujoco": (["butterfly", "evolve", "--optimizer", "rcga", "--backend", "mujoco", "--population", "4",
                        "--generations", "2", "--executor", "serial", "--quiet", "--out", "{out}/mj.json"], ["mj.json"]),
-    "fly3d_steer_turn": (["butterfly", "fly3d", "--controller", "steer", "--task", "turn", "--angle", "-90",
+    "fly3d_steer_turn": (["butterfly", "fly3d", "--controller", "{withdrawn}/steer.json", "--task", "turn", "--angle", "-90",
                           "--duration", "4", "--dt", "1/1200", "--out", "{out}"], ["path.npz"]),
-    "fly3d_wind_course": (["butterfly", "fly3d", "--controller", "wind", "--task", "course", "--seed", "3",
+    "fly3d_wind_course": (["butterfly", "fly3d", "--controller", "{withdrawn}/wind.json", "--task", "course", "--seed", "3",
                            "--wind-to", "1,0.5,0", "--gusts", "0.5", "--flutter", "0.1", "--duration", "4", "--dt",
                            "1/1200", "--out", "{out}"], ["path.npz"]),
     "evolve3d_cmaes": (["butterfly", "evolve3d", "--population", "4", "--generations", "2", "--duration", "0.5",
                         "--dt", "1/1200", "--quiet", "--out", "{out}/c3.json"], ["c3.json"]),
-    "assess3d_wind": (["butterfly", "assess3d", "--controller", "wind", "--duration", "6", "--courses", "100",
+    "assess3d_wind": (["butterfly", "assess3d", "--controller", "{withdrawn}/wind.json", "--duration", "6", "--courses", "100",
                        "--gusts", "0.3", "--dt", "1/1200"], []),
     "fish_swim": (["fish", "swim", "--fish", "5", "--duration", "4", "--out", "{out}"], ["tracks.npz"]),
     "fish_swim_nbnd": (["fish", "swim", "--preset", "NB-ND", "--fish", "3", "--duration", "3", "--seed", "2",
@@ -109,11 +110,13 @@ def _digest(path: Path) -> dict:
 
 def run_case(name: str) -> dict:
     """Run one case in this process; its record."""
+    from lifelike_mj.butterfly.flight3d.controllers import withdrawn_file
     from lifelike_mj.cli import main
 
     argv, files = CASES[name]
+    withdrawn = str(withdrawn_file("steer").parent)  # the 3D controllers since withdrawn, kept for these cases
     with tempfile.TemporaryDirectory() as tmp:
-        args = [a.replace("{out}", tmp) for a in argv] + ["--json"]
+        args = [a.replace("{out}", tmp).replace("{withdrawn}", withdrawn) for a in argv] + ["--json"]
         buf = io.StringIO()
         with contextlib.redirect_stdout(buf):
             code = main(args)

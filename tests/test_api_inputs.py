@@ -22,9 +22,10 @@ def _flight3d(**kw):
 
 
 def _garden(**kw):
+    from lifelike_mj.butterfly import flight3d
     from lifelike_mj.butterfly.flight3d.garden import Garden
 
-    return Garden(2, "steer", **kw)
+    return Garden(2, flight3d.withdrawn_file("steer"), **kw)
 
 
 def _tank(**kw):

@@ -42,7 +42,7 @@ def _loaders():
 
 #: (format, a shipped file of it): the documents the mutations start from.
 EXAMPLES = [("butterfly-controller", "butterfly/simple_rule.json"), ("butterfly-controller", "butterfly/ann_paper.json"),
-            ("butterfly-controller", "butterfly/glide.json"), ("butterfly3d-controller", "butterfly3d/wind.json"),
+            ("butterfly-controller", "butterfly/glide.json"), ("butterfly3d-controller", "butterfly3d/monarch.json"),
             ("fish-preset", "fish/B-D.json"), ("fish-preset", "fish/default.json"), ("boids-preset", "boids/5b.json"),
             ("boids-grid", "boids/fig2_grid.json")]
 

@@ -15,8 +15,8 @@ FACTORIES = {
     "flight-mujoco": lambda seed: butterfly.Flight("ann_paper", backend="mujoco", config="rich"),
     "tank": lambda seed: fish.Tank(fish.load_preset("B-D"), n_fish=3, seed=seed, size=(1.0, 0.3, 0.5)),
     "flock": lambda seed: boids.Flock(boids.load_preset("4c"), n=40, seed=seed),
-    "flight3d": lambda seed: flight3d.Flight3D(controller="wind", task=flight3d.course(seed)),
-    "garden": lambda seed: flight3d.Garden(3, "steer", seed=seed),
+    "flight3d": lambda seed: flight3d.Flight3D(controller=flight3d.withdrawn_file("wind"), task=flight3d.course(seed)),
+    "garden": lambda seed: flight3d.Garden(3, flight3d.withdrawn_file("steer"), seed=seed),
 }
 UNITS = {"flight-paper": butterfly.STATE_UNITS, "flight-mujoco": butterfly.STATE_UNITS, "tank": fish.STATE_UNITS,
          "flock": boids.STATE_UNITS, "flight3d": flight3d.STATE_UNITS, "garden": garden.STATE_UNITS}

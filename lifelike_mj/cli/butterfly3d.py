@@ -20,6 +20,7 @@ from lifelike_mj.cli.common import (
     num,
 )
 from lifelike_mj.errors import UserError
+from lifelike_mj.paths import shipped_names
 from lifelike_mj.progress import stage
 
 #: The files of ``fly3d --out``.
@@ -28,11 +29,13 @@ MAX_DURATION_S = 3600.0
 #: The settling time of assess3d's level flight (s), and the most courses it flies.
 LEVEL_SETTLE_S = 5.0
 MAX_COURSES = 1000
+#: The --controller option's help: the shipped 3D controllers' names.
+CONTROLLER_HELP = f"a shipped 3D controller's name ({', '.join(shipped_names('butterfly3d'))}) or a file"
 
 
 def _add_level_flight(p: argparse.ArgumentParser, settle_s: float, settle_help: str) -> None:
     """The options of a level flight that is flown, then looked at: the controller, its speed, the settling time."""
-    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name or a file")
+    p.add_argument("--controller", default="monarch", help=CONTROLLER_HELP)
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s")
     p.add_argument("--settle", type=num(0, 600, unit="s"), default=settle_s, help=settle_help)
 
@@ -312,7 +315,7 @@ def _hidden(text: str) -> list[int]:
 def add_commands(bf) -> None:
     """``fly3d``, ``evolve3d`` and ``assess3d`` under ``lifelike-mj butterfly``."""
     p = bf.add_parser("fly3d", help="fly the 3D butterfly with a 3D controller")
-    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name (monarch, steer, wind) or a file")
+    p.add_argument("--controller", default="monarch", help=CONTROLLER_HELP)
     p.add_argument("--task", default="level", choices=("level", "turn", "course"),
                    help="level flight, a turn (--angle) or a course of 10 waypoints drawn by --seed")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
@@ -331,7 +334,7 @@ def add_commands(bf) -> None:
     p.add_argument("--optimizer", default="cmaes", choices=("cmaes", "rcga", "crs2", "esch", "isres"),
                    help="cmaes, rcga (the paper's GA) or an nlopt method")
     p.add_argument("--tasks", default="steer", choices=("steer", "cruise", "wind", "natural", "garden", "agile", "fast",
-                                                         "landings"),
+                                                         "landings", "landings12"),
                    help="the task set: steer (level at 1 and 2 m/s, turns of 90 and -180 deg), cruise (level at 1.5 "
                         "and 2 m/s, the turns, and two flights in 1 m/s wind with 0.5 m/s gusts) or wind (courses "
                         "1-4 in 1 m/s wind from four sides with gusts of 0.5 m/s, 0.25 m/s vertically, course 5 and "
@@ -341,7 +344,8 @@ def add_commands(bf) -> None:
                         "with gusts on every axis, course 3 in a 1.5 m/s wind, and three landings on flowers) or agile "
                         "(the steer set and calm courses 1-3) or fast (level at 1 to 3 m/s, the 90 deg turn, course 5, "
                         "course 1 in gusty 1 m/s wind, course 3 in 1.5 m/s wind) or landings (six flowers all round, "
-                        "0.9-3.5 m away: for --mode land, or with --take-off for --mode take_off)")
+                        "0.9-3.5 m away: for --mode land, or with --take-off for --mode take_off) or landings12 (those and "
+                        "six more)")
     p.add_argument("--inputs", default=None, choices=("ground", "air"),
                    help="the network's speeds over the ground or through the air (default: the start's, else ground)")
     p.add_argument("--start", default=None, help="a 3D controller to start from (its network; genes are its changes)")
@@ -379,7 +383,7 @@ def add_commands(bf) -> None:
     p.set_defaults(func=cmd_evolve3d)
     p = bf.add_parser("garden", help="a garden of 3D butterflies visiting flowers, filmed")
     p.add_argument("--n", type=count(1, 500), default=20, help="butterflies, 1 to 500")
-    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name or a file")
+    p.add_argument("--controller", default="monarch", help=CONTROLLER_HELP)
     add_seed(p)
     p.add_argument("--flutter", type=num(0, 1), default=0.1, help="each butterfly's flutter, 0 to 1")
     _add_weather(p, "", "each butterfly's seed")
@@ -395,7 +399,7 @@ def add_commands(bf) -> None:
     add_json(p)
     p.set_defaults(func=cmd_garden)
     p = bf.add_parser("assess3d", help="a 3D controller's acceptance numbers: level flight, turns, courses")
-    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name or a file")
+    p.add_argument("--controller", default="monarch", help=CONTROLLER_HELP)
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s")
     p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=60.0,
                    help="seconds of level flight")
@@ -457,7 +461,7 @@ def view_keys() -> str:
 def add_export_args(p: argparse.ArgumentParser) -> None:
     from lifelike_mj.cli.export import add_window
 
-    p.add_argument("--controller", default="steer", help="a shipped 3D controller's name (monarch, steer, wind) or a file")
+    p.add_argument("--controller", default="monarch", help=CONTROLLER_HELP)
     p.add_argument("--task", default="course", choices=("level", "turn", "course"),
                    help="level flight, a turn (--angle) or a course of 10 waypoints drawn by --seed")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
@@ -504,7 +508,7 @@ def export_rigs(poses) -> list:
 
 
 def add_view_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--controller", default="wind", help="a shipped 3D controller's name (wind, steer, monarch) or a file")
+    p.add_argument("--controller", default="monarch", help=CONTROLLER_HELP)
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
     p.add_argument("--duration", type=num(0, None, lo_open=True, unit="s"), default=None,
                    help="stop after this many seconds (default: run until the window is closed)")

@@ -22,7 +22,7 @@ from lifelike_mj.errors import Diverged, UserError
 TASKS = ("level", "turn", "course", "wind")
 #: The options ``reset`` takes.
 RESET_OPTIONS = ("task",)
-#: The wind task's weather: 1 m/s of wind from a side drawn per episode, with the gusts the ``wind`` controller was
+#: The wind task's weather: 1 m/s of wind from a side drawn per episode, with the gusts the (withdrawn) ``wind`` controller was
 #: evolved in (0.5 m/s horizontally, half that vertically: the low-altitude Dryden ratio).
 WIND_M_S = 1.0
 GUSTS = {"gust_m_s": 0.5, "gust_vertical_m_s": 0.5 * 0.5}

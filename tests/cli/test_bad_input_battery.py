@@ -140,7 +140,7 @@ CASES = [
     (["butterfly", "fly3d", "--vertical-gusts", "-1"], "--vertical-gusts", {}),
     (["butterfly", "assess3d", "--wind", "1,0"], "three numbers", {}),
     (["butterfly", "evolve3d", "--hidden", "0,x"], "--hidden", {}),
-    (["butterfly", "evolve3d", "--start", "wind", "--hidden", "8"], "--hidden does not apply", {}),
+    (["butterfly", "evolve3d", "--start", "monarch", "--hidden", "8"], "--hidden does not apply", {}),
     (["butterfly", "evolve3d", "--mode", "land"], "give the controller with --start", {}),
     (["butterfly", "evolve3d", "--mode", "hover", "--start", "monarch"], "invalid choice", {}),
     (["butterfly", "evolve3d", "--reach", "0.5"], "--reach applies", {}),

@@ -7,6 +7,7 @@ import sys
 
 import pytest
 
+from lifelike_mj.butterfly import flight3d
 from lifelike_mj.cli import main
 
 
@@ -43,7 +44,8 @@ def test_fly_json_and_out(capsys, tmp_path):
 
 
 def test_fly3d_in_gusty_wind_json_and_out(capsys, tmp_path):
-    code, out, _ = run(capsys, "butterfly", "fly3d", "--controller", "wind", "--task", "course", "--seed", "101",
+    code, out, _ = run(capsys, "butterfly", "fly3d", "--controller", str(flight3d.withdrawn_file("wind")), "--task",
+                       "course", "--seed", "101",
                        "--wind", "1,0,0", "--gusts", "0.5", "--vertical-gusts", "0.25", "--duration", "3", "--json",
                        "--out", str(tmp_path / "f"))
     assert code == 0

@@ -18,14 +18,14 @@ from pathlib import Path
 import pytest
 from battery import check_refusal, snapshot
 
+from lifelike_mj.butterfly.flight3d.controllers import withdrawn_file
 from lifelike_mj.cli import main
-from lifelike_mj.paths import controllers_dir
 
-STEER = json.loads((controllers_dir() / "butterfly3d" / "steer.json").read_text())
+STEER = json.loads(withdrawn_file("steer").read_text())
 
 
 def c3(**changes) -> dict:
-    """The shipped ``steer`` controller with ``changes`` (``b_NAME``: a base entry; ``None``: the key removed)."""
+    """The (withdrawn, kept) ``steer`` controller with ``changes`` (``b_NAME``: a base entry; ``None``: the key removed)."""
     d = json.loads(json.dumps(STEER))
     for k, v in changes.items():
         if k.startswith("b_"):

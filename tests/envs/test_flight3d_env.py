@@ -41,10 +41,11 @@ def _network_policy(ctl):
 
 
 @pytest.mark.parametrize("name", ["steer", "wind"])
-def test_a_shipped_controllers_return_is_its_evolution_fitness(name):
-    """Flown through the env by its own network, a shipped controller's mean return over its task set is the fitness
-    ``evolve3d`` computes for it (the wind set has gusts and wind: the env draws them as the evolution does)."""
-    ctl = flight3d.load_controller(name)
+def test_an_evolved_controllers_return_is_its_evolution_fitness(name):
+    """Flown through the env by its own network, an evolved controller's (the swallowtail's, since withdrawn) mean
+    return over its task set is the fitness ``evolve3d`` computes for it (the wind set has gusts and wind: the env
+    draws them as the evolution does)."""
+    ctl = flight3d.load_controller(flight3d.withdrawn_file(name))
     tasks = flight3d.TASK_SETS[name]()
     problem = flight3d.FlightProblem3D(tuple(tasks), ctl, duration_s=4.0)
     fitness = float(problem.evaluate(np.zeros((1, problem.dim)))[0])

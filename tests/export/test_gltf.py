@@ -44,7 +44,7 @@ def _rot(q_xyzw):
 
 @pytest.fixture(scope="module")
 def flight():
-    f = Flight3D(controller="steer", task=flight3d.course(100))
+    f = Flight3D(controller=flight3d.withdrawn_file("steer"), task=flight3d.course(100))
     poses = record_poses(f, 1.0, fps=30.0)
     return f, poses
 

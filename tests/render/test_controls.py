@@ -31,7 +31,7 @@ def test_no_scene_key_is_one_of_mujocos_viewers_own():
             Control(key, "x", lambda: None)
     with pytest.raises(UserError, match="a scene key is one of"):
         Control("T", "x", lambda: None)
-    f = Flight3D(controller="wind", task=flight3d.level(1.5))
+    f = Flight3D(controller=flight3d.withdrawn_file("wind"), task=flight3d.level(1.5))
     scenes = [flight3d_controls(f), weight_controls(Flock(load_preset("5a"), n=10, seed=0)),
               controls(Aquarium(Tank(n_fish=2, seed=0)))]
     for scene in scenes:
@@ -43,7 +43,7 @@ def _press(controls, key):
 
 
 def test_the_butterflys_keys_change_its_course_altitude_and_wind():
-    f = Flight3D(controller="wind", task=flight3d.level(1.5))
+    f = Flight3D(controller=flight3d.withdrawn_file("wind"), task=flight3d.level(1.5))
     keys = flight3d_controls(f)
     assert [c.key for c in keys] == ["Up", "Down", "Left", "Right", "6", "7", "8", "9", "Space"]
     _press(keys, "Up")

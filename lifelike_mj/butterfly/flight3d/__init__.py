@@ -5,13 +5,13 @@ Fly one::
 
     from lifelike_mj.butterfly import flight3d
 
-    flight = flight3d.Flight3D(controller="steer", task=flight3d.turn(90.0))
+    flight = flight3d.Flight3D(controller="monarch", task=flight3d.turn(90.0))
     flight.step(4000)                                # 5 s at the default time step, 1/800 s
     print(flight.state()["position_m"])              # x forward at the start, y left, z up (m)
 
 A garden of butterflies visiting flowers::
 
-    garden = flight3d.Garden(20, "steer", seed=1)
+    garden = flight3d.Garden(20, "monarch", seed=1)
     garden.step(800)                                 # one second
 
 Evolve a controller of your own (``lifelike-mj butterfly evolve3d`` does the same)::
@@ -51,6 +51,7 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "Task3D": "tasks", "level": "tasks", "turn": "tasks", "course": "tasks", "moving_target": "tasks",
     "DRYDEN_VERTICAL_RATIO": "tasks", "new_record": "tasks",
     "Controller3D": "controllers", "load_controller": "controllers", "controller_from_dict": "controllers",
+    "withdrawn_file": "controllers", "WITHDRAWN": "controllers",
     "OBS_NAMES": "controllers", "ACTION_NAMES": "controllers", "N_OBS": "controllers", "N_ACT": "controllers",
     "n_weights": "controllers",
     "Batch": "loop", "TUMBLE_RAD": "loop",

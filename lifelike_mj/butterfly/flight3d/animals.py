@@ -3,7 +3,7 @@
 * ``"swallowtail"``: the paper's swallowtail (Oe et al. 2010): 0.319 g, each wing one planform-2 triangle
   (eq. 3: chord ``W r / L`` at span ``r``; ``L`` 5.5 cm, ``W`` 5.0 cm), fore and hind wing merged, the stroke
   plane the body's transverse plane; the parts' masses in the proportions of a tree nymph (*Idea leuconoe*).
-  The model file ``models/butterfly/butterfly3d.xml`` as it is. The shipped controllers ``steer`` and ``wind`` were
+  The model file ``models/butterfly/butterfly3d.xml`` as it is. The controllers ``steer`` and ``wind`` (withdrawn) were
   evolved on it, and the reduction to the planar paper model uses it.
 * ``"monarch"``: the monarch (*Danaus plexippus*), one species for outline, masses and kinematics, all from
   the morphology and free-flight fit of the FWUAV group's monarch (Tejaswi, Sridhar, Lee et al.;

@@ -10,7 +10,7 @@ Observation (:data:`OBS_NAMES`; SI units, in the heading frame: forward, left, u
 roll, pitch, heading error (reference less yaw, wrapped to ``(-pi, pi]``), the thorax's angular
 velocity (roll, pitch, yaw rates in its own axes), forward-speed error, sideways speed, climb rate and
 altitude error (clipped to +-1 m). A controller's ``inputs`` say what the forward and sideways speeds are
-measured against: ``"ground"`` (the shipped ``steer`` and ``monarch``) or ``"air"`` (the air around the
+measured against: ``"ground"`` (the shipped ``monarch``) or ``"air"`` (the air around the
 butterfly, wind and gusts included, as a butterfly's antennae sense it; the speed reference is then an air
 speed). The climb rate and the altitude are always the ground's.
 
@@ -297,9 +297,44 @@ def controller_from_dict(data: object, name: str = "") -> Controller3D:
                         d.get("animal", "swallowtail"), d.get("force_law", "exact"), d.get("modes"))
 
 
+#: Controllers once shipped and withdrawn, and why: on 100 random calm courses (``benchmarks/courses_3d.py``) each
+#: rolled or pitched past 90 deg at least once, which no shipped controller may. The files of ``steer`` and ``wind``
+#: are kept in the repository (:data:`WITHDRAWN_DIR`), loadable by path.
+WITHDRAWN = {
+    "cruise": "it fell on 31 and tumbled on 33 of 100 random calm courses",
+    "steer": "it tumbled (rolled or pitched past 90 degrees) on 62 of 100 random calm courses",
+    "wind": "it tumbled on 1 of 100 random calm courses",
+}
+#: Where the repository keeps the withdrawn controllers' files (relative to its root).
+WITHDRAWN_DIR = "benchmarks/results/withdrawn"
+
+
+def withdrawn_file(name: str):
+    """The kept file (a :class:`~pathlib.Path`) of the withdrawn controller ``name`` (``steer`` or ``wind``), in a
+    checkout of the repository (:data:`WITHDRAWN_DIR`; a wheel does not carry them): for benchmarks and tests that
+    reproduce their numbers."""
+    from lifelike_mj.errors import UserError
+    from lifelike_mj.paths import controllers_dir
+
+    path = controllers_dir().parent / WITHDRAWN_DIR / f"{name}.json"
+    if not path.is_file():
+        raise UserError(f"no withdrawn 3D controller file {name!r} here ({WITHDRAWN_DIR} is in a checkout of the "
+                        "repository only).")
+    return path
+
+
 def load_controller(name_or_path) -> Controller3D:
-    """A shipped 3D controller by name (``controllers/butterfly3d/``) or any 3D controller file by path."""
+    """A shipped 3D controller by name (``controllers/butterfly3d/``) or any 3D controller file by path. A withdrawn
+    controller's name (:data:`WITHDRAWN`) gets a :class:`~lifelike_mj.errors.UserError` that says why."""
+    from pathlib import Path
+
+    from lifelike_mj.errors import UserError
     from lifelike_mj.paths import load_named_json
 
+    text = str(name_or_path)
+    if text in WITHDRAWN and not Path(text).exists():
+        kept = (f"its file is kept in the repository, {WITHDRAWN_DIR}/{text}.json (load it by path)"
+                if text != "cruise" else "its file is in the repository's history")
+        raise UserError(f"the 3D controller {text!r} was withdrawn: {WITHDRAWN[text]}; use 'monarch', or {kept}.")
     data, path = load_named_json("butterfly3d", name_or_path, "3D controller")
     return controller_from_dict(data, path.stem)

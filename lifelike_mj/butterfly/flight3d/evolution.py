@@ -362,9 +362,17 @@ TASK_SETS = {
                        *_landings()),
     # a landing behaviour's (evolve3d --mode land; with --take-off, a take-off's): six flowers all round the start,
     # three near (0.9-1.4 m) and three far (2.7-3.5 m, reached at cruising speed), from 0.15 m below to 0.2 m above it
-    "landings": lambda: _landings(((1.2, 0.3, -0.15), (0.7, -0.6, 0.05), (-0.8, 0.6, 0.0), (2.5, 1.0, -0.1),
-                                   (-1.5, -2.5, 0.1), (3.5, -0.5, 0.2))),
+    "landings": lambda: _landings(_LANDING_POINTS),
+    # the same and six more all round, 1.0-3.4 m away, from 0.25 m below to 0.3 m above: twice the flowers, for a
+    # landing that must not learn six approaches by heart
+    "landings12": lambda: _landings(_LANDING_POINTS + ((-0.3, -1.0, -0.25), (1.0, 1.2, 0.25), (-2.2, -0.4, -0.2),
+                                                        (0.5, 2.8, 0.15), (2.0, -2.2, -0.05), (-3.0, 1.5, 0.3))),
 }
+
+
+#: The ``landings`` set's flowers' landing surfaces (m).
+_LANDING_POINTS = ((1.2, 0.3, -0.15), (0.7, -0.6, 0.05), (-0.8, 0.6, 0.0), (2.5, 1.0, -0.1), (-1.5, -2.5, 0.1),
+                   (3.5, -0.5, 0.2))
 
 
 def _landings(points=((1.2, 0.3, -0.15), (0.7, -0.6, 0.05), (0.4, 1.0, -0.3))) -> tuple[Task3D, ...]:

@@ -17,7 +17,7 @@ or any callable ``controller(flight) -> KinematicsCommand | None``, called from 
 ``control_every``-th step (``None``: keep the command)::
 
     from lifelike_mj.butterfly.flight3d import turn
-    Flight3D(controller="steer", task=turn(90.0)).step(6000)
+    Flight3D(controller="monarch", task=turn(90.0)).step(6000)
 
 World frame: x forward at the start, y to the left, z up; the body's pitch is nose-up positive, its roll
 right-wing-down positive, its yaw to the left positive.

@@ -120,7 +120,7 @@ class Garden(StepCounter):
     """
 
     @checks.known_keywords
-    def __init__(self, n: int = 20, controller="steer", *, seed: int = 0, n_flowers: int = 10, size_m: float = 6.0,
+    def __init__(self, n: int = 20, controller="monarch", *, seed: int = 0, n_flowers: int = 10, size_m: float = 6.0,
                  speed_m_s: float = 1.5, flutter: float = 0.1, gust_m_s: float = 0.0, wind_to_m_s=None,
                  gust_vertical_m_s: float | None = None, dt_s: float = DT_S, n_strips: int = 8, n_chord: int = 2,
                  force_law: str | None = None, wind_from_m_s=None, wind_m_s=None, land: bool | None = None) -> None:

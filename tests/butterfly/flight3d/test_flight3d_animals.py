@@ -237,7 +237,7 @@ def test_a_controller_carries_its_butterfly_through_its_file_and_into_a_flight(t
     f = flight3d.Flight3D(controller=tmp_path / "m.json")
     assert f.animal == "monarch"
     assert f.model.body_subtreemass[1] == pytest.approx(MONARCH.mass_kg, rel=1e-12)
-    steer = flight3d.Flight3D(controller="steer")
+    steer = flight3d.Flight3D(controller=flight3d.withdrawn_file("steer"))
     assert steer.animal == "swallowtail" and steer.model.body_subtreemass[1] == pytest.approx(0.319e-3, rel=1e-9)
     assert data["force_law"] == "exact" and f.options["force_law"] == "exact"
     qs = dict(data, force_law="quasi_steady")

@@ -56,7 +56,7 @@ def test_the_observation_is_relative_to_the_reference():
 
 
 def test_air_inputs_fly_as_ground_inputs_in_still_air_and_differently_in_wind():
-    ctl = flight3d.load_controller("steer")
+    ctl = flight3d.load_controller(flight3d.withdrawn_file("steer"))
     air = ctl.with_weights(ctl.weights, inputs="air")
     assert air.air_inputs and not ctl.air_inputs and air.to_dict()["inputs"] == "air"
     calm, windy = flight3d.course(100), flight3d.course(100).with_weather((0.0, 1.0, 0.0))
@@ -231,8 +231,8 @@ def test_a_moving_target_is_aimed_at_where_it_is_now():
 
 def test_a_folder_named_like_a_shipped_controller_does_not_hide_it(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    (tmp_path / "wind").mkdir()
-    assert flight3d.load_controller("wind").inputs == "air"  # the shipped file, not the folder
+    (tmp_path / "monarch").mkdir()
+    assert flight3d.load_controller("monarch").animal == "monarch"  # the shipped file, not the folder
     (tmp_path / "mine").mkdir()
     with pytest.raises(UserError, match="is a folder"):
         flight3d.load_controller("mine")

@@ -21,7 +21,7 @@ def test_flowers_and_courses_are_drawn_by_seed():
 
 def test_each_garden_butterfly_flies_what_its_own_flight_flies():
     """The garden's threaded batch gives every butterfly the flight a Flight3D on the same task gives it."""
-    ctl = flight3d.load_controller("wind")
+    ctl = flight3d.load_controller(flight3d.withdrawn_file("wind"))
     g = Garden(3, ctl, seed=2, flutter=0.1, gust_m_s=0.3)
     starts = [d.qpos[:7].copy() for d in g._datas]
     g.step(240)
@@ -49,7 +49,7 @@ def test_the_garden_films_and_its_frames_move(tmp_path):
 
     from lifelike_mj.butterfly.flight3d.garden import film_garden
 
-    g = Garden(4, "steer", seed=1)
+    g = Garden(4, flight3d.withdrawn_file("steer"), seed=1)
     info = film_garden(tmp_path / "g.gif", g, duration_s=0.3, fps=10, width=160, height=90, camera_name="chase")
     assert info["frames"] == 3
     frames = [np.asarray(f.convert("RGB"), dtype=float) for f in ImageSequence.Iterator(Image.open(tmp_path / "g.gif"))]
@@ -64,7 +64,7 @@ def test_a_garden_that_diverges_says_so_in_one_sentence():
 
     from lifelike_mj.errors import Diverged
 
-    g = Garden(2, "steer", seed=1, dt_s=1.0 / 200.0)
+    g = Garden(2, flight3d.withdrawn_file("steer"), seed=1, dt_s=1.0 / 200.0)
     g._phys.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
     with pytest.raises(Diverged, match=r"butterfly \d of the garden diverged at step \d+: .* time step \(0.005 s\)") as e:
         g.step(2000)

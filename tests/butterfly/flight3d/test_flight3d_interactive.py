@@ -18,7 +18,7 @@ def _fly(f, seconds):
 
 
 def test_a_new_altitude_course_and_wind_are_flown_to():
-    f = Flight3D(controller="wind", task=flight3d.level(1.5))
+    f = Flight3D(controller=flight3d.withdrawn_file("wind"), task=flight3d.level(1.5))
     _fly(f, 3.0)
     f.set_reference(altitude_m=1.0)
     assert f.reference == (0.0, 1.0, 1.5)
@@ -36,7 +36,7 @@ def test_a_new_altitude_course_and_wind_are_flown_to():
 
 
 def test_bad_references_are_refused():
-    f = Flight3D(controller="wind")
+    f = Flight3D(controller=flight3d.withdrawn_file("wind"))
     with pytest.raises(UserError, match="altitude_m"):
         f.set_reference(altitude_m=float("nan"))
     with pytest.raises(UserError, match="wind_to_m_s"):
@@ -50,14 +50,14 @@ def test_the_wind_is_named_by_its_meaning_and_the_old_name_still_works():
 
     from lifelike_mj.butterfly import flight3d
 
-    to = Flight3D(controller="wind", wind_to_m_s=(1.0, 0.5, 0.0))
-    fro = Flight3D(controller="wind", wind_from_m_s=(-1.0, -0.5, 0.0))
+    to = Flight3D(controller=flight3d.withdrawn_file("wind"), wind_to_m_s=(1.0, 0.5, 0.0))
+    fro = Flight3D(controller=flight3d.withdrawn_file("wind"), wind_from_m_s=(-1.0, -0.5, 0.0))
     assert to.task == fro.task and to.task.wind_from_m_s == (-1.0, -0.5, 0.0)
     to.step(600)
     fro.step(600)
     np.testing.assert_array_equal(to.state()["position_m"], fro.state()["position_m"])
     with pytest.warns(DeprecationWarning):
-        old = Flight3D(controller="wind", wind_m_s=(1.0, 0.5, 0.0))
+        old = Flight3D(controller=flight3d.withdrawn_file("wind"), wind_m_s=(1.0, 0.5, 0.0))
     assert old.task == to.task
     with pytest.warns(DeprecationWarning):
         assert old.wind_m_s.tolist() == [1.0, 0.5, 0.0]

@@ -81,7 +81,7 @@ def test_too_short_a_flight_is_one_sentence():
     with pytest.raises(UserError, match="whole wing beats"):
         M.measures(M.sample(f, 0.15), **M.body_numbers(f))
     with pytest.raises(UserError, match="at least"):
-        M.level_measures("steer", settle_s=5.0, window_s=0.1)
+        M.level_measures("monarch", settle_s=5.0, window_s=0.1)
     assert np.isfinite(M.body_numbers(f)["mass_kg"])
 
 
