@@ -201,7 +201,7 @@ def cmd_land3d(args) -> None:
         check_size(args.width, args.height, "panel")
     from lifelike_mj import checks
     from lifelike_mj.butterfly.flight3d.flight import DT_S
-    from lifelike_mj.butterfly.flight3d.landing import MAX_LANDING_S
+    from lifelike_mj.butterfly.flight3d.landing import MAX_LANDING_S, STILL_M
 
     checks.work(f"visiting {args.flowers} flowers, perched {args.perch:g} s on each",
                 (args.flowers - 1) * checks.steps_of(MAX_LANDING_S + args.perch, DT_S), checks.MAX_BODY_STEPS,
@@ -221,9 +221,11 @@ def cmd_land3d(args) -> None:
             img, what = landing_strobe(ctrl, blossoms[:2], width=args.width, height=args.height, land=landed)
         write_png(args.picture, img)
         out["picture"] = {"out": str(args.picture), **what}
-    ok = sum(v["within_bound"] and v["still"] for v in res["visits"])
+    ok = sum(v["within_bound"] and v["stayed"] for v in res["visits"])
+    still = sum(v["within_bound"] and v["still"] for v in res["visits"])
     emit(args, out, f"landed on {res['landed']} of {args.flowers - 1} flowers, {ok} within "
-                    f"{res['touchdown_bound_m_s']:g} m/s and still while perched"
+                    f"{res['touchdown_bound_m_s']:g} m/s and still on the blossom after {args.perch:g} s ({still} of "
+                    f"them moving less than {STILL_M * 1000:g} mm)"
                     + (f"; picture written to {args.picture}" if args.picture else ""))
 
 

@@ -25,14 +25,24 @@ MAX_LANDING_S, STILL_M = 20.0, 0.005
 SMOOTH_S = 0.005
 
 
+def on_blossom(thorax_m, blossom_m) -> bool:
+    """Whether a thorax at ``thorax_m`` (m) sits on the blossom centred at ``blossom_m``: within the blossom's radius
+    of its axis and above its centre (:data:`~lifelike_mj.butterfly.flight3d.flowers.BLOSSOM_SIZE_M`)."""
+    from lifelike_mj.butterfly.flight3d.flowers import BLOSSOM_SIZE_M
+
+    d = np.asarray(thorax_m, dtype=float) - np.asarray(blossom_m, dtype=float)
+    return bool(math.hypot(d[0], d[1]) <= BLOSSOM_SIZE_M[0] and d[2] > 0.0)
+
+
 def visit_flowers(controller, flowers, perch_s: float = 2.0, *, dt_s: float | None = None, record_every_s: float = 0.0,
                   ground_m: float | None = None) -> dict:
     """Fly ``controller`` (a 3D controller evolved to land) from perched on ``flowers[0]`` to each next flower in
     turn (``(n, 3)`` blossom centres, m), landing on each and perching ``perch_s`` s. Returns ``visits`` (one per
     flower after the first: ``flower``, ``landed``, ``flight_s`` (take-off to touchdown), ``touchdown_speed_m_s``,
-    ``within_bound`` (:data:`TOUCHDOWN_M_S`), ``perch_moved_m``, ``still`` (:data:`STILL_M`), ``tilt_max_deg`` (the
-    largest roll or pitch in flight)), ``landed`` (how many), and with ``record_every_s`` the path: ``t_s``,
-    ``position_m``, ``attitude_rad``, ``perched`` and the flight itself (``flight``)."""
+    ``within_bound`` (:data:`TOUCHDOWN_M_S`), ``perch_moved_m``, ``still`` (:data:`STILL_M`), ``stayed`` (still
+    perched on the blossom at the end: :func:`on_blossom`), ``tilt_max_deg`` (the largest roll or pitch in flight)),
+    ``landed`` (how many), and with ``record_every_s`` the path: ``t_s``, ``position_m``, ``attitude_rad``,
+    ``perched`` and the flight itself (``flight``)."""
     from lifelike_mj.butterfly.flight3d.flight import DT_S, Flight3D
 
     perch_s = checks.number("perch_s", perch_s, 0.0, 600.0, unit="s")
@@ -76,10 +86,11 @@ def visit_flowers(controller, flowers, perch_s: float = 2.0, *, dt_s: float | No
              "touchdown_speed_m_s": None if td is None else td["speed_m_s"],
              "within_bound": td is not None and td["speed_m_s"] <= TOUCHDOWN_M_S, "tilt_max_deg": math.degrees(tilt)}
         if td is None:
-            visits.append(v | {"perch_moved_m": None, "still": False})
+            visits.append(v | {"perch_moved_m": None, "still": False, "stayed": False})
             break
         _, moved = fly(int(round(perch_s / f.dt)))
-        visits.append(v | {"perch_moved_m": moved, "still": moved <= STILL_M and f.perched})
+        visits.append(v | {"perch_moved_m": moved, "still": moved <= STILL_M and f.perched,
+                           "stayed": f.perched and on_blossom(f.state()["position_m"], f.flowers[k])})
     out = {"visits": visits, "landed": sum(v["landed"] for v in visits), "flowers": n, "perch_s": perch_s,
            "touchdown_bound_m_s": TOUCHDOWN_M_S}
     if rec_every:

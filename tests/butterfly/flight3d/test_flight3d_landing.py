@@ -197,6 +197,16 @@ def test_a_landing_is_scored_by_its_touchdown_speed_or_how_near_and_slow_it_came
     assert landing_score(rec) == pytest.approx(0.5 + 0.5 * math.exp(-3.0))
 
 
+def test_a_thorax_is_on_the_blossom_within_its_radius_and_above_its_centre():
+    from lifelike_mj.butterfly.flight3d.landing import on_blossom
+
+    b = np.array(FLOWERS[1])
+    r = BLOSSOM_SIZE_M[0]
+    assert on_blossom(b + (0.0, 0.0, 0.02), b) and on_blossom(b + (0.99 * r, 0.0, 0.001), b)
+    assert not on_blossom(b + (0.0, 1.01 * r, 0.02), b)  # beside it
+    assert not on_blossom(b + (0.0, 0.0, -0.001), b)  # slid off, under it
+
+
 def test_a_landing_task_refuses_bad_input():
     with pytest.raises(UserError, match="two rows"):
         t3.Task3D("land", ((0, 0, 0, 0.01),))
