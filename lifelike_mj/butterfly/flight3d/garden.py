@@ -26,6 +26,7 @@ from lifelike_mj.butterfly.flight3d.controllers import Controller3D, load_contro
 from lifelike_mj.butterfly.flight3d.flight import DT_S
 from lifelike_mj.butterfly.flight3d.flowers import add_flowers, landing_surface, place_flowers
 from lifelike_mj.butterfly.flight3d.kinematics import Kinematics
+from lifelike_mj.butterfly.flight3d.landing import on_blossom
 from lifelike_mj.butterfly.flight3d.loop import Batch, attitude, take_off_kinematics
 from lifelike_mj.butterfly.flight3d.tasks import R_DIVERGED, R_PASSED, Task3D, new_record
 from lifelike_mj.errors import Diverged, UserError
@@ -228,16 +229,18 @@ class Garden(StepCounter):
             if perched and (not visits or visits[-1]["take_off_s"] is not None or visits[-1]["touchdown_s"] is None):
                 visits.append({"flower": self._orders[i][self._at[i] % COURSE_LENGTH],
                                "touchdown_s": float(rec[t3.R_LANDED_AT]),
-                               "touchdown_speed_m_s": float(rec[t3.R_TOUCH_SPEED]), "take_off_s": None})
+                               "touchdown_speed_m_s": float(rec[t3.R_TOUCH_SPEED]), "take_off_s": None,
+                               "stayed": None})
             ends = perched and t >= visits[-1]["touchdown_s"] + self._perch_s[i][self._at[i] % COURSE_LENGTH]
             gives_up = not perched and t - self._aim_since[i] > GIVE_UP_S
             if not (ends or gives_up):
                 continue
             if gives_up:
                 visits.append({"flower": self._orders[i][self._at[i] % COURSE_LENGTH], "touchdown_s": None,
-                               "touchdown_speed_m_s": None, "take_off_s": None})
+                               "touchdown_speed_m_s": None, "take_off_s": None, "stayed": None})
             else:
                 visits[-1]["take_off_s"] = t
+                visits[-1]["stayed"] = on_blossom(self._datas[i].qpos[0:3], self.blossoms[visits[-1]["flower"]])
                 t3.start_take_off(rec, t)
                 take_off_kinematics(self._datas[i].userdata, self._batch.base)
             self._at[i] += 1
@@ -251,7 +254,8 @@ class Garden(StepCounter):
     def visits(self) -> list[list[dict]]:
         """Each butterfly's visits so far, in order (a landing garden): ``flower`` (index into :attr:`blossoms`),
         ``touchdown_s`` and ``touchdown_speed_m_s`` (``None``: given up after :data:`GIVE_UP_S`), ``take_off_s``
-        (``None``: still perched)."""
+        (``None``: still perched), ``stayed`` (whether it was still on the blossom when it took off:
+        :func:`~lifelike_mj.butterfly.flight3d.landing.on_blossom`; ``None`` before)."""
         return [[dict(v) for v in vs] for vs in self._visits]
 
     def sync(self) -> None:

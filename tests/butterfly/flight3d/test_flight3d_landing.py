@@ -243,7 +243,7 @@ def test_a_landing_garden_logs_its_visits_and_gives_up_a_flower_it_cannot_reach(
     visits = g.visits()
     for i in range(2):
         assert visits[i][0] == {"flower": first[i], "touchdown_s": None, "touchdown_speed_m_s": None,
-                                "take_off_s": None}
+                                "take_off_s": None, "stayed": None}
         assert g._batch.tasks[i, t3.T_ROW0 : t3.T_ROW0 + 2] == pytest.approx(g.blossoms[g._orders[i][1], :2])
     assert not g.state()["perched"].any() and (g.state()["waypoints_passed"] == 0).all()
     g.reset()  # every butterfly aims at its first flower again
