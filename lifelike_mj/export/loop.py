@@ -92,8 +92,9 @@ def cut_loop(t: np.ndarray, pos: np.ndarray, quat: np.ndarray, period_s: float, 
         target = t[0] + n * period_s
         near = np.nonzero(np.abs(t - target) <= max(2.5 * dt, 0.1 * period_s))[0]
         k = int(min(near, key=mismatch)) if len(near) else int(np.argmin(np.abs(t - target)))
-        if best is None or mismatch(k) < best[0] - 1e-12:
-            best = (mismatch(k), k, n)
+        miss = mismatch(k)
+        if best is None or miss < best[0] - 1e-12:
+            best = (miss, k, n)
     _, end, beats = best
     travel = pos[end, root] - pos[0, root]
     u = ((t[: end + 1] - t[0]) / (t[end] - t[0]))[:, None, None]

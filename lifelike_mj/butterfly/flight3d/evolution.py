@@ -370,12 +370,13 @@ TASK_SETS = {
 }
 
 
-#: The ``landings`` set's flowers' landing surfaces (m).
+#: The landing surfaces (m) of the ``garden`` set's flowers and of the ``landings`` set's.
+_GARDEN_LANDING_POINTS = ((1.2, 0.3, -0.15), (0.7, -0.6, 0.05), (0.4, 1.0, -0.3))
 _LANDING_POINTS = ((1.2, 0.3, -0.15), (0.7, -0.6, 0.05), (-0.8, 0.6, 0.0), (2.5, 1.0, -0.1), (-1.5, -2.5, 0.1),
                    (3.5, -0.5, 0.2))
 
 
-def _landings(points=((1.2, 0.3, -0.15), (0.7, -0.6, 0.05), (0.4, 1.0, -0.3))) -> tuple[Task3D, ...]:
+def _landings(points=_GARDEN_LANDING_POINTS) -> tuple[Task3D, ...]:
     """Monarch landings on flowers whose landing surfaces are at ``points`` (m); by default the ``garden`` set's three,
     ahead, left and right, below and above the start, 0.9-1.4 m away."""
     from lifelike_mj.butterfly.flight3d.model import standing_height_m

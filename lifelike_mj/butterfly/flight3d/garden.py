@@ -227,17 +227,13 @@ class Garden(StepCounter):
             rec, visits = self._recs[i], self._visits[i]
             perched = int(tasks[i, t3.T_KIND]) == t3.TASK_PERCH
             if perched and (not visits or visits[-1]["take_off_s"] is not None or visits[-1]["touchdown_s"] is None):
-                visits.append({"flower": self._orders[i][self._at[i] % COURSE_LENGTH],
-                               "touchdown_s": float(rec[t3.R_LANDED_AT]),
-                               "touchdown_speed_m_s": float(rec[t3.R_TOUCH_SPEED]), "take_off_s": None,
-                               "stayed": None})
+                visits.append(self._new_visit(i, float(rec[t3.R_LANDED_AT]), float(rec[t3.R_TOUCH_SPEED])))
             ends = perched and t >= visits[-1]["touchdown_s"] + self._perch_s[i][self._at[i] % COURSE_LENGTH]
             gives_up = not perched and t - self._aim_since[i] > GIVE_UP_S
             if not (ends or gives_up):
                 continue
             if gives_up:
-                visits.append({"flower": self._orders[i][self._at[i] % COURSE_LENGTH], "touchdown_s": None,
-                               "touchdown_speed_m_s": None, "take_off_s": None, "stayed": None})
+                visits.append(self._new_visit(i))
             else:
                 visits[-1]["take_off_s"] = t
                 visits[-1]["stayed"] = on_blossom(self._datas[i].qpos[0:3], self.blossoms[visits[-1]["flower"]])
@@ -250,6 +246,11 @@ class Garden(StepCounter):
             tasks[i, t3.T_KIND] = t3.TASK_LAND
             rec[t3.R_LANDED_AT] = -1.0
             rec[t3.R_WP] = np.inf
+
+    def _new_visit(self, i: int, touchdown_s: float | None = None, speed_m_s: float | None = None) -> dict:
+        """A visit of butterfly ``i`` to the flower it aims at (:meth:`visits`' keys), not yet taken off from."""
+        return {"flower": self._orders[i][self._at[i] % COURSE_LENGTH], "touchdown_s": touchdown_s,
+                "touchdown_speed_m_s": speed_m_s, "take_off_s": None, "stayed": None}
 
     def visits(self) -> list[list[dict]]:
         """Each butterfly's visits so far, in order (a landing garden): ``flower`` (index into :attr:`blossoms`),

@@ -593,15 +593,13 @@ def build_model(params: ButterflyParams | None = None, masses: str = "animal", a
     return m
 
 
-def set_grip(m: mujoco.MjModel, prefix: str = "") -> None:
-    """Size the grip of the butterfly ``{prefix}butterfly`` of ``m`` (:func:`add_legs`; nothing without legs): its
-    full hold :data:`GRIP_BODY_WEIGHTS` times the butterfly's weight (N)."""
-    name = f"{prefix}grip"
-    if mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, name) < 0:
-        return
-    body = m.body(f"{prefix}butterfly").id
-    m.actuator(name).gainprm[0] = GRIP_BODY_WEIGHTS * float(m.body_subtreemass[body]) * float(
-        np.linalg.norm(m.opt.gravity))
+def set_grip(m: mujoco.MjModel) -> None:
+    """Size the grip of the butterfly of ``m`` (:func:`add_legs`; nothing without legs): its full hold
+    :data:`GRIP_BODY_WEIGHTS` times the butterfly's weight (N)."""
+    a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "grip")
+    if a >= 0:
+        weight = float(m.body_subtreemass[m.body("butterfly").id]) * float(np.linalg.norm(m.opt.gravity))
+        m.actuator_gainprm[a, 0] = GRIP_BODY_WEIGHTS * weight
 
 
 #: The legs' friction with what they stand on: sliding, torsional, rolling (a foot's claws grip).
