@@ -1,0 +1,62 @@
+"""How fast the filmed monarch's wing envelope can carry it (issue 27's speed): the base kinematics
+(``controllers.default_base("monarch")``: 120 deg strokes at 10.2 Hz) with the body held at a range of body angles.
+
+Run: ``python benchmarks/monarch_envelope.py`` (about a minute on 2 cores). Writes
+``benchmarks/results/monarch_envelope.json``.
+
+Each body angle: the attitude held (the reduction's hold, an outside torque: an envelope, not free flight), the
+quasi-steady wing-force law, from rest; after ``SETTLE_S`` the flight is measured over ``WINDOW_S``
+(``flight3d.measures``): the speed through the air, the mean vertical speed (climb > 0) and the drive's positive
+power per kg. A body angle whose vertical speed is at least 0 carries the weight at that speed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from lifelike_mj.butterfly.flight3d import measures as M
+from lifelike_mj.butterfly.flight3d.controllers import default_base
+from lifelike_mj.butterfly.flight3d.flight import Flight3D
+from lifelike_mj.io import write_json
+from lifelike_mj.machine import machine_info
+from lifelike_mj.provenance import provenance
+
+BODY_ANGLES_DEG = (20.0, 10.0, 0.0, -10.0, -20.0)
+SETTLE_S, WINDOW_S = 2.0, 2.0
+
+
+def point(pitch_deg: float, law: str = "quasi_steady") -> dict:
+    f = Flight3D(default_base("monarch"), animal="monarch", force_law=law, assist="hold",
+                 pitch_law=lambda _f: math.radians(pitch_deg))
+    f.step(int(round(SETTLE_S / f.dt)))
+    s = M.sample(f, WINDOW_S)
+    m = M.measures(s, **M.body_numbers(f))
+    vz = float(np.gradient(s["position_m"][:, 2], s["t_s"]).mean())
+    return {"body_angle_deg": pitch_deg, "force_law": law, "air_speed_m_s": m["air_speed_m_s"],
+            "vertical_speed_m_s": vz, "power_W_kg": m["power_W_kg"], "flap_frequency_hz": m["flap_frequency_hz"],
+            "stroke_deg": 0.5 * (m["stroke_left_deg"] + m["stroke_right_deg"])}
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "monarch_envelope.json"))
+    args = ap.parse_args(argv)
+    start = time.perf_counter()
+    points = []
+    for a in BODY_ANGLES_DEG:
+        points.append(point(a))
+        p = points[-1]
+        print(f"body {a:+5.0f} deg: U {p['air_speed_m_s']:.2f} m/s, vz {p['vertical_speed_m_s']:+.2f} m/s, "
+              f"{p['power_W_kg']:.1f} W/kg", flush=True)
+    write_json(args.out, {"provenance": provenance(benchmark="monarch_envelope", settle_s=SETTLE_S, window_s=WINDOW_S,
+                                                   body_angles_deg=list(BODY_ANGLES_DEG)),
+                          "machine": machine_info(), "wall_time_s": time.perf_counter() - start, "points": points})
+
+
+if __name__ == "__main__":
+    main()
