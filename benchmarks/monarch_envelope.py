@@ -14,32 +14,28 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
-from lifelike_mj.butterfly.flight3d import measures as M
 from lifelike_mj.butterfly.flight3d.controllers import default_base
-from lifelike_mj.butterfly.flight3d.flight import Flight3D
 from lifelike_mj.io import write_json
 from lifelike_mj.machine import machine_info
 from lifelike_mj.provenance import provenance
+
+sys.path.insert(0, str(Path(__file__).parent))
+import monarch_power  # noqa: E402  (the sibling benchmark's grid point)
 
 BODY_ANGLES_DEG = (20.0, 10.0, 0.0, -10.0, -20.0)
 SETTLE_S, WINDOW_S = 2.0, 2.0
 
 
-def point(pitch_deg: float, law: str = "quasi_steady") -> dict:
-    f = Flight3D(default_base("monarch"), animal="monarch", force_law=law, assist="hold",
-                 pitch_law=lambda _f: math.radians(pitch_deg))
-    f.step(int(round(SETTLE_S / f.dt)))
-    s = M.sample(f, WINDOW_S)
-    m = M.measures(s, **M.body_numbers(f))
-    vz = float(np.gradient(s["position_m"][:, 2], s["t_s"]).mean())
-    return {"body_angle_deg": pitch_deg, "force_law": law, "air_speed_m_s": m["air_speed_m_s"],
-            "vertical_speed_m_s": vz, "power_W_kg": m["power_W_kg"], "flap_frequency_hz": m["flap_frequency_hz"],
-            "stroke_deg": 0.5 * (m["stroke_left_deg"] + m["stroke_right_deg"])}
+def point(pitch_deg: float) -> dict:
+    """The filmed envelope (its frequency, stroke and feathering: ``default_base("monarch")``) with the body held at
+    ``pitch_deg``: ``monarch_power.point`` over this benchmark's window."""
+    base = default_base("monarch")
+    return monarch_power.point("quasi_steady", base.frequency_hz, math.degrees(base.amplitude_left), pitch_deg,
+                               base.feather_amplitude_left, settle_s=SETTLE_S, window_s=WINDOW_S)
 
 
 def main(argv=None) -> None:

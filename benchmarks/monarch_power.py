@@ -41,12 +41,14 @@ SETTLE_S, WINDOW_S = 1.0, 0.6
 LEVEL_M_S = -0.1
 
 
-def point(law: str, f: float, amp: float, pitch: float, feather: float) -> dict:
+def point(law: str, f: float, amp: float, pitch: float, feather: float, settle_s: float = SETTLE_S,
+          window_s: float = WINDOW_S) -> dict:
+    """One grid point (module docstring): the flight measured over ``window_s`` after ``settle_s``."""
     cmd = replace(default_base("monarch"), frequency_hz=f, amplitude_left=math.radians(amp),
                   amplitude_right=math.radians(amp), feather_amplitude_left=feather, feather_amplitude_right=feather)
     fl = Flight3D(cmd, animal="monarch", force_law=law, assist="hold", pitch_law=lambda _f: math.radians(pitch))
-    fl.step(int(round(SETTLE_S / fl.dt)))
-    s = M.sample(fl, WINDOW_S)
+    fl.step(int(round(settle_s / fl.dt)))
+    s = M.sample(fl, window_s)
     m = M.measures(s, **M.body_numbers(fl))
     vz = float(np.gradient(s["position_m"][:, 2], s["t_s"]).mean())
     return {"force_law": law, "frequency_hz": f, "amplitude_deg": amp, "pitch_deg": pitch, "feather_rad": feather,
