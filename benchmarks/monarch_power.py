@@ -53,7 +53,7 @@ def point(law: str, f: float, amp: float, pitch: float, feather: float, settle_s
     vz = float(np.gradient(s["position_m"][:, 2], s["t_s"]).mean())
     return {"force_law": law, "frequency_hz": f, "amplitude_deg": amp, "pitch_deg": pitch, "feather_rad": feather,
             "air_speed_m_s": m["air_speed_m_s"], "vertical_speed_m_s": vz, "power_W_kg": m["power_W_kg"],
-            "power_net_W_kg": m["power_net_W_kg"], "carries_weight": vz >= LEVEL_M_S}
+            "power_net_W_kg": m["power_net_W_kg"], "advance_ratio": m["advance_ratio"], "carries_weight": vz >= LEVEL_M_S}
 
 
 def main(argv=None) -> None:
