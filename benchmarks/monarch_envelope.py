@@ -6,8 +6,8 @@ Run: ``python benchmarks/monarch_envelope.py`` (about a minute on 2 cores). Writ
 
 Each body angle: the attitude held (the reduction's hold, an outside torque: an envelope, not free flight), the
 quasi-steady wing-force law, from rest; after ``SETTLE_S`` the flight is measured over ``WINDOW_S``
-(``flight3d.measures``): the speed through the air, the mean vertical speed (climb > 0) and the drive's positive
-power per kg. A body angle whose vertical speed is at least 0 carries the weight at that speed.
+(``flight3d.measures``), as ``monarch_power.point`` measures a grid point: the speed through the air, the mean
+vertical speed (climb > 0), the drive's positive power per kg and the advance ratio over both wings.
 """
 
 from __future__ import annotations
