@@ -100,7 +100,7 @@ def cmd_evolve3d(args) -> None:
     from lifelike_mj.butterfly.flight3d.evolution import TASK_SETS, evolve
 
     check_executor(args)
-    layers = [10, *args.hidden, 9]
+    layers = [11 if args.speed_input else 10, *args.hidden, 9]
     start = load_controller(args.start) if args.start else None
     if start is not None and args.hidden:
         raise UserError("--hidden does not apply with --start (the network is the start controller's).")
@@ -115,7 +115,7 @@ def cmd_evolve3d(args) -> None:
                        overwrite=args.overwrite, task_set=args.tasks, start=start, gene_bound=args.gene_bound,
                        inputs=args.inputs, executor=args.executor, workers=args.workers, ray_address=args.ray_address,
                        dt_s=args.dt, animal=args.animal, natural=args.natural, force_law=args.force_law,
-                       take_off=args.take_off, mode=args.mode, reach=args.reach)
+                       take_off=args.take_off, mode=args.mode, reach=args.reach, speed_input=args.speed_input)
     if ctrl is None:
         raise KeyboardInterrupt("stopped before the first generation was evaluated; nothing was written")
     state = "stopped early (Ctrl-C); best so far" if res.interrupted else "done"
@@ -361,6 +361,9 @@ def add_commands(bf) -> None:
     p.add_argument("--natural", action="store_true",
                    help="also ask the flight to look like a butterfly's: level wings and even strokes in straight "
                         "flight, a dorsal gap of 35-50 deg, at most 20.2 W/kg, the body angle falling with speed")
+    p.add_argument("--speed-input", action="store_true",
+                   help="the network also sees the forward speed asked, so that it can trim for it (with --start: the "
+                        "start's networks gain that input, its weights starting at zero)")
     p.add_argument("--take-off", action="store_true",
                    help="every training flight starts perched on a flower, its wings closed, and takes off clapping")
     p.add_argument("--mode", default=None, choices=("land", "take_off"),

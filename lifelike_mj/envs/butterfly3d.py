@@ -37,12 +37,19 @@ MAX_SPEED_M_S = 2.0e3
 
 
 def _observation_space() -> spaces.Box:
-    """Angles within [-pi, pi], rates and speeds within their bounds, the altitude error within its clip."""
+    """Angles within [-pi, pi], rates and speeds (the speed asked among them) within their bounds, the altitude error
+    within its clip."""
     from lifelike_mj.butterfly.flight3d.controllers import ALTITUDE_CLIP_M
 
     pi, w, v = math.pi, MAX_RATE_RAD_S, MAX_SPEED_M_S
-    lo = np.array([-pi, -pi, -pi, -w, -w, -w, -v, -v, -v, -ALTITUDE_CLIP_M])
+    lo = np.array([-pi, -pi, -pi, -w, -w, -w, -v, -v, -v, -ALTITUDE_CLIP_M, -v])
     return spaces.Box(lo, -lo, (flight3d.N_OBS,), dtype=np.float64)
+
+
+def _still_controller() -> flight3d.Controller3D:
+    """A linear controller of zeros on every observation: the base command as it is (the actions come from outside)."""
+    return flight3d.Controller3D([flight3d.N_OBS, flight3d.N_ACT], np.zeros(flight3d.n_weights([flight3d.N_OBS,
+                                                                                                flight3d.N_ACT])))
 
 
 class ButterflyFlight3DEnv(Drawn, gym.Env):
@@ -153,7 +160,7 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
                                    checks.MAX_BODY_STEPS, "time steps")
         ctl = controller if isinstance(controller, flight3d.Controller3D) else (
             flight3d.load_controller(controller) if controller is not None else
-            flight3d.Controller3D([flight3d.N_OBS, flight3d.N_ACT], np.zeros(flight3d.n_weights([10, 9]))))
+            _still_controller())
         if every is not None or inputs is not None or animal is not None:
             ctl = ctl.replace(every=ctl.every if every is None else every, inputs=inputs or ctl.inputs,
                               animal=animal or ctl.animal)
@@ -405,6 +412,6 @@ def network_controller3d(layers: list[tuple[np.ndarray, np.ndarray]], template: 
         for j in range(w.shape[0]):
             flat.extend(w[j].tolist())
             flat.append(float(b[j]))
-    t = template or flight3d.Controller3D([flight3d.N_OBS, flight3d.N_ACT], np.zeros(flight3d.n_weights([10, 9])))
+    t = template or _still_controller()
     return flight3d.Controller3D(sizes, flat, t.base, dict(zip(flight3d.ACTION_NAMES, t.scale)), t.every,
                                  t.omega_c_rad_s, provenance, "", t.inputs)

@@ -61,7 +61,7 @@ CASES = [
     (FLY3D, "layers[1] must be a whole number from 1 to 256, got 257", {"c.json": c3(layers=[10, 257, 9])}),
     (FLY3D, "layers must have 2 to 6 whole numbers, got 7", {"c.json": c3(layers=[10, 4, 4, 4, 4, 4, 9])}),
     (FLY3D, "layers must be a list, got '10,9'", {"c.json": c3(layers="10,9")}),
-    (FLY3D, "layers must be whole numbers running from 10 inputs to 9 outputs", {"c.json": c3(layers=[6, 1])}),
+    (FLY3D, "layers must be whole numbers running from 10 or 11 inputs to 9 outputs", {"c.json": c3(layers=[6, 1])}),
     (FLY3D, "must be a number in [-1e+06, 1e+06], got 1e+308", {"c.json": c3(weights=[1e308] * 99)}),
     (FLY3D, "must be a number in [-1e+06, 1e+06], got inf",
      {"c.json": json.dumps(c3()).replace('"weights": [', '"weights": [1e999, ', 1)}),

@@ -90,7 +90,7 @@ def test_a_trained_network_leaves_the_env_as_a_controller_file_fly3d_flies(tmp_p
     """A policy of NetworkInputs3D -> tanh layers -> NetworkActions3D is written out by network_controller3d; the
     controller flies the same flight (same rewards) as the policy in the env."""
     rng = np.random.default_rng(3)
-    shapes = [(16, 10), (9, 16)]
+    shapes = [(16, flight3d.N_OBS), (9, 16)]
     layers = [(0.3 * rng.standard_normal(s), 0.1 * rng.standard_normal(s[0])) for s in shapes]
 
     def policy(x):  # numpy stand-in for a trained torch actor: tanh hidden layer, linear mean

@@ -8,8 +8,12 @@ points at the next waypoint). The network never sees where it is, only how far i
 
 Observation (:data:`OBS_NAMES`; SI units, in the heading frame: forward, left, up):
 roll, pitch, heading error (reference less yaw, wrapped to ``(-pi, pi]``), the thorax's angular
-velocity (roll, pitch, yaw rates in its own axes), forward-speed error, sideways speed, climb rate and
-altitude error (clipped to +-1 m). A controller's ``inputs`` say what the forward and sideways speeds are
+velocity (roll, pitch, yaw rates in its own axes), forward-speed error, sideways speed, climb rate,
+altitude error (clipped to +-1 m) and the forward speed asked (the reference's own speed, m/s). A network has
+either the first ten inputs (the shipped ``monarch``) or all eleven: a network that also sees the speed asked can set
+its trim for that speed (a lower body for a faster flight, as a butterfly's body angle falls with its speed;
+Dudley 1990) instead of holding it off by a speed error, which a network without memory must keep to trim
+differently. A controller's ``inputs`` say what the forward and sideways speeds are
 measured against: ``"ground"`` (the shipped ``monarch``) or ``"air"`` (the air around the
 butterfly, wind and gusts included, as a butterfly's antennae sense it; the speed reference is then an air
 speed). The climb rate and the altitude are always the ground's.
@@ -21,7 +25,7 @@ command: the wings' stroke offset and amplitude, both wings alike (``sym``) and 
 and the flap frequency. The kinematics follow each
 new command smoothly (the filter of :mod:`~lifelike_mj.butterfly.flight3d.kinematics`).
 
-Networks: ``layers = [10, ..., 9]``, hidden neurons ``tanh``; ``[10, 9]`` is a linear policy.
+Networks: ``layers = [10 or 11, ..., 9]``, hidden neurons ``tanh``; ``[10, 9]`` and ``[11, 9]`` are linear policies.
 
 Behaviours (:data:`MODES`): beside its flight network a controller may carry networks of the same shape for the parts
 of a flight that ask for another way of flying, as an animal's motor patterns change between cruising, landing and
@@ -36,15 +40,17 @@ import math
 import numpy as np
 
 OBS_NAMES = ("roll_rad", "pitch_rad", "heading_error_rad", "roll_rate_rad_s", "pitch_rate_rad_s",
-             "yaw_rate_rad_s", "speed_error_m_s", "sideways_m_s", "climb_m_s", "altitude_error_m")
+             "yaw_rate_rad_s", "speed_error_m_s", "sideways_m_s", "climb_m_s", "altitude_error_m", "speed_ref_m_s")
 ACTION_NAMES = ("offset_sym", "offset_asym", "amplitude_sym", "amplitude_asym", "feather_sym", "feather_asym",
                 "feather_amplitude", "abdomen_mean", "frequency")
 N_OBS, N_ACT = len(OBS_NAMES), len(ACTION_NAMES)
+#: How many inputs a network may have: the first ten observations, or all of them (module docstring).
+INPUT_COUNTS = (N_OBS - 1, N_OBS)
 #: Altitude errors beyond this (m) are seen as this.
 ALTITUDE_CLIP_M = 1.0
 #: What the network's inputs are divided by (the observation's units): angles by 1 rad, rates by 10 rad/s,
 #: speeds by 1 m/s, the altitude error by 0.5 m, so that every input is of order one in flight.
-INPUT_SCALE = np.array([1.0, 1.0, 1.0, 10.0, 10.0, 10.0, 1.0, 1.0, 1.0, 0.5])
+INPUT_SCALE = np.array([1.0, 1.0, 1.0, 10.0, 10.0, 10.0, 1.0, 1.0, 1.0, 0.5, 1.0])
 
 def n_weights(layers) -> int:
     """How many weights a network of ``layers`` has (biases included)."""
@@ -124,9 +130,10 @@ class Controller3D:
         except TypeError:
             given = None
         ok = (given is not None and 2 <= len(given) <= MAX_LAYERS and all(checks.is_whole(v) for v in given)
-              and given[0] == N_OBS and given[-1] == N_ACT and all(1 <= v <= MAX_WIDTH for v in given))
+              and given[0] in INPUT_COUNTS and given[-1] == N_ACT and all(1 <= v <= MAX_WIDTH for v in given))
         if not ok:
-            raise UserError(f"{where}: layers must be whole numbers running from {N_OBS} inputs to {N_ACT} outputs, "
+            raise UserError(f"{where}: layers must be whole numbers running from {INPUT_COUNTS[0]} or {INPUT_COUNTS[1]} "
+                            f"inputs to {N_ACT} outputs, "
                             f"at most {MAX_LAYERS} layers of at most {MAX_WIDTH} neurons, got {layers!r}.")
         layers = [int(v) for v in given]
         self.layers = np.array(layers, dtype=np.int64)
@@ -213,6 +220,29 @@ class Controller3D:
         kw.update(changes)
         return Controller3D(**kw)
 
+    @property
+    def sees_speed_asked(self) -> bool:
+        """Whether the networks have the eleventh input, the forward speed asked (module docstring)."""
+        return int(self.layers[0]) == N_OBS
+
+    def with_speed_input(self) -> Controller3D:
+        """The same controller whose networks also see the forward speed asked (the eleventh observation), each
+        first-layer neuron's weight on it zero: it flies exactly as before until those weights change. A controller
+        that sees it already is returned as it is."""
+        if self.sees_speed_asked:
+            return self
+        n_in = int(self.layers[0])
+        first = (n_in + 1) * int(self.layers[1])
+
+        def padded(w):
+            rows = np.asarray(w[:first]).reshape(int(self.layers[1]), n_in + 1)
+            rows = np.concatenate([rows[:, :n_in], np.zeros((len(rows), 1)), rows[:, n_in:]], axis=1)
+            return np.concatenate([rows.reshape(-1), w[first:]])
+
+        modes = {k: {**m, "weights": padded(m["weights"])} for k, m in self.modes.items()}
+        return self.replace(layers=[N_OBS, *[int(v) for v in self.layers[1:]]], weights=padded(self.weights),
+                            modes=modes)
+
     def with_weights(self, weights, inputs: str | None = None) -> Controller3D:
         """The same controller with other weights of its flight network (and, given ``inputs``, other inputs)."""
         return self.replace(weights=weights, inputs=inputs or self.inputs)
@@ -249,7 +279,8 @@ def json_schema() -> dict:
     props = {
         "layers": {"type": "array", "minItems": 2, "maxItems": MAX_LAYERS,
                    "items": {"type": "integer", "minimum": 1, "maximum": MAX_WIDTH},
-                   "description": f"neurons per layer, from the {N_OBS} observations to the {N_ACT} actions"},
+                   "description": f"neurons per layer, from the first {INPUT_COUNTS[0]} observations or all "
+                                  f"{N_OBS} to the {N_ACT} actions"},
         "weights": {"type": "array", "maxItems": max_weights, "items": number("", -MAX_WEIGHT, MAX_WEIGHT),
                     "description": "per layer, per neuron: its input weights, then its bias"},
         "base": KinematicsCommand.json_schema(),

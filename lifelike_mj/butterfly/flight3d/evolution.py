@@ -397,7 +397,7 @@ def pd_prior(layers, animal: str = "swallowtail") -> np.ndarray:
         return w
 
     def at(action, obs):
-        return c3.ACTION_NAMES.index(action) * (c3.N_OBS + 1) + c3.OBS_NAMES.index(obs)
+        return c3.ACTION_NAMES.index(action) * (layers[0] + 1) + c3.OBS_NAMES.index(obs)
 
     if animal == "monarch":
         w[at("offset_sym", "pitch_rad")] = 3.0
@@ -417,7 +417,7 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
            inputs: str | None = None, executor: str = "serial", workers: int | None = None,
            ray_address: str | None = None, dt_s: float = DT_S, animal: str | None = None, natural: bool = False,
            force_law: str | None = None, take_off: bool = False, mode: str | None = None,
-           reach: float | None = None):
+           reach: float | None = None, speed_input: bool = False):
     """Evolve a 3D controller on ``tasks`` (default: the ``steer`` set) with ``optimizer`` and write it to
     ``out`` with its provenance (the problem, the optimiser, the budget, the time it took, the fitness
     history). Returns ``(result, controller)``; nothing is overwritten unasked (the checks and locks of the
@@ -438,7 +438,11 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     starts perched on a flower and takes off (:class:`FlightProblem3D`). ``mode``: evolve the start's behaviour network
     of that name (:data:`~lifelike_mj.butterfly.flight3d.controllers.MODES`; it starts from the start's own, else
     from its flight network) with the reach ``reach`` (m or s; default: the start's, else
-    :data:`~lifelike_mj.butterfly.flight3d.controllers.MODE_REACH`); its other networks fly as they are."""
+    :data:`~lifelike_mj.butterfly.flight3d.controllers.MODE_REACH`); its other networks fly as they are.
+    ``speed_input``: the networks also see the forward speed asked (the eleventh observation of
+    :mod:`~lifelike_mj.butterfly.flight3d.controllers`): a new controller's ``layers`` then start at 11, a start's
+    networks gain the input with zero weights (:meth:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D.
+    with_speed_input`)."""
     from lifelike_mj import provenance as _prov
     from lifelike_mj.evolve import make_evaluator, optimize
     from lifelike_mj.evolve.checkpoint import guarded_run_files
@@ -454,17 +458,19 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
         raise UserError(f"evolving the {mode} behaviour needs a controller to start from, whose flight network flies "
                         "the rest.")
     if start is not None:
-        template = start
-        layers = [int(v) for v in start.layers]
+        template = start.with_speed_input() if speed_input else start
+        layers = [int(v) for v in template.layers]
         if inputs is not None or animal is not None or force_law is not None:
-            template = start.replace(inputs=inputs or start.inputs, animal=animal or start.animal,
-                                     force_law=force_law or start.force_law)
+            template = template.replace(inputs=inputs or start.inputs, animal=animal or start.animal,
+                                        force_law=force_law or start.force_law)
         if mode is not None:
             template = template.with_mode(mode, template.mode_weights(mode), reach)
     else:
         layers = [int(v) for v in layers]
+        if speed_input and layers:
+            layers[0] = c3.N_OBS
         animal = animal or "swallowtail"
-        template = c3.Controller3D(layers, pd_prior(layers, animal) if len(layers) >= 2 and layers[0] == c3.N_OBS
+        template = c3.Controller3D(layers, pd_prior(layers, animal) if len(layers) >= 2 and layers[0] in c3.INPUT_COUNTS
                                    else [], c3.default_base(animal), inputs=inputs or "ground", animal=animal,
                                    force_law=force_law or "exact")
     problem = FlightProblem3D(tuple(tasks), template, duration_s=duration_s, gene_bound=gene_bound, dt_s=dt_s,

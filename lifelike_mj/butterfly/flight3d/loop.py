@@ -89,8 +89,9 @@ def attitude(q):
 
 @njit(cache=True)
 def observe(qpos, qvel, heading, altitude, speed, air, obs, pitch_ref=0.0):
-    """The observation (module docstring) of the free body whose root is at ``qpos[0:7]``, ``qvel[0:6]``,
-    against the reference ``heading`` (rad), ``altitude`` (m) and forward ``speed`` (m/s). The forward and
+    """The observation (module docstring; ``obs`` holds :data:`N_OBS`, of which a network reads its first
+    ``layers[0]``) of the free body whose root is at ``qpos[0:7]``, ``qvel[0:6]``, against the reference ``heading``
+    (rad), ``altitude`` (m) and forward ``speed`` (m/s). The forward and
     sideways speeds are taken relative to the horizontal velocity ``air[0:2]`` (m/s): zeros for speeds over
     the ground, the wind for speeds through the air. ``pitch_ref`` (rad, a landing's flare): the pitch is seen
     relative to it, so that a network that holds its pitch flies that much more nose up."""
@@ -108,6 +109,7 @@ def observe(qpos, qvel, heading, altitude, speed, air, obs, pitch_ref=0.0):
     obs[7] = -s * vx + c * vy
     obs[8] = qvel[2]
     obs[9] = max(-ALTITUDE_CLIP_M, min(ALTITUDE_CLIP_M, qpos[2] - altitude))
+    obs[10] = speed
 
 
 @njit(cache=True)

@@ -43,7 +43,7 @@ def test_the_observation_is_relative_to_the_reference():
     qvel[3:6] = (1.0, -2.0, 3.0)
     obs = np.empty(flight3d.N_OBS)
     flight3d.loop.observe(qpos, qvel, math.radians(90), 0.1, 1.5, np.zeros(3), obs)
-    want = [0.1, 0.2, math.radians(60), 1.0, 2.0, 3.0, 0.5, 0.0, -0.3, 0.3]
+    want = [0.1, 0.2, math.radians(60), 1.0, 2.0, 3.0, 0.5, 0.0, -0.3, 0.3, 1.5]
     np.testing.assert_allclose(obs, want, atol=1e-12)
     flight3d.loop.observe(qpos, qvel, math.radians(90), -5.0, 1.5, np.zeros(3), obs)
     assert obs[9] == flight3d.controllers.ALTITUDE_CLIP_M
@@ -52,7 +52,7 @@ def test_the_observation_is_relative_to_the_reference():
     c, s = math.cos(math.radians(30)), math.sin(math.radians(30))
     wind = np.array([1.0 * c - 0.5 * -s, 1.0 * s - 0.5 * c, 0.4])
     flight3d.loop.observe(qpos, qvel, math.radians(90), 0.1, 1.5, wind, obs)
-    np.testing.assert_allclose(obs, [0.1, 0.2, math.radians(60), 1.0, 2.0, 3.0, -0.5, 0.5, -0.3, 0.3], atol=1e-12)
+    np.testing.assert_allclose(obs, [0.1, 0.2, math.radians(60), 1.0, 2.0, 3.0, -0.5, 0.5, -0.3, 0.3, 1.5], atol=1e-12)
 
 
 def test_air_inputs_fly_as_ground_inputs_in_still_air_and_differently_in_wind():
@@ -65,6 +65,35 @@ def test_air_inputs_fly_as_ground_inputs_in_still_air_and_differently_in_wind():
         x.step(600)
     np.testing.assert_array_equal(f[0].data.qpos, f[1].data.qpos)
     assert np.abs(f[2].data.qpos[:3] - f[3].data.qpos[:3]).max() > 0.01
+
+
+def test_the_speed_asked_is_an_input_only_to_networks_that_have_it(tmp_path):
+    ctl = flight3d.load_controller("monarch")
+    seen = ctl.with_speed_input()
+    assert list(seen.layers) == [flight3d.N_OBS, flight3d.N_ACT] and seen.sees_speed_asked
+    assert not ctl.sees_speed_asked and seen.with_speed_input() is seen
+    # each neuron's weights gain a zero before the bias; the others stay where they were
+    w10 = ctl.weights.reshape(flight3d.N_ACT, flight3d.N_OBS)
+    w11 = seen.weights.reshape(flight3d.N_ACT, flight3d.N_OBS + 1)
+    np.testing.assert_array_equal(w11[:, :-2], w10[:, :-1])
+    np.testing.assert_array_equal(w11[:, -1], w10[:, -1])
+    assert not w11[:, -2].any()
+    path = tmp_path / "seen.json"
+    path.write_text(json.dumps(seen.to_dict()))
+    assert flight3d.load_controller(path).sees_speed_asked
+    # with zero weight on it the flight is bit for bit the old one; a weight on it changes the flight, and only
+    # through the speed asked (the same weight at another speed asked flies otherwise)
+    w = w11.copy()
+    w[flight3d.ACTION_NAMES.index("abdomen_mean"), -2] = 0.5
+    leaning = seen.with_weights(w.reshape(-1))
+    f = [Flight3D(controller=c, task=flight3d.level(v)) for c, v in ((ctl, 1.5), (seen, 1.5), (leaning, 1.5),
+                                                                     (leaning, 1.0))]
+    for x in f:
+        x.step(400)
+    np.testing.assert_array_equal(f[0].data.qpos, f[1].data.qpos)
+    assert np.abs(f[2].data.qpos[3:7] - f[1].data.qpos[3:7]).max() > 1e-3
+    assert np.abs(f[3].data.qpos[3:7] - f[2].data.qpos[3:7]).max() > 1e-3
+    assert f[0].decide()[-1] == 1.5 and f[3].decide()[-1] == 1.0
 
 
 def test_a_linear_network_is_tanh_of_the_scaled_inputs_and_the_command_maps_each_action():
@@ -95,7 +124,7 @@ def test_a_controller_file_round_trips_and_bad_ones_are_one_sentence(tmp_path):
     np.testing.assert_array_equal(again.weights, ctl.weights)
     assert again.to_dict() == ctl.to_dict()
     good = ctl.to_dict()
-    with pytest.raises(UserError, match="layers must be whole numbers running from 10 inputs to 9 outputs"):
+    with pytest.raises(UserError, match="layers must be whole numbers running from 10 or 11 inputs to 9 outputs"):
         flight3d.controller_from_dict(dict(good, layers=[6, 1]))
     with pytest.raises(UserError, match="need 89 finite weights"):
         flight3d.controller_from_dict(dict(good, weights=[0.0] * 84))
