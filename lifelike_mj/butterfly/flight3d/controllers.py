@@ -66,6 +66,8 @@ FORMAT = "lifelike-mj/butterfly3d-controller"
 MAX_LAYERS, MAX_WIDTH, MAX_WEIGHT, MAX_EVERY, MAX_OMEGA_C = 6, 256, 1.0e6, 12_000, 1.0e4
 #: What a controller's forward and sideways speeds are measured against (module docstring).
 INPUTS = ("ground", "air")
+#: Bounds of the speed boost (module docstring): its gain (1/s) and its largest bound (m/s).
+MAX_SPEED_GAIN, MAX_BOOST_M_S = 100.0, 10.0
 #: The wing-force laws a controller can be evolved with and fly (those of the model's callback that act over the
 #: wing's area: :data:`~lifelike_mj.butterfly.flight3d.model.FORCE_LAWS` less ``none`` and the paper's ``tip``).
 FORCE_LAWS_FLOWN = ("exact", "strip", "quasi_steady")
@@ -118,7 +120,7 @@ class Controller3D:
     def __init__(self, layers, weights, base=None, scale: dict | None = None, every: int = 1,
                  omega_c_rad_s: float = 2.0 * math.pi * 10.0, provenance: dict | None = None, name: str = "",
                  inputs: str = "ground", animal: str = "swallowtail", force_law: str = "exact",
-                 modes: dict | None = None) -> None:
+                 modes: dict | None = None, speed_gain_per_s: float = 0.0, speed_boost_max_m_s: float = 1.5) -> None:
         from lifelike_mj import checks
         from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
         from lifelike_mj.errors import UserError
@@ -162,6 +164,12 @@ class Controller3D:
         if inputs not in INPUTS:
             raise UserError(f"{where}: inputs are {' or '.join(repr(v) for v in INPUTS)}, got {inputs!r}.")
         self.inputs = inputs
+        self.speed_gain_per_s = checks.number("speed_gain_per_s", speed_gain_per_s, 0.0, MAX_SPEED_GAIN, unit="1/s")
+        self.speed_boost_max_m_s = checks.number("speed_boost_max_m_s", speed_boost_max_m_s, 0.0, MAX_BOOST_M_S,
+                                                 unit="m/s")
+        if self.speed_gain_per_s > 0.0 and int(self.layers[0]) != N_OBS:
+            raise UserError(f"{where}: a speed boost (speed_gain_per_s) needs a network that sees the speed asked "
+                            f"({N_OBS} inputs).")
         from lifelike_mj.butterfly.flight3d.animals import animal as _animal
 
         self.animal = _animal(animal).name
@@ -200,6 +208,8 @@ class Controller3D:
                 "scale": dict(zip(ACTION_NAMES, (float(v) for v in self.scale))), "every": self.every,
                 "omega_c_rad_s": self.omega_c_rad_s, "inputs": self.inputs, "animal": self.animal,
                 "force_law": self.force_law, "provenance": self.provenance,
+                **({"speed_gain_per_s": self.speed_gain_per_s, "speed_boost_max_m_s": self.speed_boost_max_m_s}
+                   if self.speed_gain_per_s > 0.0 else {}),
                 **({"modes": {k: {"weights": [float(v) for v in m["weights"]], MODES[k]: m[MODES[k]]}
                               for k, m in self.modes.items()}} if self.modes else {})}
 
@@ -208,12 +218,18 @@ class Controller3D:
         """Whether the network's speeds are through the air (the compiled loop's flag)."""
         return self.inputs == "air"
 
+    def loop_options(self) -> np.ndarray:
+        """What the compiled loop needs beside the networks: whether the speeds are through the air (1 or 0), the speed
+        boost's gain (1/s) and bound (m/s)."""
+        return np.array([float(self.air_inputs), self.speed_gain_per_s, self.speed_boost_max_m_s])
+
     def replace(self, **changes) -> Controller3D:
         """The same controller with the given constructor arguments changed (each checked as by the constructor)."""
         kw = {"layers": self.layers, "weights": self.weights, "base": self.base,
               "scale": dict(zip(ACTION_NAMES, self.scale)), "every": self.every, "omega_c_rad_s": self.omega_c_rad_s,
               "provenance": self.provenance, "name": self.name, "inputs": self.inputs, "animal": self.animal,
-              "force_law": self.force_law, "modes": self.modes}
+              "force_law": self.force_law, "modes": self.modes, "speed_gain_per_s": self.speed_gain_per_s,
+              "speed_boost_max_m_s": self.speed_boost_max_m_s}
         unknown = set(changes) - set(kw)
         if unknown:
             raise TypeError(f"replace: unknown argument {sorted(unknown)[0]!r}")
@@ -225,21 +241,32 @@ class Controller3D:
         """Whether the networks have the eleventh input, the forward speed asked (module docstring)."""
         return int(self.layers[0]) == N_OBS
 
-    def with_speed_input(self) -> Controller3D:
-        """The same controller whose networks also see the forward speed asked (the eleventh observation), each
-        first-layer neuron's weight on it zero: it flies exactly as before until those weights change. A controller
-        that sees it already is returned as it is."""
+    def with_speed_input(self, pitch_deg_per_m_s: float = 0.0, about_m_s: float = 1.0) -> Controller3D:
+        """The same controller whose networks also see the forward speed asked (the eleventh observation). With the
+        defaults each first-layer neuron's weight on it is zero: it flies exactly as before until those weights change.
+        ``pitch_deg_per_m_s`` (deg per m/s): a **pitch schedule** instead. Each first-layer neuron's weight on the speed
+        asked is its weight on the pitch times that many rad per m/s, and its bias less that weight times
+        ``about_m_s``: the networks then see the pitch as if it were ``pitch_deg_per_m_s`` higher per m/s asked above
+        ``about_m_s`` (lower below), so that a network that holds its pitch flies its body that much lower per m/s
+        asked. The same as before at ``about_m_s``. A controller that sees the speed asked already is returned as it
+        is."""
+        from lifelike_mj import checks
+
         if self.sees_speed_asked:
             return self
-        n_in = int(self.layers[0])
-        first = (n_in + 1) * int(self.layers[1])
+        n_in, n_first = int(self.layers[0]), int(self.layers[1])
+        first = (n_in + 1) * n_first
+        k = math.radians(checks.number("pitch_deg_per_m_s", pitch_deg_per_m_s, -90.0, 90.0, unit="deg per m/s"))
+        v0 = checks.number("about_m_s", about_m_s, 0.0, 100.0, unit="m/s")
+        pitch = OBS_NAMES.index("pitch_rad")
 
         def padded(w):
-            rows = np.asarray(w[:first]).reshape(int(self.layers[1]), n_in + 1)
-            rows = np.concatenate([rows[:, :n_in], np.zeros((len(rows), 1)), rows[:, n_in:]], axis=1)
+            rows = np.asarray(w[:first]).reshape(n_first, n_in + 1)
+            speed = rows[:, pitch] * k
+            rows = np.concatenate([rows[:, :n_in], speed[:, None], rows[:, n_in:] - (speed * v0)[:, None]], axis=1)
             return np.concatenate([rows.reshape(-1), w[first:]])
 
-        modes = {k: {**m, "weights": padded(m["weights"])} for k, m in self.modes.items()}
+        modes = {k_: {**m, "weights": padded(m["weights"])} for k_, m in self.modes.items()}
         return self.replace(layers=[N_OBS, *[int(v) for v in self.layers[1:]]], weights=padded(self.weights),
                             modes=modes)
 
@@ -296,6 +323,9 @@ def json_schema() -> dict:
                    "lifelike_mj.butterfly.flight3d.animals); missing: the paper's swallowtail"},
         "force_law": {"enum": list(FORCE_LAWS_FLOWN), "description": "the wing-force law it was evolved "
                       "with and flies with (module lifelike_mj.butterfly.flight3d.model); missing: exact"},
+        "speed_gain_per_s": number("1/s: how fast the speed asked that the network sees rises while the ground speed "
+                                   "falls short (0: never)", 0.0, MAX_SPEED_GAIN),
+        "speed_boost_max_m_s": number("m/s: the most the speed asked is raised by", 0.0, MAX_BOOST_M_S),
         "provenance": {"type": "object"},
         "modes": {"type": "object", "additionalProperties": False, "description": "behaviour networks of the flight "
                   "network's shape: land flies a landing's last from_m (m), take_off the first for_s (s) of a take-off",
@@ -325,7 +355,8 @@ def controller_from_dict(data: object, name: str = "") -> Controller3D:
         base = KinematicsCommand(**{k: float(v) for k, v in base.items()})
     return Controller3D(d["layers"], d["weights"], base, d.get("scale"), d.get("every", 1),
                         d.get("omega_c_rad_s", 2.0 * math.pi * 10.0), d.get("provenance"), name, d.get("inputs", "ground"),
-                        d.get("animal", "swallowtail"), d.get("force_law", "exact"), d.get("modes"))
+                        d.get("animal", "swallowtail"), d.get("force_law", "exact"), d.get("modes"),
+                        d.get("speed_gain_per_s", 0.0), d.get("speed_boost_max_m_s", 1.5))
 
 
 #: Controllers once shipped and withdrawn, and why: on 100 random calm courses (``benchmarks/courses_3d.py``) each

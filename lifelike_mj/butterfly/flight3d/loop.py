@@ -21,6 +21,7 @@ from lifelike_mj.butterfly.flight3d.controllers import ALTITUDE_CLIP_M, INPUT_SC
 from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS, filter_at
 from lifelike_mj.butterfly.flight3d.tasks import (
     R_AIM,
+    R_BOOST,
     R_CLAP_UNTIL,
     R_DIVERGED,
     R_FIT,
@@ -52,6 +53,7 @@ from lifelike_mj.butterfly.flight3d.tasks import (
     TASK_PERCH,
     TASK_SCHEDULE,
     TASK_TARGET,
+    TASK_WAYPOINTS,
 )
 from lifelike_mj.physics import mjabi
 
@@ -338,7 +340,7 @@ def take_off_kinematics(ud: np.ndarray, base: np.ndarray) -> None:
 
 
 @njit(cache=True)
-def _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, path, path_every, n_path, tumble_rad, base):
+def _before(ud, qpos, qvel, time, dt, task, rec, obs, opts, ground, path, path_every, n_path, tumble_rad, base):
     """The first half of a step: the gusts advance, the air is set, the reference is taken and the observation made
     (into ``obs``), the path sampled. Returns ``(tumbled, n_path)``: a roll or pitch beyond ``tumble_rad`` ends the
     flight here (recorded in ``rec``). A landing keeps its speed at its closest approach (``R_NEAR_SPEED``); one that
@@ -364,8 +366,13 @@ def _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, path, 
     pitch_ref = 0.0
     if int(task[T_KIND]) == TASK_LAND:
         pitch_ref = flare(task, qpos)
-    observe(qpos, qvel, heading, altitude, speed, ud[mj3d.U_AIR : mj3d.U_AIR + 3] if air_inputs else ground, obs,
+    kind = int(task[T_KIND])
+    if opts[1] > 0.0 and (kind == TASK_SCHEDULE or kind == TASK_WAYPOINTS):
+        along = math.cos(heading) * qvel[0] + math.sin(heading) * qvel[1]
+        rec[R_BOOST] = max(0.0, min(opts[2], rec[R_BOOST] + opts[1] * (speed - along) * dt))
+    observe(qpos, qvel, heading, altitude, speed, ud[mj3d.U_AIR : mj3d.U_AIR + 3] if opts[0] != 0.0 else ground, obs,
             pitch_ref)
+    obs[10] += rec[R_BOOST]
     if path_every > 0 and step % path_every == 0 and n_path < path.shape[0]:
         path[n_path, 0] = time[0]
         for i in range(3):
@@ -473,15 +480,18 @@ def style(ud, qpos, qvel, obs, p, dt, rec):
 
 @njit(cache=True)
 def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, reach, base, scale, task, rec, path,
-              path_every, tumble_rad, air_inputs):
+              path_every, tumble_rad, opts):
     """Fly one butterfly ``n_steps`` steps from its current state: every ``every`` steps the network turns
     the observation into a new command; after each ``mj_step`` the kinematics advance exactly in the
     userdata. ``rec``: the run record (``R_*``); ``path``: rows of (t, x, y, z, roll, pitch, yaw) every
     ``path_every`` steps (none when 0). A roll or pitch beyond ``tumble_rad`` (a tumble) or a runaway
     ends the flight (recorded in ``rec``). ``weights``: the flight network's, then the behaviours' (the controller's
     ``all_weights``), each network picked by :func:`behaviour` with ``reach``. Without weights the command in the
-    userdata stays. ``air_inputs``: the network's speeds are through the air (the controller's ``inputs == "air"``),
-    else over the ground."""
+    userdata stays. ``opts`` (the controller's :meth:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D.
+    loop_options`): whether the network's speeds are through the air (``inputs == "air"``; else over the ground),
+    and the gain (1/s) and bound (m/s) of the speed boost (the run record's ``R_BOOST``: the speed asked that an
+    eleven-input network sees rises while the ground speed toward the heading asked falls short, as a butterfly flies
+    faster through the air in a head wind)."""
     ud = _f64(_ptr_at(dptr + off[_O_UD]), mj3d.N_USERDATA)
     qpos = _f64(_ptr_at(dptr + off[_O_QPOS]), nq)
     qvel = _f64(_ptr_at(dptr + off[_O_QVEL]), nv)
@@ -503,7 +513,7 @@ def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, reac
     for _ in range(n_steps):
         if rec[R_DIVERGED] >= 0 or rec[R_TUMBLED] >= 0:
             return
-        tumbled, n_path = _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, path, path_every,
+        tumbled, n_path = _before(ud, qpos, qvel, time, dt, task, rec, obs, opts, ground, path, path_every,
                                   n_path, tumble_rad, base)
         if tumbled:
             return
@@ -517,7 +527,7 @@ def fly_steps(mptr, dptr, off, nq, nv, n_steps, dt, every, layers, weights, reac
 
 @njit(cache=True)
 def to_decision(mptr, dptr, off, nq, nv, n_max, dt, every, action, act, base, scale, task, rec, obs, tumble_rad,
-                air_inputs):
+                opts):
     """Fly one butterfly to its next decision with an action from outside (a policy, not the network): with
     ``act``, the action ``action`` (``(N_ACT,)``, in ``[-1, 1]``, the flutter added as for a network's) is taken at
     the current step, whose observation is ``obs``; then the steps go on, as :func:`fly_steps` flies them, until the
@@ -542,7 +552,7 @@ def to_decision(mptr, dptr, off, nq, nv, n_max, dt, every, action, act, base, sc
         if not _after(mptr, dptr, off, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
             return False
     while True:
-        tumbled, _ = _before(ud, qpos, qvel, time, dt, task, rec, obs, air_inputs, ground, none, 0, 0, tumble_rad,
+        tumbled, _ = _before(ud, qpos, qvel, time, dt, task, rec, obs, opts, ground, none, 0, 0, tumble_rad,
                              base)
         if tumbled:
             return False
@@ -555,23 +565,23 @@ def to_decision(mptr, dptr, off, nq, nv, n_max, dt, every, action, act, base, sc
 
 @njit(cache=True, parallel=True)
 def to_decisions(mptr, dptrs, off, nq, nv, n_max, dt, every, actions, act, base, scale, tasks, recs, obs, tumble_rad,
-                 air_inputs, going):
+                 opts, going):
     """:func:`to_decision` for many butterflies at once, one action row each (threads over the copies); copies with
     ``act[i]`` false only observe. ``going[i]``: whether copy ``i`` goes on."""
     for i in prange(len(dptrs)):
         going[i] = to_decision(mptr, dptrs[i], off, nq, nv, n_max, dt, every, actions[i], act[i], base, scale,
-                               tasks[i], recs[i], obs[i], tumble_rad, air_inputs)
+                               tasks[i], recs[i], obs[i], tumble_rad, opts)
 
 
 @njit(cache=True, parallel=True)
 def fly_batch(mptr, dptrs, off, nq, nv, n_steps, dt, every, layers, weights, reach, base, scale, tasks, recs, tumble_rad,
-              air_inputs):
+              opts):
     """:func:`fly_steps` for many butterflies at once (one ``mjData`` each, ``weights[i]`` and
     ``tasks[i]`` per copy), threads over the copies; no paths are recorded."""
     none = np.empty((0, 7))
     for i in prange(len(dptrs)):
         fly_steps(mptr, dptrs[i], off, nq, nv, n_steps, dt, every, layers, weights[i], reach, base, scale, tasks[i],
-                  recs[i], none, 0, tumble_rad, air_inputs)
+                  recs[i], none, 0, tumble_rad, opts)
 
 
 
@@ -598,12 +608,12 @@ class Batch:
         #: Each butterfly's observation at its last decision (:meth:`decide`; ``OBS_NAMES``, SI units).
         self.observations = np.zeros((self.n, N_OBS))
         if controller is None:
-            self.layers, self.scale, self.every, self.air_inputs = np.zeros(1, dtype=np.int64), np.zeros(N_ACT), 1, False
+            self.layers, self.scale, self.every, self.opts = np.zeros(1, dtype=np.int64), np.zeros(N_ACT), 1, np.zeros(3)
             self.weights, self.reach = np.zeros((self.n, 0)), np.zeros(2)
             self.base = np.asarray(base, dtype=np.float64)
         else:
             self.layers, self.scale = controller.layers, controller.scale
-            self.every, self.air_inputs = controller.every, controller.air_inputs
+            self.every, self.opts = controller.every, controller.loop_options()
             self.base = controller.base.as_array() if base is None else np.asarray(base, dtype=np.float64)
             own = controller.all_weights()
             w = own if weights is None else weights
@@ -623,11 +633,11 @@ class Batch:
                 fly_steps(m._address, int(self.ptrs[0]), mjabi.offsets_tuple(), m.nq, m.nv, n_steps, self.dt,
                           self.every, self.layers, self.weights[0], self.reach, self.base, self.scale, self.tasks[0],
                           self.records[0], _NO_PATH if path is None else path, path_every, self.tumble_rad,
-                          self.air_inputs)
+                          self.opts)
             else:
                 fly_batch(m._address, self.ptrs, mjabi.offsets_tuple(), m.nq, m.nv, n_steps, self.dt, self.every,
                           self.layers, self.weights, self.reach, self.base, self.scale, self.tasks, self.records,
-                          self.tumble_rad, self.air_inputs)
+                          self.tumble_rad, self.opts)
 
     def decide(self, actions: np.ndarray | None, n_max: int, act: np.ndarray | None = None) -> np.ndarray:
         """Fly every butterfly to its next decision (:func:`to_decision`) with ``actions`` (one row of ``N_ACT``
@@ -646,11 +656,11 @@ class Batch:
             if self.n == 1:
                 going[0] = to_decision(m._address, int(self.ptrs[0]), mjabi.offsets_tuple(), m.nq, m.nv, int(n_max),
                                        self.dt, self.every, a[0], bool(act[0]), self.base, self.scale, self.tasks[0],
-                                       self.records[0], self.observations[0], self.tumble_rad, self.air_inputs)
+                                       self.records[0], self.observations[0], self.tumble_rad, self.opts)
             else:
                 to_decisions(m._address, self.ptrs, mjabi.offsets_tuple(), m.nq, m.nv, int(n_max), self.dt, self.every,
                              a, act, self.base, self.scale, self.tasks, self.records, self.observations,
-                             self.tumble_rad, self.air_inputs, going)
+                             self.tumble_rad, self.opts, going)
         return going
 
     def diverged(self) -> np.ndarray:

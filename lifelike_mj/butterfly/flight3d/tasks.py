@@ -51,7 +51,10 @@ N_STYLE = len(STYLE_NAMES)
 #: when the last take-off began (s; ``-inf``: none, the flight began in the air).
 R_LANDED_AT = R_STYLE + N_STYLE
 R_TOUCH_SPEED, R_AIM, R_CLAP_UNTIL, R_TOOK_OFF_AT = R_LANDED_AT + 1, R_LANDED_AT + 2, R_LANDED_AT + 3, R_LANDED_AT + 4
-R_WP = R_LANDED_AT + 5
+#: The speed boost now (m/s): what the loop adds to the speed asked that an eleven-input network sees, grown while the
+#: ground speed toward the heading asked falls short of the speed asked (a controller's ``speed_gain_per_s``).
+R_BOOST = R_LANDED_AT + 5
+R_WP = R_BOOST + 1
 #: A landing keeps its closest approach to the point where it would stand (m) in ``R_WP`` and its speed over the ground
 #: then (m/s) in ``R_NEAR_SPEED`` (a landing task has two rows, so both are there).
 R_NEAR_SPEED = R_WP + 1

@@ -96,6 +96,52 @@ def test_the_speed_asked_is_an_input_only_to_networks_that_have_it(tmp_path):
     assert f[0].decide()[-1] == 1.5 and f[3].decide()[-1] == 1.0
 
 
+def test_a_pitch_schedule_shows_the_network_its_pitch_higher_the_faster_it_is_asked_to_fly():
+    from lifelike_mj.butterfly.flight3d.measures import level_measures
+
+    ctl = flight3d.load_controller("monarch")
+    sched = ctl.with_speed_input(10.0, about_m_s=1.0)
+    out = [np.empty(flight3d.N_ACT) for _ in range(3)]
+    scratch = np.empty(2 * flight3d.N_OBS)
+    x = np.random.default_rng(1).normal(size=flight3d.N_OBS)
+    for v, o, c, shift in ((1.0, out[0], sched, 0.0), (3.0, out[1], sched, 0.0), (3.0, out[2], ctl, math.radians(20))):
+        y = x.copy()
+        y[10] = v
+        y[1] += shift
+        flight3d.loop.network(c.layers, c.weights, y, o, scratch)
+    plain = np.empty(flight3d.N_ACT)
+    flight3d.loop.network(ctl.layers, ctl.weights, x, plain, scratch)
+    np.testing.assert_allclose(out[0], plain, atol=1e-12)  # as before at the speed it is set about
+    np.testing.assert_allclose(out[1], out[2], atol=1e-12)  # 2 m/s faster: the pitch seen 20 deg higher
+    # and so the monarch, which holds its pitch, flies its body lower the faster it is asked to fly
+    body = [level_measures(sched, v, settle_s=3.0, window_s=1.0)["body_angle_deg"] for v in (1.0, 2.5)]
+    assert body[0] - body[1] > 5.0
+
+def test_the_speed_boost_raises_the_speed_asked_in_a_head_wind_up_to_its_bound(tmp_path):
+    seen = flight3d.load_controller("monarch").with_speed_input()
+    with pytest.raises(UserError, match="needs a network that sees the speed asked"):
+        flight3d.load_controller("monarch").replace(speed_gain_per_s=0.5)
+    boosted = seen.replace(speed_gain_per_s=0.5, speed_boost_max_m_s=0.8)
+    path = tmp_path / "boosted.json"
+    path.write_text(json.dumps(boosted.to_dict()))
+    again = flight3d.load_controller(path)
+    assert (again.speed_gain_per_s, again.speed_boost_max_m_s) == (0.5, 0.8)
+    assert "speed_gain_per_s" not in seen.to_dict()  # no boost: the file is as before
+    head = flight3d.level(1.0).with_weather((-1.5, 0.0, 0.0))  # a 1.5 m/s head wind: no ground made at 1 m/s
+    f = [Flight3D(controller=c, task=t) for c, t in ((seen, head), (boosted, head), (boosted, flight3d.level(1.0)))]
+    asked = []
+    for x in f:
+        x.step(800)  # 1 s
+        asked.append(x.decide()[-1])
+    assert asked[0] == 1.0  # without a boost the network sees the task's speed
+    # 0.5/s times a shortfall of about 1 m/s and more: past half its bound within the second, and never past it
+    assert 1.4 < asked[1] <= 1.8
+    for _ in range(3):
+        f[1].step(800)
+        assert f[1].decide()[-1] <= 1.8
+    assert f[1].decide()[-1] == pytest.approx(1.8)
+    assert asked[2] < asked[1]  # in still air the same butterfly needs less
+
 def test_a_linear_network_is_tanh_of_the_scaled_inputs_and_the_command_maps_each_action():
     layers = np.array([flight3d.N_OBS, flight3d.N_ACT])
     rng = np.random.default_rng(0)
