@@ -78,7 +78,11 @@ def cmd_swim(args) -> None:
                          f"acceleration kurtosis {summary['accel_kurtosis']:.2f}, turning entropy "
                          f"{summary['turn_entropy']:.2f} bits, mean speed {summary['mean_speed_body_lengths_s']:.2f} "
                          f"body lengths/s, {summary['fish_outside_tank']} outside the tank "
-                         f"({summary['realtime_factor']:.0f}x real time)"))
+                         f"({summary['realtime_factor']:.0f}x real time); together: nearest neighbour "
+                         f"{summary['group']['nn_distance_bl']['median']:.1f} body lengths (median), polarisation "
+                         f"{summary['group']['polarisation']:.2f}, a kick every "
+                         f"{summary['group']['kick_interval_s']['mean']:.2f} s (CV "
+                         f"{summary['group']['kick_interval_s']['cv']:.2f})"))
 
 
 def cmd_drag_check(args) -> None:

@@ -25,6 +25,7 @@ import numpy as np
 from lifelike_mj.fish.metrics import MU_NAMES, track_measures
 from lifelike_mj.fish.params import COAST, FishParams, load_preset
 from lifelike_mj.fish.scene import BODY_LENGTH_M, box_areas
+from lifelike_mj.fish.shoal import group_measures
 from lifelike_mj.fish.sim import (
     COMPILED_PASSIVE,
     FISH_BLOCK,
@@ -58,6 +59,7 @@ def swim_summary(result: SwimResult) -> dict:
     m = track_measures(result.times_s, result.positions, BODY_LENGTH_M, mu_log=result.mu % 4,
                        control_dt=p.control_dt_s)
     duration = float(result.times_s[-1] - result.times_s[0])
+    m["group"] = group_measures(result.times_s, result.positions, BODY_LENGTH_M, result.tank_m)
     m.update({
         "fish_outside_tank": int(result.outside_tank().sum()),
         "avoiding_fraction": float((result.mu >= 4).mean()),

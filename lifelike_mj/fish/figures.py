@@ -237,3 +237,79 @@ def patterns_figure(rows: list[dict], out_path: str | os.PathLike | None = None)
 
 
 __all__ = ["PATTERN_ORDER", "accel_histogram_figure", "patterns_figure", "side_accelerations_bl", "tracks_figure"]
+
+
+def group_figure(result: SwimResult, out_path: str | os.PathLike | None = None, body_length_m: float = 0.07) -> Figure:
+    """The measures of fish living together (:mod:`lifelike_mj.fish.shoal`), from the tracks alone, in six panels:
+    the nearest-neighbour distance, the polarisation and milling over time, the intervals between kicks, the speed,
+    the distance to the nearest side wall (histograms, body lengths and seconds), and where the neighbours are in a
+    fish's own frame (ahead, to its left; a 2-D histogram within 10 body lengths, the maps of Calovi et al. 2018)."""
+    from lifelike_mj.fish import shoal
+
+    if not checks.is_number(body_length_m) or not body_length_m > 0:
+        raise UserError(f"the body length must be a positive number of m, got {body_length_m!r}.")
+    t, p, bl = result.times_s, result.positions, float(body_length_m)
+    if t.size < 3:
+        raise UserError("the swim is too short for the group measures (it needs at least three samples).")
+    m = shoal.group_measures(t, p, bl, result.tank_m)
+    vel = shoal.velocities(t, p)
+    head = shoal.headings(vel, shoal.MIN_SPEED_BL_S * bl)
+    speed = np.linalg.norm(vel, axis=-1)
+    kicks = [np.diff(shoal.kick_times(t, speed[:, f], shoal.KICK_RISE_BL_S * bl)) for f in range(result.n_fish)]
+    iv = np.concatenate(kicks) if kicks else np.zeros(0)
+    fig = _new_figure(13.0, 7.5)
+    axs = fig.subplots(2, 3)
+    name = result.params.name or "custom"
+    fig.suptitle(f"{result.n_fish} {name} fish, {float(t[-1] - t[0]):g} s (seed {result.seed}): living together, "
+                 "from the tracks alone")
+    nn = shoal.nearest_neighbour_m(p) / bl
+    ax = axs[0, 0]
+    if np.isfinite(nn).any():
+        ax.hist(nn[np.isfinite(nn)].ravel(), bins=40, color="tab:blue", alpha=0.8)
+        ax.axvline(m["nn_distance_bl"]["median"], color="tab:red", ls="--",
+                   label=f"median {m['nn_distance_bl']['median']:.1f} BL")
+        ax.legend(fontsize=8)
+    ax.set_xlabel("nearest-neighbour distance (body lengths)")
+    ax.set_ylabel("fish x samples")
+    ax = axs[0, 1]
+    ax.plot(t, shoal.polarisation(head), lw=0.8, label=f"polarisation O_P (mean {m['polarisation']:.2f})")
+    ax.plot(t, shoal.milling(p, head), lw=0.8, label=f"milling O_R (mean {m['milling']:.2f})")
+    ax.axhline(0.65, color="k", lw=0.6, ls=":")
+    ax.axhline(0.35, color="k", lw=0.6, ls=":")
+    ax.set_ylim(0.0, 1.0)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("order parameter")
+    ax.legend(fontsize=8, loc="upper right")
+    ax = axs[0, 2]
+    k = m["kick_interval_s"]
+    if iv.size:
+        ax.hist(iv, bins=np.arange(0.0, max(2.0, float(np.percentile(iv, 99))) + 0.05, 1.0 / 30.0), color="tab:green",
+                alpha=0.8, label=f"mean {k['mean']:.2f} s, CV {k['cv']:.2f}\n5th percentile {k['p5']:.2f} s\n"
+                f"(a kick: a speed rise of {shoal.KICK_RISE_BL_S:g} BL/s or more)")
+        ax.legend(fontsize=8)
+    ax.set_xlabel("interval between a fish's kicks (s)")
+    ax.set_ylabel("intervals")
+    ax = axs[1, 0]
+    ax.hist((speed / bl).ravel(), bins=40, color="tab:orange", alpha=0.8,
+            label=f"median {m['speed_bl_s']['median']:.2f} BL/s")
+    ax.legend(fontsize=8)
+    ax.set_xlabel("speed (body lengths/s)")
+    ax.set_ylabel("fish x samples")
+    ax = axs[1, 1]
+    w = shoal.wall_distance_m(p, result.tank_m) / bl
+    ax.hist(w.ravel(), bins=40, color="tab:purple", alpha=0.8,
+            label=f"median {m['wall_distance_bl']['median']:.1f} BL")
+    ax.legend(fontsize=8)
+    ax.set_xlabel("distance to the nearest side wall (body lengths)")
+    ax.set_ylabel("fish x samples")
+    ax = axs[1, 2]
+    rel, _ = shoal.neighbour_frame(p, head)
+    rel = rel / bl
+    if rel.size:
+        ax.hist2d(rel[:, 1], rel[:, 0], bins=40, range=[[-10, 10], [-10, 10]], cmap="viridis")
+    ax.plot([0.0], [0.0], marker="^", color="w", ms=8)
+    ax.set_aspect("equal")
+    ax.set_xlabel("neighbour to the fish's left (body lengths)")
+    ax.set_ylabel("neighbour ahead (body lengths)")
+    ax.invert_xaxis()
+    return finish(fig, out_path, "group figure")

@@ -8,6 +8,7 @@ Fig. 11-12) and a rendered frame of the tank when offscreen rendering is availab
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from lifelike_mj.errors import UserError
@@ -34,7 +35,7 @@ def _f(x: float, d: int = 2) -> str:
 def reproduce_fish(out: str | Path, seeds=PATTERN_SEEDS, pattern_s: float = PATTERN_S, swim_s: float = SWIM_S,
                    progress: bool = True) -> dict:
     """Run everything; returns the results dictionary (also written as ``results.json``)."""
-    from lifelike_mj.fish.figures import accel_histogram_figure, patterns_figure, tracks_figure
+    from lifelike_mj.fish.figures import accel_histogram_figure, group_figure, patterns_figure, tracks_figure
     from lifelike_mj.fish.render import frame_png
 
     out = Path(out)
@@ -46,6 +47,7 @@ def reproduce_fish(out: str | Path, seeds=PATTERN_SEEDS, pattern_s: float = PATT
         write_tracks(r, out)
         tracks_figure(r, out / "fig7_tracks.png")
         accel_histogram_figure(r, out / "fig8_accel_histogram.png")
+        group_figure(r, out / "group.png")
         summ = swim_summary(r)
         _, p = resample(r.times_s, side_view(r.positions))
         _, acc = speed_and_accel(p, 24.0)
@@ -63,6 +65,8 @@ def reproduce_fish(out: str | Path, seeds=PATTERN_SEEDS, pattern_s: float = PATT
         except (UserError, ImportError, RuntimeError) as exc:
             snap = f"(no rendered frame on this machine: {exc})\n"
 
+    g = summ["group"]
+    k = g["kick_interval_s"]
     lines = ["# Tropical fish (Satoi, Nakadai, Hoshino 2015): reproduction report", ""]
     lines += ["## F1-F3: ten `B-D` fish, 30 s (seed 0)", "",
               "| observation | paper | ours |", "|---|---|---|",
@@ -74,10 +78,22 @@ def reproduce_fish(out: str | Path, seeds=PATTERN_SEEDS, pattern_s: float = PATT
               f"| speed | (damselfish, 7 cm) | mean {_f(summ['mean_speed_body_lengths_s'])} BL/s, max "
               f"{_f(summ['max_speed_body_lengths_s'])} BL/s (side view, 24 fps) |",
               f"| fish outside the tank | - | {summ['fish_outside_tank']} |", "",
+              "Living together, from the same tracks (the paper's fish ignore each other; `fish/shoal.py`):", "",
+              "| measure | ours |", "|---|---|",
+              f"| nearest neighbour | median {_f(g['nn_distance_bl']['median'], 1)} body lengths; "
+              f"{100 * g['near_fraction_2bl']:.0f} % of the time within 2 |",
+              f"| polarisation / milling | {_f(g['polarisation'])} / {_f(g['milling'])} (independent headings: about "
+              f"{_f(math.sqrt(math.pi / (4 * N_FISH)))}) |",
+              f"| kicks (speed rises of 0.5 BL/s or more) | every {_f(k['mean'])} s, CV {_f(k['cv'])}, 5th percentile "
+              f"{_f(k['p5'])} s |",
+              f"| distance to the nearest side wall | median {_f(g['wall_distance_bl']['median'], 1)} body lengths |", "",
               markdown_figure("fig7_tracks.png", "cf. Satoi 2015 Fig. 7 — one fish's speed, the motion unit it is in, "
                               "and its track seen from the side (F1, F2)."), "",
               markdown_figure("fig8_accel_histogram.png", "cf. Satoi 2015 Fig. 8 — histogram of the acceleration along "
-                              "the side-view tracks of ten fish, 24 fps (F3)."), "", snap]
+                              "the side-view tracks of ten fish, 24 fps (F3)."), "",
+              markdown_figure("group.png", "The same ten fish together: nearest neighbour, order parameters, kick "
+                              "intervals, speed, distance to the wall, and where the neighbours are in a fish's frame."),
+              "", snap]
     lines += ["## F4: the four patterns on objective measures", "",
               f"{len(seeds)} seeds x {_f(pattern_s, 0)} s x {N_FISH} fish; medians over seeds.", "",
               "| pattern | burstiness B | acceleration kurtosis | turning entropy (bits) | burst interval (s) | "

@@ -328,7 +328,8 @@ def test_reproduce_fish_writes_report_results_and_figures(tmp_path):
     assert "F4" in text and "B-D > NB-ND on burstiness" in text
     assert json.loads((tmp_path / "results.json").read_text())["drag_check"]["max_rel_error"] < 1e-9
     assert res["swim"]["fish"] == 10
-    for name in ("fig7_tracks.png", "fig8_accel_histogram.png", "fig11_patterns.png", "tracks.csv", "tracks.npz"):
+    assert "Living together" in text and "nearest neighbour" in text
+    for name in ("fig7_tracks.png", "fig8_accel_histogram.png", "fig11_patterns.png", "group.png", "tracks.csv", "tracks.npz"):
         assert (tmp_path / name).stat().st_size > 0
 
 

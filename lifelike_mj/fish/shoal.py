@@ -1,0 +1,229 @@
+"""Measures of fish living together, from their tracks alone: spacing, order, kicks, speed and walls.
+
+Every function reads positions over time (what a video tracker gives of real fish), never the model, so that the
+same code scores a simulated tank and a filmed one. Units: SI in and out (m, s, m/s), and body lengths where a name
+says ``_bl``. Headings are horizontal (x along the tank, y across): fish in a shallow or wide tank swim mostly level,
+and the published order parameters are planar (Couzin et al. 2002; Tunstrom et al. 2013; Calovi et al. 2018).
+Distances between fish are three-dimensional.
+
+* **Velocity** (:func:`velocities`): central differences of the positions (one-sided at the ends).
+* **Nearest-neighbour distance** (:func:`nearest_neighbour_m`): per fish and sample, the distance to the closest
+  other fish's centre.
+* **Polarisation** ``O_P = |mean_i h_i|`` (:func:`polarisation`), ``h_i`` the unit horizontal heading: 1 when all
+  swim the same way, about ``sqrt(pi / (4 N))`` for ``N`` fish heading independently (0.28 for ten).
+* **Milling** ``O_R = |mean_i (r_i x h_i)_z|`` (:func:`milling`), ``r_i`` the unit horizontal vector from the
+  group's centroid to fish ``i``: 1 when all circle the centroid the same way. Tunstrom et al. (2013) call a group
+  polarised when ``O_P > 0.65`` and ``O_R < 0.35``, milling when ``O_R > 0.65`` and ``O_P < 0.35``, a swarm when
+  both are below 0.35.
+* **Cohesion** (:func:`cohesion_m`): the mean distance of the fish from their centroid.
+* **Kicks** (:func:`kick_times`): the onsets of speed rises. A kick is a local minimum of a fish's speed followed by a
+  rise of at least ``rise_bl_s`` body lengths per second before the speed next falls: a burst-and-coast fish's
+  kicks, as Calovi et al. (2018) segment their tetras' tracks (heading and speed change at the kick, then a glide).
+* **Distance to the wall** (:func:`wall_distance_m`): horizontal, to the nearest side wall of a box tank centred
+  on the origin (``tank_m`` = length, depth, height).
+* **Neighbour maps** (:func:`neighbour_frame`): where each other fish is in the focal fish's frame (ahead, to its
+  left) and how it heads relative to it: the maps Calovi et al. draw.
+
+:func:`group_measures` summarises all of them for a swim.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: A fish slower than this (body lengths per second) has no heading in the order parameters.
+MIN_SPEED_BL_S = 0.05
+#: A kick is a speed rise of at least this much (body lengths per second) from a local minimum.
+KICK_RISE_BL_S = 0.5
+
+
+def _positions(positions) -> np.ndarray:
+    p = np.asarray(positions, dtype=float)
+    if p.ndim == 2:
+        p = p[:, None, :]
+    if p.ndim != 3 or p.shape[-1] != 3:
+        raise ValueError(f"positions must have shape (T, F, 3) or (T, 3), got {p.shape}")
+    return p
+
+
+def velocities(times_s, positions) -> np.ndarray:
+    """Velocities (T, F, 3) in m/s of positions (T, F, 3) sampled at ``times_s`` (T,) strictly increasing:
+    central differences inside, one-sided at the two ends (``numpy.gradient``)."""
+    t = np.asarray(times_s, dtype=float)
+    p = _positions(positions)
+    if t.ndim != 1 or t.size < 2 or t.size != p.shape[0] or not np.all(np.diff(t) > 0):
+        raise ValueError("times_s must be strictly increasing, one time per sample, at least two")
+    return np.gradient(p, t, axis=0)
+
+
+def headings(vel, min_speed_m_s: float = 0.0) -> np.ndarray:
+    """Unit horizontal headings (T, F, 2) of velocities (T, F, 3); NaN where the horizontal speed is at most
+    ``min_speed_m_s`` (or zero)."""
+    v = np.asarray(vel, dtype=float)[..., :2]
+    s = np.linalg.norm(v, axis=-1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        h = v / s
+    h[(s[..., 0] <= max(min_speed_m_s, 0.0)) | (s[..., 0] == 0.0)] = np.nan
+    return h
+
+
+def nearest_neighbour_m(positions) -> np.ndarray:
+    """Per sample and fish (T, F), the distance (m) to the nearest other fish's centre (NaN for a lone fish)."""
+    p = _positions(positions)
+    T, F, _ = p.shape
+    if F < 2:
+        return np.full((T, F), np.nan)
+    d = np.linalg.norm(p[:, :, None, :] - p[:, None, :, :], axis=-1)
+    d[:, np.arange(F), np.arange(F)] = np.inf
+    return d.min(axis=2)
+
+
+def polarisation(head) -> np.ndarray:
+    """``O_P`` per sample (T,): the length of the mean of the unit headings (T, F, 2), over the fish that have one
+    (NaN where none has)."""
+    h = np.asarray(head, dtype=float)
+    ok = np.all(np.isfinite(h), axis=-1)
+    n = ok.sum(axis=1)
+    s = np.where(ok[..., None], h, 0.0).sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(n > 0, np.linalg.norm(s, axis=-1) / n, np.nan)
+
+
+def milling(positions, head) -> np.ndarray:
+    """``O_R`` per sample (T,): ``|mean_i (r_i x h_i)_z|`` with ``r_i`` the unit horizontal vector from the centroid
+    of all fish to fish ``i`` and ``h_i`` its unit heading, over the fish that have both."""
+    p = _positions(positions)[..., :2]
+    h = np.asarray(head, dtype=float)
+    r = p - p.mean(axis=1, keepdims=True)
+    rn = np.linalg.norm(r, axis=-1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        r = r / rn
+    cross = r[..., 0] * h[..., 1] - r[..., 1] * h[..., 0]
+    ok = np.isfinite(cross)
+    n = ok.sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(n > 0, np.abs(np.where(ok, cross, 0.0).sum(axis=1)) / n, np.nan)
+
+
+def cohesion_m(positions) -> np.ndarray:
+    """Per sample (T,), the mean distance (m) of the fish from their centroid."""
+    p = _positions(positions)
+    return np.linalg.norm(p - p.mean(axis=1, keepdims=True), axis=-1).mean(axis=1)
+
+
+def kick_times(times_s, speed, rise_m_s: float) -> np.ndarray:
+    """The kicks of one fish: the times (s) of the local minima of ``speed`` (m/s, one per time in ``times_s``) from
+    which the speed rises by at least ``rise_m_s`` before it next falls. A flat stretch counts as one minimum, at its
+    start."""
+    t = np.asarray(times_s, dtype=float)
+    v = np.asarray(speed, dtype=float)
+    if v.size < 3:
+        return np.zeros(0)
+    dv = np.diff(v)
+    sign = np.sign(dv)
+    # carry the last non-zero slope over flat stretches, so that a plateau is not a turning point
+    for i in range(1, sign.size):
+        if sign[i] == 0:
+            sign[i] = sign[i - 1]
+    kicks = []
+    i, n = 0, v.size
+    while i < n - 1:
+        if sign[i] > 0 and (i == 0 or sign[i - 1] < 0):
+            j = i
+            while j < n - 1 and sign[j] >= 0:
+                j += 1
+            if v[j] - v[i] >= rise_m_s:
+                kicks.append(t[i])
+            i = j
+        else:
+            i += 1
+    return np.asarray(kicks)
+
+
+def wall_distance_m(positions, tank_m) -> np.ndarray:
+    """Per sample and fish (T, F), the horizontal distance (m) to the nearest side wall of a box tank of
+    ``tank_m = (length, depth, height)`` centred on the origin in x and y."""
+    p = _positions(positions)
+    L, D = float(tank_m[0]), float(tank_m[1])
+    return np.minimum(L / 2 - np.abs(p[..., 0]), D / 2 - np.abs(p[..., 1]))
+
+
+def neighbour_frame(positions, head) -> tuple[np.ndarray, np.ndarray]:
+    """Where the other fish are as each fish sees them: ``(rel, dphi)`` with ``rel`` (M, 2), a neighbour's horizontal
+    position in the focal fish's frame (m: ahead, to its left) and ``dphi`` (M,) its heading less the focal fish's
+    (rad, in ``(-pi, pi]``), for every sample and ordered pair whose two headings exist."""
+    p = _positions(positions)[..., :2]
+    h = np.asarray(head, dtype=float)
+    T, F, _ = p.shape
+    if F < 2:
+        return np.zeros((0, 2)), np.zeros(0)
+    i, j = np.nonzero(~np.eye(F, dtype=bool))
+    d = p[:, j] - p[:, i]  # (T, P, 2)
+    hi, hj = h[:, i], h[:, j]
+    ahead = d[..., 0] * hi[..., 0] + d[..., 1] * hi[..., 1]
+    left = -d[..., 0] * hi[..., 1] + d[..., 1] * hi[..., 0]
+    dphi = np.arctan2(hi[..., 0] * hj[..., 1] - hi[..., 1] * hj[..., 0], hi[..., 0] * hj[..., 0] + hi[..., 1] * hj[..., 1])
+    ok = np.isfinite(ahead) & np.isfinite(dphi)
+    return np.stack([ahead[ok], left[ok]], axis=-1), dphi[ok]
+
+
+def _stats(x: np.ndarray) -> dict:
+    x = np.asarray(x, dtype=float)
+    x = x[np.isfinite(x)]
+    if not x.size:
+        nan = float("nan")
+        return {"mean": nan, "median": nan, "p5": nan, "p95": nan}
+    return {"mean": float(x.mean()), "median": float(np.median(x)), "p5": float(np.percentile(x, 5)),
+            "p95": float(np.percentile(x, 95))}
+
+
+def group_measures(times_s, positions, body_length_m: float, tank_m=None, *, skip_s: float = 0.0,
+                   kick_rise_bl_s: float = KICK_RISE_BL_S, min_speed_bl_s: float = MIN_SPEED_BL_S) -> dict:
+    """The measures of the module docstring for a swim: ``times_s`` (T,), ``positions`` (T, F, 3) m, the fish's
+    ``body_length_m``, the box tank ``tank_m`` (length, depth, height; None: no wall distance). Samples before
+    ``skip_s`` (s after the first) are left out (the start from rest). Returns a JSON-ready dict:
+
+    * ``nn_distance_bl``: the nearest-neighbour distance's mean, median, 5th and 95th percentiles over fish and
+      samples (body lengths), and ``near_fraction_2bl``: the fraction of fish and samples with a neighbour within
+      2 body lengths;
+    * ``polarisation`` and ``milling``: their means over samples, and the fractions of samples polarised, milling
+      or swarming by Tunstrom et al.'s thresholds;
+    * ``cohesion_bl``: the mean distance from the centroid (body lengths), its mean over samples;
+    * ``kick_interval_s``: the intervals between a fish's consecutive kicks, pooled: mean, CV (standard deviation over
+      mean), minimum, 5th percentile, median and count;
+    * ``speed_bl_s``: the speed's mean, median, 5th and 95th percentiles (body lengths per second);
+    * ``wall_distance_bl``: the distance to the nearest side wall's mean, median, 5th and 95th percentiles."""
+    t = np.asarray(times_s, dtype=float)
+    p = _positions(positions)
+    if not body_length_m > 0:
+        raise ValueError("body_length_m must be positive")
+    vel = velocities(t, p)
+    keep = t >= t[0] + skip_s
+    t, p, vel = t[keep], p[keep], vel[keep]
+    bl = float(body_length_m)
+    head = headings(vel, min_speed_bl_s * bl)
+    speed = np.linalg.norm(vel, axis=-1)
+    nan = float("nan")
+    out: dict = {"fish": int(p.shape[1]), "samples": int(p.shape[0]), "body_length_m": bl, "skip_s": float(skip_s)}
+    nn = nearest_neighbour_m(p) / bl
+    out["nn_distance_bl"] = _stats(nn)
+    out["near_fraction_2bl"] = float(np.mean(nn[np.isfinite(nn)] <= 2.0)) if np.isfinite(nn).any() else nan
+    op, orr = polarisation(head), milling(p, head)
+    ok = np.isfinite(op) & np.isfinite(orr)
+    out["polarisation"] = float(np.nanmean(op)) if ok.any() else nan
+    out["milling"] = float(np.nanmean(orr)) if ok.any() else nan
+    out["state_fractions"] = {
+        "polarised": float(np.mean((op[ok] > 0.65) & (orr[ok] < 0.35))) if ok.any() else nan,
+        "milling": float(np.mean((orr[ok] > 0.65) & (op[ok] < 0.35))) if ok.any() else nan,
+        "swarm": float(np.mean((op[ok] < 0.35) & (orr[ok] < 0.35))) if ok.any() else nan}
+    out["cohesion_bl"] = float(cohesion_m(p).mean() / bl)
+    iv = np.concatenate([np.diff(kick_times(t, speed[:, f], kick_rise_bl_s * bl)) for f in range(p.shape[1])])
+    out["kick_interval_s"] = {
+        "count": int(iv.size), "mean": float(iv.mean()) if iv.size else nan,
+        "cv": float(iv.std() / iv.mean()) if iv.size > 1 and iv.mean() > 0 else nan,
+        "min": float(iv.min()) if iv.size else nan, "p5": float(np.percentile(iv, 5)) if iv.size else nan,
+        "median": float(np.median(iv)) if iv.size else nan}
+    out["speed_bl_s"] = _stats(speed / bl)
+    out["wall_distance_bl"] = _stats(wall_distance_m(p, tank_m) / bl) if tank_m is not None else None
+    return out
+
