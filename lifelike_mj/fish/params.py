@@ -42,6 +42,29 @@ Parameters (section numbers of the paper):
   saturates instead, at a speed no damselfish keeps up).
 * ``control_hz`` (the paper's 60 frames per second) and ``substeps`` (MuJoCo steps per control
   step).
+
+Beyond the paper (fish that live together; every one off by default, so that the paper's presets swim as
+before, bit for bit):
+
+* **Kick rhythm** (``kick_gamma_shape`` > 0): a kick (a run of *accelerate* steps) starts only when the fish's
+  timer runs out, and the next kick is due ``kick_floor_s`` plus a gamma-distributed wait (shape
+  ``kick_gamma_shape``, mean ``kick_mean_s - kick_floor_s``) after this one's start: a semi-Markov chain with a
+  refractory floor, as burst-and-coast fish kick (Calovi et al. 2018). Between kicks the chain runs among coast,
+  cruise and brake; the chain's own weight to stay in *accelerate* still sets how long a kick lasts. A fish
+  avoiding a wall may kick as the paper's chain lets it, the floor still holding.
+* **Social turns** (``social_attraction_rad``, ``social_alignment_rad``, ``social_depth_rad_per_bl`` > 0): at the
+  start of each kick a fish turns toward and along the neighbours it sees (within ``social_range_bl`` body lengths,
+  outside a rear blind sector of ``social_blind_deg``; no occlusion), heeding the ``social_neighbours`` most influential, in the
+  functional forms of Calovi et al. (2018): attraction ``gamma_att ((d - d0) / l_att) / (1 + (d / l_att)^2) sin psi
+  (1 + cos psi)`` (repulsion inside ``social_d0_bl``), alignment ``gamma_ali exp(-(d / l_ali)^2) sin dphi
+  (1 + 0.3 cos 2 dphi) (1 + 0.6 cos psi - 0.32 cos 2 psi)`` (``d`` the distance, ``psi`` the neighbour's bearing,
+  ``dphi`` its heading less the fish's, in its horizontal plane), and a pull to the neighbours' depth
+  (``social_depth_rad_per_bl``, rad per body length, at most 0.5 rad). The sum (rad), times ``social_turn_gain`` (at most 80 deg),
+  steers each push of the kick as a push at that angle would turn the fish (eq. 8-9: a lateral and a vertical
+  share ``r sin`` of it), while its forward share stays as drawn: the kick still speeds the fish up. With
+  ``social_speed_per_bl`` > 0 the kick's push is also scaled by ``1 + social_speed_per_bl`` times how far ahead (body
+  lengths, along its heading) those neighbours are on average, within 0.5-1.5: a fish behind the others pushes
+  harder, one ahead of them less (our addition: the functional forms above turn a fish but never change its speed).
 """
 
 from __future__ import annotations
@@ -98,6 +121,21 @@ class FishParams:
     runaway_speed_bl_s: float = 4.5
     control_hz: float = 60.0
     substeps: int = 4
+    # ---- beyond the paper (issue 28): off in the paper's presets, which then swim bit for bit as before ----
+    kick_gamma_shape: float = 0.0
+    kick_floor_s: float = 0.2
+    kick_mean_s: float = 0.5
+    social_attraction_rad: float = 0.0
+    social_alignment_rad: float = 0.0
+    social_depth_rad_per_bl: float = 0.0
+    social_range_bl: float = 20.0
+    social_blind_deg: float = 60.0
+    social_d0_bl: float = 1.0
+    social_l_att_bl: float = 6.5
+    social_l_ali_bl: float = 6.5
+    social_neighbours: int = 2
+    social_turn_gain: float = 1.0
+    social_speed_per_bl: float = 0.0
     #: A Markov matrix of your own (4 x 4 non-negative weights, rows normalised; row i: from MU i)
     #: instead of the one P_a..P_e make; ``None``: the paper's structure.
     transition: tuple | None = None
@@ -157,6 +195,11 @@ class FishParams:
             raise UserError(f"vision_angle_deg must lie in (0, 90), got {self.vision_angle_deg}.")
         if int(self.substeps) != self.substeps or not 1 <= self.substeps <= 100:
             raise UserError(f"substeps must be a whole number from 1 to 100, got {self.substeps}.")
+        if self.kick_gamma_shape > 0 and not self.kick_mean_s > self.kick_floor_s:
+            raise UserError(f"kick_mean_s ({self.kick_mean_s:g} s) must exceed kick_floor_s ({self.kick_floor_s:g} s): "
+                            "the mean interval between kicks is the floor plus a gamma-distributed wait.")
+        if int(self.social_neighbours) != self.social_neighbours:
+            raise UserError(f"social_neighbours must be a whole number, got {self.social_neighbours}.")
         if not 1.0 <= self.control_hz <= 10_000.0:
             raise UserError(f"control_hz must be in [1, 10000] Hz (the paper's is 60), got {self.control_hz}.")
         for k, (lo, hi, lo_open) in RANGES.items():  # the same bounds as the preset file's schema
@@ -225,6 +268,12 @@ RANGES: dict[str, tuple[float, float, bool]] = {
     "avoid_duration_s": (0.0, 3600.0, False), "avoid_accel_gain": (1.0, 1e6, False),
     "avoid_force_scale": (0.0, 1.0, True), "avoid_turn_deg": (0.0, 180.0, False),
     "runaway_speed_bl_s": (0.0, 1e4, True), "control_hz": (1.0, 10_000.0, False), "substeps": (1.0, 100.0, False),
+    "kick_gamma_shape": (0.0, 8.0, False), "kick_floor_s": (0.0, 60.0, False), "kick_mean_s": (0.0, 60.0, True),
+    "social_attraction_rad": (0.0, 10.0, False), "social_alignment_rad": (0.0, 10.0, False),
+    "social_depth_rad_per_bl": (0.0, 10.0, False),
+    "social_range_bl": (0.0, 1e4, True), "social_blind_deg": (0.0, 360.0, False), "social_d0_bl": (0.0, 100.0, False),
+    "social_l_att_bl": (0.0, 1e4, True), "social_l_ali_bl": (0.0, 1e4, True), "social_neighbours": (1.0, 1000.0, False),
+    "social_turn_gain": (0.0, 100.0, False), "social_speed_per_bl": (0.0, 10.0, False),
 }
 #: A transition weight's largest value (the matrix's rows are normalised).
 MAX_TRANSITION_WEIGHT = 1e6
@@ -289,6 +338,9 @@ def json_schema() -> dict:
                              "description": f"per body axis (x, y, z), {unit_of(f.name)}"}
         elif f.name == "substeps":
             props[f.name] = {"type": "integer", "minimum": 1, "maximum": 100, "description": "MuJoCo steps per control step"}
+        elif f.name == "social_neighbours":
+            props[f.name] = {"type": "integer", "minimum": 1, "maximum": 1000,
+                             "description": "how many neighbours a fish heeds at a kick (the most influential)"}
         elif f.name == "control_hz":
             props[f.name] = ranged(f.name, "control steps per second, Hz (the paper: 60)")
         else:

@@ -186,13 +186,29 @@ def python_passive(m: mujoco.MjModel, d: mujoco.MjData) -> None:
 S_MU, S_AVOID_T, S_AWAY = 0, 1, 2  # S_AWAY: 3 (unit vector away from the last wall seen)
 S_YAW, S_PITCH = 5, 6  # turn directions chosen when an avoidance starts (+1 left / nose up, -1, or 0)
 S_SPEED = 7  # running mean of the speed (time constant RUNAWAY_TAU_S, m/s)
-N_STATE = 8
+S_KICK_T = 8  # the kick rhythm: seconds until the next kick is due (params.kick_gamma_shape > 0)
+S_SOC_PHI, S_SOC_THETA = 9, 10  # the social turn of the current kick (deg added to phi and theta)
+S_SINCE = 11  # seconds since the current or last kick began
+S_SOC_PUSH = 12  # the social factor on the current kick's push (1: none)
+N_STATE = 13
 #: Time constant (s) of the running mean speed that the runaway check reads.
 RUNAWAY_TAU_S = 10.0
 # control constants (float array)
 C_RMIN, C_RMAX, C_THR, C_PHR, C_BA, C_BK, C_R, C_VIS, C_VANG, C_AVT, C_AVF, C_TURN, C_HEAD, C_MASS = range(14)
 C_IY, C_IZ, C_DT, C_VMAX = 14, 15, 16, 17
-N_CONST = 18
+# beyond the paper (params.py): the kick rhythm, the social turns (lengths in m, angles in rad unless named)
+C_KSHAPE, C_KFLOOR, C_KSCALE = 18, 19, 20
+C_SATT, C_SALI, C_SDEPTH, C_SRANGE, C_SCOSBLIND, C_SD0, C_SLATT, C_SLALI, C_SNEIGH, C_SGAIN, C_BL = range(21, 32)
+C_SSPEED = 32
+N_CONST = 33
+#: The most a social turn changes a push's angles (deg; the paper's random yaw spans +-80).
+SOCIAL_MAX_DEG = 80.0
+#: The most the pull to the neighbours' depth asks (rad).
+SOCIAL_DEPTH_MAX = 0.5
+#: The social factor on a push stays within these (params.py, ``social_speed_per_bl``).
+SOCIAL_PUSH_MIN, SOCIAL_PUSH_MAX = 0.5, 1.5
+#: Inside ``social_d0_bl`` a neighbour repels this many times the attraction's weight at contact (params.py).
+SOCIAL_REPEL = 2.0
 #: A seen surface counts when the heading points into it by more than asin(0.2) = 11.5 deg.
 APPROACH_MIN = 0.2
 #: During an avoidance the chosen turn side flips only when the away direction lies this far
@@ -239,7 +255,96 @@ def _look(vm, vd, pos, R, head, dist_m, ang, away, scratch, gid):
 
 
 @njit(cache=True)
-def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n, forced_mu, forced_push):
+def _social_turn(i, qpos, ud, c, n, out):
+    """The turn (rad; ``out[0]`` yaw, left positive; ``out[1]`` pitch, nose up positive) that fish ``i`` asks of
+    its next kick from the neighbours it sees (params.py, "Social turns"): each neighbour within range and outside
+    the rear blind sector adds attraction and alignment in Calovi et al.'s forms; the ``C_SNEIGH`` of largest
+    effect are summed, and the pull to their mean depth added. ``out[2]``: how far ahead of the fish those
+    neighbours are on average (m, along its heading; 0 for none)."""
+    qa = int(ud[U_FISH + FISH_BLOCK * i])
+    xi, yi, zi = qpos[qa], qpos[qa + 1], qpos[qa + 2]
+    w, x, y, z = qpos[qa + 3], qpos[qa + 4], qpos[qa + 5], qpos[qa + 6]
+    hx, hy = 1 - 2 * (y * y + z * z), 2 * (x * y + w * z)  # the body's x axis, horizontal part
+    hn = math.sqrt(hx * hx + hy * hy)
+    out[0] = 0.0
+    out[1] = 0.0
+    out[2] = 0.0
+    if hn < 1e-9:
+        return
+    hx, hy = hx / hn, hy / hn
+    k = int(c[C_SNEIGH])
+    best = np.zeros(k)  # |effect| of the k kept so far
+    eff = np.zeros(k)
+    dz = np.zeros(k)
+    ahead = np.zeros(k)
+    for j in range(n):
+        if j == i:
+            continue
+        qb = int(ud[U_FISH + FISH_BLOCK * j])
+        rx, ry, rz = qpos[qb] - xi, qpos[qb + 1] - yi, qpos[qb + 2] - zi
+        d = math.sqrt(rx * rx + ry * ry + rz * rz)
+        dh = math.sqrt(rx * rx + ry * ry)
+        if d > c[C_SRANGE] or dh < 1e-9:
+            continue
+        cpsi = (hx * rx + hy * ry) / dh
+        if cpsi < c[C_SCOSBLIND]:
+            continue  # behind, in the blind sector
+        spsi = (hx * ry - hy * rx) / dh
+        w2, x2, y2, z2 = qpos[qb + 3], qpos[qb + 4], qpos[qb + 5], qpos[qb + 6]
+        gx, gy = 1 - 2 * (y2 * y2 + z2 * z2), 2 * (x2 * y2 + w2 * z2)
+        gn = math.sqrt(gx * gx + gy * gy)
+        if gn < 1e-9:
+            continue
+        gx, gy = gx / gn, gy / gn
+        sdphi = hx * gy - hy * gx
+        cdphi = hx * gx + hy * gy
+        latt, lali = c[C_SLATT], c[C_SLALI]
+        if d >= c[C_SD0]:
+            att = c[C_SATT] * ((d - c[C_SD0]) / latt) / (1.0 + (d / latt) ** 2) * spsi * (1.0 + cpsi)
+        else:  # too close: turn away, the harder the closer (whatever the bearing: a fish ahead is avoided too)
+            att = -c[C_SATT] * SOCIAL_REPEL * (1.0 - d / c[C_SD0]) * (1.0 if spsi >= 0.0 else -1.0)
+        c2psi = 2 * cpsi * cpsi - 1
+        c2dphi = 2 * cdphi * cdphi - 1
+        ali = (c[C_SALI] * math.exp(-((d / lali) ** 2)) * sdphi * (1.0 + 0.3 * c2dphi)
+               * (1.0 + 0.6 * cpsi - 0.32 * c2psi))
+        e = att + ali
+        m = 0
+        for q in range(1, k):
+            if best[q] < best[m]:
+                m = q
+        if abs(e) > best[m] or best[m] == 0.0:
+            best[m] = abs(e) if e != 0.0 else 1e-300
+            eff[m] = e
+            dz[m] = rz
+            ahead[m] = dh * cpsi
+    kept = 0
+    mz = 0.0
+    for q in range(k):
+        if best[q] > 0.0:
+            out[0] += eff[q]
+            mz += dz[q]
+            out[2] += ahead[q]
+            kept += 1
+    if kept > 0:
+        out[2] /= kept
+    if kept > 0 and c[C_SDEPTH] > 0.0:
+        pull = c[C_SDEPTH] * (mz / kept) / c[C_BL]
+        out[1] = max(-SOCIAL_DEPTH_MAX, min(SOCIAL_DEPTH_MAX, pull))
+
+
+@njit(cache=True)
+def _gamma_wait(shape, scale, u2):
+    """A gamma-distributed wait (s) of whole ``shape`` (rounded, at least 1) and ``scale``: the sum of that many
+    exponential waits, from the uniforms ``u2`` (as many as the shape, at most ``len(u2)``)."""
+    m = max(1, min(len(u2), int(round(shape))))
+    t = 0.0
+    for q in range(m):
+        t -= math.log(u2[q])
+    return scale * t
+
+
+@njit(cache=True)
+def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n, forced_mu, forced_push, u2):
     """One control step for all fish: look, choose the MU, set the push (module docstring). A fish
     whose ``forced_mu`` is >= 0 takes that MU instead of the chain's draw; an accelerating fish whose
     ``forced_push`` row is finite pushes with that ``(r (N), theta (deg), phi (deg))`` instead of the
@@ -281,12 +386,37 @@ def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n, forced_mu, 
         mu = int(state[i, S_MU])
         tab = cum_avoid if avoiding else cum
         nxt = 3
-        for j in range(4):
-            if u[i, 0] < tab[mu, j]:
-                nxt = j
-                break
+        if c[C_KSHAPE] > 0.0 and mu != ACCELERATE and not (avoiding and state[i, S_SINCE] >= c[C_KFLOOR]):
+            # the kick rhythm: no kick before it is due, one as soon as it is; between kicks the chain runs
+            # among coast, cruise and brake (the same uniform, over their share of the row)
+            state[i, S_KICK_T] -= c[C_DT]
+            if state[i, S_KICK_T] <= 0.0:
+                nxt = ACCELERATE
+            else:
+                lo = tab[mu, 0]
+                x = lo + u[i, 0] * (1.0 - lo)
+                for j in range(1, 4):
+                    if x < tab[mu, j]:
+                        nxt = j
+                        break
+        else:
+            if c[C_KSHAPE] > 0.0:
+                state[i, S_KICK_T] -= c[C_DT]
+            for j in range(4):
+                if u[i, 0] < tab[mu, j]:
+                    nxt = j
+                    break
         if forced_mu[i] >= 0:
             nxt = forced_mu[i]
+        onset = nxt == ACCELERATE and mu != ACCELERATE
+        state[i, S_SINCE] = 0.0 if onset else state[i, S_SINCE] + c[C_DT]
+        if onset and c[C_KSHAPE] > 0.0:
+            state[i, S_KICK_T] = c[C_KFLOOR] + _gamma_wait(c[C_KSHAPE], c[C_KSCALE], u2[i])
+        if onset and (c[C_SATT] > 0.0 or c[C_SALI] > 0.0 or c[C_SDEPTH] > 0.0 or c[C_SSPEED] > 0.0):
+            _social_turn(i, qpos, ud, c, n, away)
+            state[i, S_SOC_PHI] = max(-SOCIAL_MAX_DEG, min(SOCIAL_MAX_DEG, c[C_SGAIN] * math.degrees(away[0])))
+            state[i, S_SOC_THETA] = max(-SOCIAL_MAX_DEG, min(SOCIAL_MAX_DEG, c[C_SGAIN] * math.degrees(away[1])))
+            state[i, S_SOC_PUSH] = max(SOCIAL_PUSH_MIN, min(SOCIAL_PUSH_MAX, 1.0 + c[C_SSPEED] * away[2] / c[C_BL]))
         state[i, S_MU] = nxt
         ud[base + 2] = nxt
         ud[base + 3] = 0.0
@@ -297,6 +427,8 @@ def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n, forced_mu, 
         scale = c[C_AVF] if avoiding else 1.0
         fwd_scale = 1.0
         r = scale * (c[C_RMIN] + (c[C_RMAX] - c[C_RMIN]) * u[i, 1])
+        if c[C_SSPEED] > 0.0:
+            r *= state[i, S_SOC_PUSH]
         pitch = math.degrees(math.asin(min(1.0, max(-1.0, R[6]))))  # nose up > 0
         sg = 1.0 if pitch > 0 else (-1.0 if pitch < 0 else 0.0)
         theta = 90.0 + c[C_THR] * (2.0 * u[i, 2] - 1.0) + c[C_BA] * sg / (1.0 + math.exp(-c[C_BK] * abs(pitch)))
@@ -320,6 +452,11 @@ def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n, forced_mu, 
         lateral = r * math.sin(th) * math.cos(ph)
         vertical = r * math.cos(th)
         forward = fwd_scale * r * math.sin(th) * math.sin(ph)
+        if c[C_SATT] > 0.0 or c[C_SALI] > 0.0 or c[C_SDEPTH] > 0.0:
+            # the social turn steers the kick as a push of that angle would turn it (eq. 8-9: left and nose up
+            # positive), its forward share left as drawn
+            lateral += r * math.sin(math.radians(state[i, S_SOC_PHI]))
+            vertical += r * math.sin(math.radians(state[i, S_SOC_THETA]))
         mr2 = c[C_MASS] * c[C_R] * c[C_R]
         ud[base + 3] = forward
         ud[base + 4] = -c[C_IY] * vertical / mr2  # about the body's left axis: negative = nose up
@@ -328,13 +465,13 @@ def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n, forced_mu, 
 
 @njit(cache=True)
 def _run_chunk(mptr, dptr, vm, vd, qpos, qvel, ud, state, cum, cum_avoid, U, c, n, substeps, out_pos, out_quat,
-               out_mu, record, err, forced_mu, forced_push):
+               out_mu, record, err, forced_mu, forced_push, U2):
     """Control steps ``U.shape[0]`` (each: :func:`_control`, then ``substeps`` ``mj_step``), recording
     positions, orientations and MUs after each when ``record``. On a runaway (the running mean speed
     above ``C_VMAX``) or NaN writes ``err = (kind, step, fish, speed)`` (kind 1 runaway, 2 not
     finite) and returns."""
     for k in range(U.shape[0]):
-        _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, U[k], c, n, forced_mu, forced_push)
+        _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, U[k], c, n, forced_mu, forced_push, U2[k])
         for _ in range(substeps):
             _mj_step(_vp(mptr), _vp(dptr))
         for i in range(n):
@@ -507,7 +644,24 @@ class Tank(StepCounter):
         c[C_IY], c[C_IZ] = sc.inertia[1], sc.inertia[2]
         c[C_DT] = params.control_dt_s
         c[C_VMAX] = params.runaway_speed_bl_s * BODY_LENGTH_M
+        c[C_KSHAPE], c[C_KFLOOR] = params.kick_gamma_shape, params.kick_floor_s
+        if params.kick_gamma_shape > 0:
+            c[C_KSCALE] = (params.kick_mean_s - params.kick_floor_s) / max(1, round(params.kick_gamma_shape))
+        c[C_SATT], c[C_SALI] = params.social_attraction_rad, params.social_alignment_rad
+        c[C_SDEPTH] = params.social_depth_rad_per_bl
+        c[C_SRANGE] = params.social_range_bl * BODY_LENGTH_M
+        c[C_SCOSBLIND] = -math.cos(math.radians(params.social_blind_deg) / 2.0)
+        c[C_SD0], c[C_SLATT], c[C_SLALI] = (params.social_d0_bl * BODY_LENGTH_M, params.social_l_att_bl * BODY_LENGTH_M,
+                                            params.social_l_ali_bl * BODY_LENGTH_M)
+        c[C_SNEIGH], c[C_SGAIN], c[C_BL] = params.social_neighbours, params.social_turn_gain, BODY_LENGTH_M
+        c[C_SSPEED] = params.social_speed_per_bl
+        self.state_array[:, S_SOC_PUSH] = 1.0
         self.c = c
+        #: A second random stream per fish, for what the paper's chain does not draw (the kick rhythm's waits), so
+        #: that the paper's own draws stay as they were; drawn only when the rhythm is on.
+        self.rngs2 = [np.random.Generator(np.random.PCG64(ch)) for ch in ss.spawn(n)]
+        if params.kick_gamma_shape > 0:  # the first kick is due at a random phase of the mean interval
+            self.state_array[:, S_KICK_T] = [g.random() * params.kick_mean_s for g in self.rngs2]
         self._k = 0
         mujoco.mj_forward(m, self.data)
 
@@ -528,6 +682,18 @@ class Tank(StepCounter):
         U = np.empty((k, self.scene.n, 4))
         for i, g in enumerate(self.rngs):
             U[:, i, :] = g.random((k, 4))
+        return U
+
+    #: Uniforms per fish and control step of the second stream (the kick rhythm's gamma wait: its shape, at most).
+    N_U2 = 8
+
+    def _randoms2(self, k: int) -> np.ndarray:
+        """The second stream's uniforms for ``k`` control steps (zeros, none drawn, while the rhythm is off)."""
+        if self.params.kick_gamma_shape <= 0:
+            return np.zeros((k, self.scene.n, 1))
+        U = np.empty((k, self.scene.n, self.N_U2))
+        for i, g in enumerate(self.rngs2):
+            U[:, i, :] = 1.0 - g.random((k, self.N_U2))  # in (0, 1]: their logarithms are finite
         return U
 
     def step(self, n: int = 1) -> None:
@@ -575,7 +741,8 @@ class Tank(StepCounter):
         with passive_callback(COMPILED_PASSIVE), watching():
             _run_chunk(sc.model._address, self.data._address, sc.vision_model._address, self.vision_data._address,
                        self.data.qpos, self.data.qvel, self.data.userdata, self.state_array, self.cum, self.cum_avoid,
-                       U, self.c, n, int(self.params.substeps), pos, quat, mu, record, err, forced_mu, forced_push)
+                       U, self.c, n, int(self.params.substeps), pos, quat, mu, record, err, forced_mu, forced_push,
+                       self._randoms2(k))
             done = (int(err[1]) + 1 if err[0] != 0 else k) * int(self.params.substeps)
             if was_reset(self.data, t0, done, float(self.scene.model.opt.timestep)):
                 raise Diverged(describe(self.data, "the tank") + " " + self._unstable_cause(), self._k + k)
