@@ -25,6 +25,8 @@ def main() -> None:
     print(f"| 10 fish, simulated s per wall s | x{ten['realtime_factor']:.0f} | >= x200 |")
     print(f"| 1,000 fish, simulated s per wall s | x{thou['realtime_factor']:.2f} | >= x1 |")
     print(f"| 1,000 fish, building the scene | {thou['build_s']:.2f} s | |")
+    sch = r["thousand_school"]
+    print(f"| 1,000 `school` fish (interacting), simulated s per wall s | x{sch['realtime_factor']:.2f} | >= x1 |")
     if "fps" in rend:
         print(f"| rendering 640x480, frames per s | {rend['fps']:.0f} | >= 60 |")
     else:
