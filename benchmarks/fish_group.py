@@ -1,7 +1,7 @@
 """Fish measured as a group (issue 28): the paper's ten ``B-D`` fish, which ignore each other, the same fish with
 the kick rhythm, and the ``school`` and ``shoal`` presets.
 
-Run: ``python benchmarks/fish_group.py`` (about 40 s). Writes ``benchmarks/results/fish_group.json``.
+Run: ``python benchmarks/fish_group.py`` (about a minute). Writes ``benchmarks/results/fish_group.json``.
 
 Ten fish for 120 s, seeds 11-14 (none used in choosing the settings, which were chosen on seeds 1-4), measured from
 the tracks alone by ``fish.shoal.group_measures`` (what ``lifelike-mj fish swim --fish 10 --duration 120 --seed 11
@@ -12,6 +12,10 @@ and gather):
 * ``B-D + rhythm``: the kick rhythm (a floor of 0.25 s, a gamma wait of shape 4, a mean interval of 0.55 s) and yaw
   noise of +-25 deg in place of +-80 (``RHYTHM``), in the filmed tank;
 * ``school`` in the filmed tank and in an open tank (``OPEN_TANK``), ``shoal`` in the open tank.
+
+A startle cascade (``fish.aquarium``, ``cascade=True``): ten ``school`` fish in the open tank, seeds 5-12, swim until
+they are a school (polarisation above 0.8, nearest neighbours under 2.5 BL, looked at every half second from 20 s
+on); then the fish at the front is startled alone, and the benchmark records which fish escape within 1 s, and when.
 
 And the paper's kick intervals again for kick thresholds from 0.1 to 1.5 body lengths per second, since a kick's
 definition (a speed rise of at least that much) sets how many small rises count.
@@ -43,6 +47,36 @@ VARIANTS = {"B-D": ("B-D", {}, None, 0.0), "B-D + rhythm": ("B-D", RHYTHM, None,
 THRESHOLDS_BL_S = (0.1, 0.3, 0.5, 0.8, 1.0, 1.5)
 
 
+CASCADE_SEEDS = tuple(range(5, 13))
+
+
+def cascade(seed: int) -> dict:
+    """A startle at the front of a school (module docstring): when each fish first escapes (s after the startle)."""
+    import numpy as np
+
+    from lifelike_mj.fish.aquarium import Aquarium
+    from lifelike_mj.fish.shoal import headings, polarisation
+
+    a = Aquarium(fish.Tank(fish.load_preset("school"), n_fish=10, seed=seed, size=OPEN_TANK), cascade=True)
+    a.step(60 * 20)
+    while True:
+        st = a.tank.state()
+        nn = nearest_neighbour_m(st["position_m"][None])
+        if polarisation(headings(st["velocity_m_s"][None], 0.01))[0] > 0.8 and np.median(nn) < 2.5 * BODY_LENGTH_M:
+            break
+        a.step(30)
+    front = int(np.argmax(st["position_m"][:, :2] @ st["velocity_m_s"][:, :2].mean(axis=0)))
+    t0 = a.time
+    a.startle(front)
+    first = np.full(10, np.inf)
+    for _ in range(60):
+        a.step(1)
+        new = (a.startled_at >= t0 - 1e-9) & np.isinf(first)
+        first[new] = a.startled_at[new] - t0
+    return {"seed": seed, "startled_at_s": t0, "reached": int(np.isfinite(first).sum()),
+            "first_escape_s": [float(v) if np.isfinite(v) else None for v in first]}
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "fish_group.json"))
@@ -67,6 +101,10 @@ def main(argv=None) -> None:
               f"{100 * g['near_fraction_2bl']:.1f} % within 2 BL, polarisation {g['polarisation']:.2f}, milling "
               f"{g['milling']:.2f}, cohesion {g['cohesion_bl']:.1f} BL, closest {g['closest_bl']:.2f} BL, kicks every "
               f"{k['mean']:.2f} s (CV {k['cv']:.2f}, 5th percentile {k['p5']:.2f} s)")
+    cascades = [cascade(seed) for seed in CASCADE_SEEDS]
+    for c in cascades:
+        last = max(v for v in c["first_escape_s"] if v is not None)
+        print(f"cascade, seed {c['seed']}: {c['reached']} of 10 escaped within 1 s (the last after {last:.2f} s)")
     for s in sweep:
         if s["seed"] == SEEDS[0]:
             print(f"threshold {s['threshold_bl_s']:.1f} BL/s: mean {s['mean']:.2f} s, CV {s['cv']:.2f}, 5th percentile "
@@ -74,7 +112,7 @@ def main(argv=None) -> None:
     write_json(args.out, {"provenance": provenance(benchmark="fish_group", seeds=list(SEEDS), duration_s=DURATION_S,
                                                    thresholds_bl_s=list(THRESHOLDS_BL_S), variants=VARIANTS),
                           "machine": machine_info(), "wall_time_s": time.perf_counter() - start, "runs": runs,
-                          "kick_threshold_sweep": sweep})
+                          "kick_threshold_sweep": sweep, "cascades": cascades})
 
 
 if __name__ == "__main__":

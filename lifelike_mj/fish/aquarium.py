@@ -12,8 +12,20 @@ have in mind), as two stated rules on top of the four motion units. Nothing else
   ``(r_min_N + r_max_N) / 2``) instead of in a drawn direction; its timing stays the chain's. The first fish
   whose centre comes within :data:`EAT_RADIUS_M` of a pellet eats it.
 
-The random numbers are drawn as without the aquarium (the tank's policies, :class:`~lifelike_mj.fish.sim.Tank`),
-so until the first tap or pellet a tank swims exactly as the same tank without them.
+* **A startle spreads** (``cascade=True``; off by default): a fish that sees a neighbour start an escape may
+  startle too, as startles spread through real schools (Rosenthal et al. 2015). It sees a neighbour within
+  :data:`CASCADE_RANGE_BL` body lengths and outside the rear blind sector of its preset (``social_blind_deg``). Each
+  such escape is judged once, :data:`CASCADE_LATENCY_S` after it began (the time to see it and for the Mauthner
+  cells to fire), and startles the fish with the probability ``1 / (1 + exp(-(a + b ln d)))``. Here ``d`` is the
+  distance in body lengths, and ``a`` and ``b`` are :data:`CASCADE_LOGIT`. Rosenthal et al. fitted this form,
+  falling with the log of the distance, to golden shiners; the numbers are ours: 0.9 at 1 body length, 0.5 at 3,
+  0.1 at 9. A fish startled by a neighbour flees the way that neighbour flees. For :data:`CASCADE_REFRACTORY_S`
+  after its own escape began, a fish catches no other (so a startle runs through a school once). ``startle(i)`` startles one fish
+  alone, as a looming object only it sees.
+
+The random numbers are drawn as without the aquarium (the tank's policies, :class:`~lifelike_mj.fish.sim.Tank`; the
+cascade's draws come from a generator of their own), so until the first tap or pellet a tank swims exactly as the
+same tank without them.
 """
 
 from __future__ import annotations
@@ -38,6 +50,14 @@ FOOD_SIGHT_M = 1.5
 FOOD_SINK_M_S = 0.05
 #: A fish eats a pellet when its centre comes this close (m).
 EAT_RADIUS_M = 0.04
+#: A startle cascade (module docstring): how far a fish sees an escape (body lengths), how long after an escape began
+#: a neighbour reacts to it (s), and the logistic law's ``(a, b)`` of the probability that it does.
+CASCADE_RANGE_BL = 10.0
+CASCADE_LATENCY_S = 0.05
+#: A fish that escaped does not catch another escape from a neighbour for this long after its own began (s): a
+#: startle runs through a school once rather than echoing back and forth.
+CASCADE_REFRACTORY_S = 3.0
+CASCADE_LOGIT = (2.2, -2.0)
 #: A pellet's radius (m) and colour, as the viewers draw it.
 PELLET_DRAWN_M = 0.02
 PELLET_RGBA = (0.75, 0.45, 0.15, 1.0)
@@ -56,10 +76,15 @@ class Aquarium:
     ``tank``: the tank (made with no policies of its own). ``tap(point_m)`` and ``drop_food(x_m, y_m)`` act now;
     ``pellets_m`` holds the pellets still in the water; ``startled`` says which fish are startled."""
 
-    def __init__(self, tank: Tank) -> None:
+    def __init__(self, tank: Tank, cascade: bool = False) -> None:
         if tank.mu_policy is not None or tank.push_policy is not None:
             raise UserError("the aquarium needs a tank without policies of its own.")
         self.tank = tank
+        self.cascade = bool(cascade)
+        #: When each fish's last escape began (s; -inf: none), and the escapes each fish has judged.
+        self.startled_at = np.full(tank.n_fish, -np.inf)
+        self._judged = np.zeros((tank.n_fish, tank.n_fish), dtype=bool)
+        self._cascade_rng = np.random.default_rng([tank.seed, 28])
         self.tank.mu_policy, self.tank.push_policy = self._mu, self._push
         self.dt = tank.dt
         self._startle_until = np.full(tank.n_fish, -np.inf)
@@ -87,6 +112,9 @@ class Aquarium:
     def reset(self, seed: int | None = None) -> None:
         self.tank.reset(seed)
         self._startle_until[:] = -np.inf
+        self.startled_at[:] = -np.inf
+        self._judged[:] = False
+        self._cascade_rng = np.random.default_rng([self.tank.seed, 28])
         self.pellets_m = np.zeros((0, 3))
         self.eaten = 0
 
@@ -94,6 +122,8 @@ class Aquarium:
         for _ in range(checks.whole("the number of steps", n, 0)):
             self.tank.step(1)
             self._food()
+            if self.cascade:
+                self._spread()
 
     def state(self) -> dict[str, np.ndarray]:
         return {**self.tank.state(), "startled": self.startled, "pellets_m": self.pellets_m.copy()}
@@ -122,9 +152,58 @@ class Aquarium:
                             f"bottom at z = 0), got {point_m!r}.")
         pos, _ = self.tank.snapshot()
         near = np.linalg.norm(pos - p, axis=1) <= TAP_RADIUS_M
-        self._startle_until[near] = self.time + STARTLE_S
-        self._startle_from[near] = p
+        self._begin(near, p)
         return int(near.sum())
+
+    def startle(self, fish: int) -> None:
+        """Startle fish ``fish`` alone (as a looming object only it sees), fleeing straight ahead."""
+        i = checks.whole("the fish", fish, 0, self.tank.n_fish - 1)
+        pos, quat = self.tank.snapshot()
+        R = np.empty(9)
+        mujoco.mju_quat2Mat(R, quat[i])
+        ahead = R.reshape(3, 3)[:, 0]
+        mask = np.zeros(self.tank.n_fish, dtype=bool)
+        mask[i] = True
+        self._begin(mask, pos[i] - ahead)
+
+    def _begin(self, mask: np.ndarray, away_from) -> None:
+        """Startle the fish of ``mask``, fleeing from the point(s) ``away_from`` (m)."""
+        self._startle_until[mask] = self.time + STARTLE_S
+        self._startle_from[mask] = away_from
+        self.startled_at[mask] = self.time
+        self._judged[:, mask] = False  # a new escape: its neighbours judge it afresh
+
+    def _spread(self) -> None:
+        """The cascade (module docstring): each fish judges, once, each escape it sees that began
+        :data:`CASCADE_LATENCY_S` ago or more and is still on."""
+        from lifelike_mj.fish.scene import BODY_LENGTH_M
+
+        t = self.time
+        seen = self.startled & (t - self.startled_at >= CASCADE_LATENCY_S - 1e-9)
+        if not seen.any():
+            return
+        pos, quat = self.tank.snapshot()
+        R = np.empty(9)
+        cos_blind = -math.cos(math.radians(self.tank.params.social_blind_deg) / 2.0)
+        a, b = CASCADE_LOGIT
+        fresh = np.zeros(self.tank.n_fish, dtype=bool)
+        origin = np.zeros((self.tank.n_fish, 3))
+        for i in np.flatnonzero(~self.startled & (t - self.startled_at >= CASCADE_REFRACTORY_S)):
+            mujoco.mju_quat2Mat(R, quat[i])
+            ahead = R.reshape(3, 3)[:, 0]
+            for j in np.flatnonzero(seen & ~self._judged[i]):
+                d = pos[j] - pos[i]
+                dist = float(np.linalg.norm(d))
+                if dist > CASCADE_RANGE_BL * BODY_LENGTH_M or dist < 1e-9 or float(ahead @ d) / dist < cos_blind:
+                    continue
+                self._judged[i, j] = True
+                p = 1.0 / (1.0 + math.exp(-(a + b * math.log(max(dist / BODY_LENGTH_M, 1e-3)))))
+                if self._cascade_rng.random() < p and not fresh[i]:
+                    fresh[i] = True
+                    # flee the way the neighbour flees: from a point as far behind this fish as its threat is
+                    origin[i] = pos[i] + (self._startle_from[j] - pos[j])
+        if fresh.any():
+            self._begin(fresh, origin[fresh])
 
     def drop_food(self, x_m: float, y_m: float) -> None:
         """A pellet at ``(x_m, y_m)`` on the surface (module docstring)."""

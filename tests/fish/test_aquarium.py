@@ -87,3 +87,43 @@ def test_taps_and_food_outside_the_tank_are_refused():
         a.drop_food(9.0, 0.0)
     with pytest.raises(UserError, match="without policies"):
         Aquarium(Tank(n_fish=2, seed=0, mu_policy=lambda t: np.full(2, -1)))
+
+
+def _school_now(a):
+    """Whether the aquarium's fish swim as a school now: polarised and close."""
+    from lifelike_mj.fish import shoal
+
+    st = a.tank.state()
+    head = shoal.headings(st["velocity_m_s"][None], 0.01)
+    nn = shoal.nearest_neighbour_m(st["position_m"][None])
+    return shoal.polarisation(head)[0] > 0.8 and np.median(nn) < 2.5 * 0.07
+
+
+@pytest.mark.parametrize("seed", [5, 6, 7])
+def test_a_startle_at_the_front_of_a_school_runs_through_it_within_a_second(seed):
+    from lifelike_mj.fish import load_preset
+
+    runs = {}
+    for cascade in (True, False):
+        a = Aquarium(Tank(load_preset("school"), n_fish=10, seed=seed, size=(3.0, 3.0, 1.0)), cascade=cascade)
+        a.step(60 * 20)
+        while not _school_now(a):  # the same moment in both runs: the cascade changes nothing before the startle
+            a.step(30)
+        st = a.tank.state()
+        h = st["velocity_m_s"][:, :2].mean(axis=0)
+        front = int(np.argmax(st["position_m"][:, :2] @ h))
+        t0 = a.time
+        a.startle(front)
+        first = np.full(10, np.inf)
+        for _ in range(60):  # one second
+            a.step(1)
+            new = (a.startled_at >= t0 - 1e-9) & np.isinf(first)
+            first[new] = a.startled_at[new] - t0
+        runs[cascade] = first
+        if cascade:
+            a.step(60)  # two seconds after the startle: nobody caught a second escape
+            assert np.all(a.startled_at - t0 < 1.0 + 1e-9)
+    reached = np.isfinite(runs[True])
+    assert reached.sum() > 5  # most of the school (issue 28), within the second
+    assert np.all(runs[True][reached] >= 0.0) and np.sort(runs[True][reached])[1] >= 0.05 - 1e-9  # after a latency
+    assert np.isfinite(runs[False]).sum() == 1  # without the cascade only the fish startled
