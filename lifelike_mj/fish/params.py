@@ -65,6 +65,8 @@ before, bit for bit):
   ``social_speed_per_bl`` > 0 the kick's push is also scaled by ``1 + social_speed_per_bl`` times how far ahead (body
   lengths, along its heading) those neighbours are on average, within 0.5-1.5: a fish behind the others pushes
   harder, one ahead of them less (our addition: the functional forms above turn a fish but never change its speed).
+* **Fish that touch** (``fish_contacts`` = 1): the fish's collision capsules collide with each other as well as with
+  the tank (frictionless, as against the glass), so that no fish passes through another.
 """
 
 from __future__ import annotations
@@ -136,6 +138,7 @@ class FishParams:
     social_neighbours: int = 2
     social_turn_gain: float = 1.0
     social_speed_per_bl: float = 0.0
+    fish_contacts: int = 0
     #: A Markov matrix of your own (4 x 4 non-negative weights, rows normalised; row i: from MU i)
     #: instead of the one P_a..P_e make; ``None``: the paper's structure.
     transition: tuple | None = None
@@ -198,6 +201,8 @@ class FishParams:
         if self.kick_gamma_shape > 0 and not self.kick_mean_s > self.kick_floor_s:
             raise UserError(f"kick_mean_s ({self.kick_mean_s:g} s) must exceed kick_floor_s ({self.kick_floor_s:g} s): "
                             "the mean interval between kicks is the floor plus a gamma-distributed wait.")
+        if self.fish_contacts not in (0, 1):
+            raise UserError(f"fish_contacts is 0 or 1 (whether fish collide with each other), got {self.fish_contacts}.")
         if int(self.social_neighbours) != self.social_neighbours:
             raise UserError(f"social_neighbours must be a whole number, got {self.social_neighbours}.")
         if not 1.0 <= self.control_hz <= 10_000.0:
@@ -274,6 +279,7 @@ RANGES: dict[str, tuple[float, float, bool]] = {
     "social_range_bl": (0.0, 1e4, True), "social_blind_deg": (0.0, 360.0, False), "social_d0_bl": (0.0, 100.0, False),
     "social_l_att_bl": (0.0, 1e4, True), "social_l_ali_bl": (0.0, 1e4, True), "social_neighbours": (1.0, 1000.0, False),
     "social_turn_gain": (0.0, 100.0, False), "social_speed_per_bl": (0.0, 10.0, False),
+    "fish_contacts": (0.0, 1.0, False),
 }
 #: A transition weight's largest value (the matrix's rows are normalised).
 MAX_TRANSITION_WEIGHT = 1e6
@@ -338,6 +344,9 @@ def json_schema() -> dict:
                              "description": f"per body axis (x, y, z), {unit_of(f.name)}"}
         elif f.name == "substeps":
             props[f.name] = {"type": "integer", "minimum": 1, "maximum": 100, "description": "MuJoCo steps per control step"}
+        elif f.name == "fish_contacts":
+            props[f.name] = {"type": "integer", "minimum": 0, "maximum": 1,
+                             "description": "1: the fish's collision capsules also collide with each other"}
         elif f.name == "social_neighbours":
             props[f.name] = {"type": "integer", "minimum": 1, "maximum": 1000,
                              "description": "how many neighbours a fish heeds at a kick (the most influential)"}

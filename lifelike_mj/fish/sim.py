@@ -572,6 +572,12 @@ class Tank(StepCounter):
         self.scene.model.opt.timestep = self.params.timestep_s
         if self.scene.model.nuserdata < U_FISH + FISH_BLOCK * self.scene.n:
             raise RuntimeError("internal: the scene was compiled without room for the fish userdata")
+        if self.params.fish_contacts:
+            # the fish's collision capsules (contype 1) collide with each other too (params.py, "Fish that touch")
+            m = self.scene.model
+            caps = np.flatnonzero((m.geom_contype == 1) & np.isin(m.geom_bodyid, self.scene.body))
+            m.geom_conaffinity[caps] = 1
+            m.body_conaffinity[self.scene.body] |= 1  # the broad phase filters bodies by these (the OR of their geoms')
         self.vision_data = mujoco.MjData(self.scene.vision_model)
         mujoco.mj_kinematics(self.scene.vision_model, self.vision_data)
         for name, fn in (("mu_policy", mu_policy), ("push_policy", push_policy)):

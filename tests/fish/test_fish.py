@@ -216,7 +216,8 @@ def test_presets_load_with_units_in_every_name(name):
     assert p.name == name
     for k in p.to_dict():
         assert k.startswith("P_") or k in ("cd", "cd_rot", "substeps", "avoid_accel_gain", "avoid_force_scale",
-                                           "kick_gamma_shape", "social_neighbours", "social_turn_gain") \
+                                           "kick_gamma_shape", "social_neighbours", "social_turn_gain",
+                                           "fish_contacts") \
             or any(k.endswith(u) for u in ("_N", "_deg", "_m", "_m2", "_m5", "_s", "_hz", "_kg_m3", "_per_deg",
                                            "_bl_s", "_bl", "_rad", "_rad_per_bl")), k
     assert load_preset("default") == load_preset("B-D")

@@ -183,6 +183,8 @@ def test_the_school_and_shoal_presets_in_an_open_tank(seed):
         k = g["kick_interval_s"]
         assert 0.3 <= k["cv"] <= 0.55 and k["p5"] >= 0.2 and 0.4 <= k["mean"] <= 0.7
         assert not r.outside_tank().any()
+        # the fish touch (two capsules of 8 mm radius side by side: 0.23 BL apart) but never pass through each other
+        assert shoal.nearest_neighbour_m(r.positions).min() / BODY_LENGTH_M > 0.2
     assert out["school"]["polarisation"] >= 0.7 and out["school"]["nn_distance_bl"]["median"] <= 2.3
     assert out["shoal"]["polarisation"] < 0.5 and out["shoal"]["nn_distance_bl"]["median"] <= 3.0
     assert out["shoal"]["cohesion_bl"] < 8.0 and out["school"]["cohesion_bl"] < 8.0
