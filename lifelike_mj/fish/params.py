@@ -47,11 +47,11 @@ Beyond the paper (fish that live together; every one off by default, so that the
 before, bit for bit):
 
 * **Kick rhythm** (``kick_gamma_shape`` > 0): a kick (a run of *accelerate* steps) starts only when the fish's
-  timer runs out, and the next kick is due ``kick_floor_s`` plus a gamma-distributed wait (shape
-  ``kick_gamma_shape``, mean ``kick_mean_s - kick_floor_s``) after this one's start: a semi-Markov chain with a
-  refractory floor, as burst-and-coast fish kick (Calovi et al. 2018). Between kicks the chain runs among coast,
-  cruise and brake; the chain's own weight to stay in *accelerate* still sets how long a kick lasts. A fish
-  avoiding a wall may kick as the paper's chain lets it, the floor still holding.
+  timer runs out, and the next kick is due ``kick_floor_s`` plus a gamma-distributed wait (whole shape
+  ``kick_gamma_shape`` up to 8, an Erlang wait; mean ``kick_mean_s - kick_floor_s``) after this one's start: a
+  semi-Markov chain with a refractory floor, as burst-and-coast fish kick (Calovi et al. 2018). Between kicks the
+  chain runs among coast, cruise and brake; the chain's own weight to stay in *accelerate* still sets how long a
+  kick lasts. A fish avoiding a wall may kick as the paper's chain lets it, the floor still holding.
 * **Social turns** (``social_attraction_rad``, ``social_alignment_rad``, ``social_depth_rad_per_bl`` > 0): at the
   start of each kick a fish turns toward and along the neighbours it sees (within ``social_range_bl`` body lengths,
   outside a rear blind sector of ``social_blind_deg``; no occlusion), heeding the ``social_neighbours`` most influential, in the
@@ -124,7 +124,7 @@ class FishParams:
     control_hz: float = 60.0
     substeps: int = 4
     # ---- beyond the paper (issue 28): off in the paper's presets, which then swim bit for bit as before ----
-    kick_gamma_shape: float = 0.0
+    kick_gamma_shape: int = 0
     kick_floor_s: float = 0.2
     kick_mean_s: float = 0.5
     social_attraction_rad: float = 0.0
@@ -203,6 +203,9 @@ class FishParams:
                             "the mean interval between kicks is the floor plus a gamma-distributed wait.")
         if self.fish_contacts not in (0, 1):
             raise UserError(f"fish_contacts is 0 or 1 (whether fish collide with each other), got {self.fish_contacts}.")
+        if int(self.kick_gamma_shape) != self.kick_gamma_shape:
+            raise UserError(f"kick_gamma_shape must be a whole number from 0 (the paper's chain) to 8, got "
+                            f"{self.kick_gamma_shape}.")
         if int(self.social_neighbours) != self.social_neighbours:
             raise UserError(f"social_neighbours must be a whole number, got {self.social_neighbours}.")
         if not 1.0 <= self.control_hz <= 10_000.0:
@@ -344,6 +347,9 @@ def json_schema() -> dict:
                              "description": f"per body axis (x, y, z), {unit_of(f.name)}"}
         elif f.name == "substeps":
             props[f.name] = {"type": "integer", "minimum": 1, "maximum": 100, "description": "MuJoCo steps per control step"}
+        elif f.name == "kick_gamma_shape":
+            props[f.name] = {"type": "integer", "minimum": 0, "maximum": 8,
+                             "description": "0: the paper's chain; else the kick rhythm's gamma (Erlang) shape"}
         elif f.name == "fish_contacts":
             props[f.name] = {"type": "integer", "minimum": 0, "maximum": 1,
                              "description": "1: the fish's collision capsules also collide with each other"}

@@ -199,8 +199,8 @@ C_IY, C_IZ, C_DT, C_VMAX = 14, 15, 16, 17
 # beyond the paper (params.py): the kick rhythm, the social turns (lengths in m, angles in rad unless named)
 C_KSHAPE, C_KFLOOR, C_KSCALE = 18, 19, 20
 C_SATT, C_SALI, C_SDEPTH, C_SRANGE, C_SCOSBLIND, C_SD0, C_SLATT, C_SLALI, C_SNEIGH, C_SGAIN, C_BL = range(21, 32)
-C_SSPEED = 32
-N_CONST = 33
+C_SSPEED, C_SOCIAL = 32, 33  # C_SOCIAL: 1 when any social term is on
+N_CONST = 34
 #: The most a social turn changes a push's angles (deg; the paper's random yaw spans +-80).
 SOCIAL_MAX_DEG = 80.0
 #: The most the pull to the neighbours' depth asks (rad).
@@ -334,9 +334,9 @@ def _social_turn(i, qpos, ud, c, n, out):
 
 @njit(cache=True)
 def _gamma_wait(shape, scale, u2):
-    """A gamma-distributed wait (s) of whole ``shape`` (rounded, at least 1) and ``scale``: the sum of that many
-    exponential waits, from the uniforms ``u2`` (as many as the shape, at most ``len(u2)``)."""
-    m = max(1, min(len(u2), int(round(shape))))
+    """A gamma-distributed wait (s) of whole ``shape`` (an Erlang wait) and ``scale``: the sum of ``shape``
+    exponential waits of mean ``scale``, from the uniforms ``u2`` (at least ``shape`` of them)."""
+    m = int(shape)
     t = 0.0
     for q in range(m):
         t -= math.log(u2[q])
@@ -412,7 +412,7 @@ def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n, forced_mu, 
         state[i, S_SINCE] = 0.0 if onset else state[i, S_SINCE] + c[C_DT]
         if onset and c[C_KSHAPE] > 0.0:
             state[i, S_KICK_T] = c[C_KFLOOR] + _gamma_wait(c[C_KSHAPE], c[C_KSCALE], u2[i])
-        if onset and (c[C_SATT] > 0.0 or c[C_SALI] > 0.0 or c[C_SDEPTH] > 0.0 or c[C_SSPEED] > 0.0):
+        if onset and c[C_SOCIAL] > 0.0:
             _social_turn(i, qpos, ud, c, n, away)
             state[i, S_SOC_PHI] = max(-SOCIAL_MAX_DEG, min(SOCIAL_MAX_DEG, c[C_SGAIN] * math.degrees(away[0])))
             state[i, S_SOC_THETA] = max(-SOCIAL_MAX_DEG, min(SOCIAL_MAX_DEG, c[C_SGAIN] * math.degrees(away[1])))
@@ -452,7 +452,7 @@ def _control(vm, vd, qpos, qvel, ud, state, cum, cum_avoid, u, c, n, forced_mu, 
         lateral = r * math.sin(th) * math.cos(ph)
         vertical = r * math.cos(th)
         forward = fwd_scale * r * math.sin(th) * math.sin(ph)
-        if c[C_SATT] > 0.0 or c[C_SALI] > 0.0 or c[C_SDEPTH] > 0.0:
+        if c[C_SOCIAL] > 0.0:
             # the social turn steers the kick as a push of that angle would turn it (eq. 8-9: left and nose up
             # positive), its forward share left as drawn
             lateral += r * math.sin(math.radians(state[i, S_SOC_PHI]))
@@ -652,7 +652,7 @@ class Tank(StepCounter):
         c[C_VMAX] = params.runaway_speed_bl_s * BODY_LENGTH_M
         c[C_KSHAPE], c[C_KFLOOR] = params.kick_gamma_shape, params.kick_floor_s
         if params.kick_gamma_shape > 0:
-            c[C_KSCALE] = (params.kick_mean_s - params.kick_floor_s) / max(1, round(params.kick_gamma_shape))
+            c[C_KSCALE] = (params.kick_mean_s - params.kick_floor_s) / params.kick_gamma_shape
         c[C_SATT], c[C_SALI] = params.social_attraction_rad, params.social_alignment_rad
         c[C_SDEPTH] = params.social_depth_rad_per_bl
         c[C_SRANGE] = params.social_range_bl * BODY_LENGTH_M
@@ -661,6 +661,7 @@ class Tank(StepCounter):
                                             params.social_l_ali_bl * BODY_LENGTH_M)
         c[C_SNEIGH], c[C_SGAIN], c[C_BL] = params.social_neighbours, params.social_turn_gain, BODY_LENGTH_M
         c[C_SSPEED] = params.social_speed_per_bl
+        c[C_SOCIAL] = float(max(c[C_SATT], c[C_SALI], c[C_SDEPTH], c[C_SSPEED]) > 0.0)
         self.state_array[:, S_SOC_PUSH] = 1.0
         self.c = c
         #: A second random stream per fish, for what the paper's chain does not draw (the kick rhythm's waits), so
