@@ -236,6 +236,12 @@ class FishParams:
         return p / p.sum()
 
     @property
+    def social(self) -> bool:
+        """Whether the fish heed each other (any of the social terms above zero; module docstring)."""
+        return max(self.social_attraction_rad, self.social_alignment_rad, self.social_depth_rad_per_bl,
+                   self.social_speed_per_bl) > 0.0
+
+    @property
     def control_dt_s(self) -> float:
         return 1.0 / self.control_hz
 

@@ -309,7 +309,8 @@ def view_fish(params: FishParams, n_fish: int = 10, seed: int = 0, size=None, du
     under ``mjpython``. ``web``: :class:`~lifelike_mj.render.web.WebOptions` to serve MuJoCo's web viewer
     instead of opening a window (no display needed). The tank is a virtual aquarium
     (:mod:`lifelike_mj.fish.aquarium`, unless it has policies of its own): Space taps the front glass, Enter
-    drops a food pellet (keys in the window, buttons in the web viewer).
+    drops a food pellet (keys in the window, buttons in the web viewer); fish that heed each other (a preset's
+    social terms, as in ``school`` and ``shoal``) pass a startle on (the aquarium's cascade).
     """
     if web is None:
         require_display("fish")
@@ -345,7 +346,7 @@ def view_fish(params: FishParams, n_fish: int = 10, seed: int = 0, size=None, du
     from lifelike_mj.fish.aquarium import Aquarium, controls
 
     if tank.mu_policy is None and tank.push_policy is None:  # the virtual aquarium: Space taps, Enter feeds
-        aquarium = Aquarium(tank)
+        aquarium = Aquarium(tank, cascade=tank.params.social)  # fish that heed each other pass a startle on
         view(aquarium, 1.0 / tank.dt, end, setup, web=web, controls=controls(aquarium, seed))
     else:
         view(tank, 1.0 / tank.dt, end, setup, web=web)

@@ -661,7 +661,7 @@ class Tank(StepCounter):
                                             params.social_l_ali_bl * BODY_LENGTH_M)
         c[C_SNEIGH], c[C_SGAIN], c[C_BL] = params.social_neighbours, params.social_turn_gain, BODY_LENGTH_M
         c[C_SSPEED] = params.social_speed_per_bl
-        c[C_SOCIAL] = float(max(c[C_SATT], c[C_SALI], c[C_SDEPTH], c[C_SSPEED]) > 0.0)
+        c[C_SOCIAL] = float(params.social)
         self.state_array[:, S_SOC_PUSH] = 1.0
         self.c = c
         #: A second random stream per fish, for what the paper's chain does not draw (the kick rhythm's waits), so
