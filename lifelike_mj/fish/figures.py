@@ -255,8 +255,7 @@ def group_figure(result: SwimResult, out_path: str | os.PathLike | None = None, 
     vel = shoal.velocities(t, p)
     head = shoal.headings(vel, shoal.MIN_SPEED_BL_S * bl)
     speed = np.linalg.norm(vel, axis=-1)
-    kicks = [np.diff(shoal.kick_times(t, speed[:, f], shoal.KICK_RISE_BL_S * bl)) for f in range(result.n_fish)]
-    iv = np.concatenate(kicks) if kicks else np.zeros(0)
+    iv = shoal.kick_intervals_s(t, speed, shoal.KICK_RISE_BL_S * bl)
     fig = _new_figure(13.0, 7.5)
     axs = fig.subplots(2, 3)
     name = result.params.name or "custom"

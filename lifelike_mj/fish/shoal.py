@@ -140,6 +140,13 @@ def kick_times(times_s, speed, rise_m_s: float) -> np.ndarray:
     return np.asarray(kicks)
 
 
+def kick_intervals_s(times_s, speed, rise_m_s: float) -> np.ndarray:
+    """The intervals (s) between consecutive kicks (:func:`kick_times`) of each fish, pooled over the fish (an
+    interval never spans two fish); ``speed`` (T, F) m/s, one row per time in ``times_s``."""
+    v = np.asarray(speed, dtype=float).reshape(len(times_s), -1)
+    return np.concatenate([np.zeros(0)] + [np.diff(kick_times(times_s, v[:, f], rise_m_s)) for f in range(v.shape[1])])
+
+
 def wall_distance_m(positions, tank_m) -> np.ndarray:
     """Per sample and fish (T, F), the horizontal distance (m) to the nearest side wall of a box tank of
     ``tank_m = (length, depth, height)`` centred on the origin in x and y."""
@@ -217,7 +224,7 @@ def group_measures(times_s, positions, body_length_m: float, tank_m=None, *, ski
         "milling": float(np.mean((orr[ok] > 0.65) & (op[ok] < 0.35))) if ok.any() else nan,
         "swarm": float(np.mean((op[ok] < 0.35) & (orr[ok] < 0.35))) if ok.any() else nan}
     out["cohesion_bl"] = float(cohesion_m(p).mean() / bl)
-    iv = np.concatenate([np.diff(kick_times(t, speed[:, f], kick_rise_bl_s * bl)) for f in range(p.shape[1])])
+    iv = kick_intervals_s(t, speed, kick_rise_bl_s * bl)
     out["kick_interval_s"] = {
         "count": int(iv.size), "mean": float(iv.mean()) if iv.size else nan,
         "cv": float(iv.std() / iv.mean()) if iv.size > 1 and iv.mean() > 0 else nan,
