@@ -32,15 +32,37 @@ def _preset(args):
     return load_preset(args.preset)
 
 
+def _tank_type(text: str) -> tuple[float, float, float]:
+    """An argparse ``type``: a tank's ``length,depth,height`` in m, each side at least 2.5 body lengths."""
+    from lifelike_mj.fish.scene import check_tank
+
+    try:
+        vals = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected three lengths in m, as 3,3,1, got {text!r}") from None
+    try:
+        return check_tank(vals)
+    except UserError as e:
+        raise argparse.ArgumentTypeError(str(e).rstrip(".")) from None
+
+
+_tank_type.__name__ = "tank size"
+
+
 def _tank(args):
     from lifelike_mj.fish.scene import tank_size
 
+    if getattr(args, "tank", None) is not None:
+        if args.tank_scale != 1.0:
+            raise UserError("give the tank either as --tank or as --tank-scale, not both.")
+        return args.tank
     return tank_size(positive("--tank-scale", args.tank_scale))
 
 
 def _add_fish(p) -> None:
     p.add_argument("--preset", default="default",
-                   help="fish motion preset: NB-ND, NB-D, B-ND, B-D or a JSON file (default: B-D, also called 'default')")
+                   help="fish motion preset: the paper's NB-ND, NB-D, B-ND, B-D; school, shoal or pair (fish that heed each "
+                        "other); or a JSON file (default: B-D, also called 'default')")
     from lifelike_mj.fish.params import MAX_FISH
 
     p.add_argument("--n", "--fish", dest="fish", type=count(1, MAX_FISH), default=10,
@@ -49,6 +71,9 @@ def _add_fish(p) -> None:
     p.add_argument("--tank-scale", type=num(MIN_TANK_SCALE, 10.0), default=1.0,
                    help=f"tank size as a fraction of the filmed 5 m x 0.5 m x 1 m tank, {MIN_TANK_SCALE} to 10 "
                         "(every side at least 2.5 body lengths)")
+    p.add_argument("--tank", type=_tank_type, default=None, metavar="L,D,H",
+                   help="tank size in m, length,depth,height (e.g. 3,3,1: the open tank the school and shoal presets "
+                        "were measured in; 1.12,1.12,0.3 for pair); in place of --tank-scale")
 
 
 def cmd_swim(args) -> None:

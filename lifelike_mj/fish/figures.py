@@ -312,3 +312,44 @@ def group_figure(result: SwimResult, out_path: str | os.PathLike | None = None, 
     ax.set_ylabel("neighbour ahead (body lengths)")
     ax.invert_xaxis()
     return finish(fig, out_path, "group figure")
+
+
+#: The published values the pair figure marks (Calovi et al. 2018, the tetras' kicks and glides; tagged in
+#: docs/results.md): the mean kick duration (s), its floor (s) and the glide's decay time (s).
+CALOVI_KICK_MEAN_S, CALOVI_KICK_FLOOR_S, CALOVI_GLIDE_TAU_S = 0.5, 0.2, 0.8
+
+
+def pair_figure(one: dict, two: dict, out_path: str | os.PathLike | None = None, title: str = "") -> Figure:
+    """One fish against two, as Calovi et al. (2018) compare their tetras: six density histograms of
+    :func:`lifelike_mj.fish.shoal.pair_quantities`' arrays, ``one`` (a lone fish's, pooled over runs) beside ``two``
+    (two fish's): the distance to the nearest wall and the angle to it, the distance between the two fish and their
+    heading difference, the kicks' durations and lengths. Dashed lines mark Calovi et al.'s mean kick duration and
+    its floor."""
+    for name, q in (("one", one), ("two", two)):
+        if not isinstance(q, dict) or "wall_distance_bl" not in q:
+            raise UserError(f"the pair figure's {name!r} must be fish.shoal.pair_quantities' dict.")
+    if "distance_bl" not in two:
+        raise UserError("the pair figure's 'two' must come from two fish or more.")
+    fig = _new_figure(13.0, 7.5)
+    axs = fig.subplots(2, 3)
+    fig.suptitle(title or "one fish and two fish, from the tracks alone (densities)")
+    panels = (("wall_distance_bl", "distance to the nearest side wall (body lengths)", np.linspace(0, 8, 33)),
+              ("wall_angle_deg", "angle to the nearest wall (deg; 90 = along it)", np.linspace(0, 180, 37)),
+              ("distance_bl", "distance between the two fish (body lengths)", np.linspace(0, 12, 49)),
+              ("heading_difference_deg", "heading difference |dphi| (deg)", np.linspace(0, 180, 37)),
+              ("kick_duration_s", "kick duration (s)", np.linspace(0, 2, 41)),
+              ("kick_length_bl", "kick length (body lengths)", np.linspace(0, 6, 41)))
+    for ax, (key, label, bins) in zip(axs.ravel(), panels, strict=True):
+        for q, colour, who in ((one, "tab:blue", "one fish"), (two, "tab:orange", "two fish")):
+            x = np.asarray(q.get(key, ()), dtype=float)
+            x = x[np.isfinite(x)]
+            if x.size:
+                ax.hist(x, bins=bins, density=True, histtype="step", lw=1.6, color=colour,
+                        label=f"{who}: median {np.median(x):.2f}")
+        if key == "kick_duration_s":
+            ax.axvline(CALOVI_KICK_MEAN_S, color="k", ls="--", lw=0.8, label="tetras' mean (Calovi et al.)")
+            ax.axvline(CALOVI_KICK_FLOOR_S, color="k", ls=":", lw=0.8, label="tetras' floor (Calovi et al.)")
+        ax.set_xlabel(label)
+        ax.set_ylabel("density")
+        ax.legend(fontsize=8)
+    return finish(fig, out_path, "pair figure")

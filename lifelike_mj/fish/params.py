@@ -308,7 +308,8 @@ def preset_path(name: str) -> Path:
 
 
 def load_preset(name_or_path: str | Path | None = None, _seen: tuple[str, ...] = ()) -> FishParams:
-    """A preset by name (``NB-ND``, ``NB-D``, ``B-ND``, ``B-D``, ``default``) or by path to a file."""
+    """A preset by name (the paper's ``NB-ND``, ``NB-D``, ``B-ND``, ``B-D``, ``default``; ``school``, ``shoal``, ``pair``)
+    or by path to a file."""
     ref = "default" if name_or_path is None else str(name_or_path)
     data, p = load_named_json("fish", ref, "fish preset")
     if isinstance(data, dict) and "same_as" in data:

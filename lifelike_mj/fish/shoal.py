@@ -234,3 +234,103 @@ def group_measures(times_s, positions, body_length_m: float, tank_m=None, *, ski
     out["wall_distance_bl"] = _stats(wall_distance_m(p, tank_m) / bl) if tank_m is not None else None
     return out
 
+
+
+def wall_angle_rad(positions, head, tank_m) -> np.ndarray:
+    """Per sample and fish (T, F), the angle (rad, in ``[0, pi]``) between a fish's horizontal heading and the outward
+    normal of the nearest side wall of a box tank (``tank_m`` as in :func:`wall_distance_m`): 0 swimming straight at
+    the wall, ``pi / 2`` along it, ``pi`` straight away. Calovi et al. (2018)'s ``theta_w`` in a circular tank, read
+    in a box; NaN where a fish has no heading."""
+    p = _positions(positions)
+    h = np.asarray(head, dtype=float)
+    L, D = float(tank_m[0]), float(tank_m[1])
+    gx, gy = L / 2 - np.abs(p[..., 0]), D / 2 - np.abs(p[..., 1])
+    nx = np.where(gx <= gy, np.sign(p[..., 0]), 0.0)
+    ny = np.where(gx <= gy, 0.0, np.sign(p[..., 1]))
+    return np.arccos(np.clip(h[..., 0] * nx + h[..., 1] * ny, -1.0, 1.0))
+
+
+def kick_segments(times_s, positions, body_length_m: float, *, kick_rise_bl_s: float = KICK_RISE_BL_S
+                  ) -> dict:
+    """Each fish's track cut at its kicks (:func:`kick_times`), pooled over the fish: ``duration_s`` (from one kick's
+    onset to the next), ``length_m`` (the path swum in that time), and ``glide_tau_s`` with ``glide_power``: how the
+    speed decays after the kick's peak, fitted on each segment with at least 6 samples of falling speed.
+
+    ``glide_tau_s`` is the time constant ``tau`` of an exponential decay ``v = v_k exp(-t / tau)`` (Calovi et al.'s
+    glide, linear drag), fitted to ``ln v``; ``glide_power`` says which law fits the segment better, 1 for the
+    exponential and 2 for the hyperbolic decay ``v = v_k / (1 + t / t_h)`` of quadratic drag (a straight line in
+    ``1 / v``), by the smaller relative residual."""
+    t = np.asarray(times_s, dtype=float)
+    p = _positions(positions)
+    vel = velocities(t, p)
+    speed = np.linalg.norm(vel, axis=-1)
+    step = np.linalg.norm(np.diff(p, axis=0), axis=-1)  # (T-1, F)
+    dur, length, taus, power = [], [], [], []
+    for f in range(p.shape[1]):
+        kt = kick_times(t, speed[:, f], kick_rise_bl_s * body_length_m)
+        idx = np.searchsorted(t, kt)
+        for a, b in zip(idx[:-1], idx[1:], strict=True):
+            dur.append(t[b] - t[a])
+            length.append(step[a:b, f].sum())
+            v = speed[a:b + 1, f]
+            k = int(np.argmax(v))
+            g, tg = v[k:], t[a + k:b + 1] - t[a + k]
+            if g.size < 6 or g.min() <= 0.0:
+                continue
+            slope, icpt = np.polyfit(tg, np.log(g), 1)
+            if slope >= 0.0:
+                continue
+            taus.append(-1.0 / slope)
+            res_exp = np.sqrt(np.mean((np.exp(icpt + slope * tg) - g) ** 2))
+            s2, i2 = np.polyfit(tg, 1.0 / g, 1)
+            fit2 = i2 + s2 * tg
+            res_hyp = np.sqrt(np.mean((1.0 / fit2 - g) ** 2)) if np.all(fit2 > 0) else np.inf
+            power.append(1 if res_exp <= res_hyp else 2)
+    return {"duration_s": np.asarray(dur), "length_m": np.asarray(length), "glide_tau_s": np.asarray(taus),
+            "glide_power": np.asarray(power, dtype=int)}
+
+
+def pair_quantities(times_s, positions, body_length_m: float, tank_m, *, skip_s: float = 0.0,
+                    kick_rise_bl_s: float = KICK_RISE_BL_S, min_speed_bl_s: float = MIN_SPEED_BL_S) -> dict:
+    """The quantities whose distributions Calovi et al. (2018) report for one and for two fish, for every sample
+    (after ``skip_s``) and fish, as arrays (units in the names): ``wall_distance_bl``, ``wall_angle_deg``
+    (:func:`wall_angle_rad`), ``speed_bl_s``; for two fish or more, over the ordered pairs, ``distance_bl`` (3D,
+    between centres), ``heading_difference_deg`` (``|dphi|``, 0 swimming the same way) and ``viewing_angle_deg``
+    (``|psi|``, where the neighbour lies from the focal fish's heading: 0 ahead, 180 behind); and from the kicks
+    (:func:`kick_segments`), ``kick_duration_s``, ``kick_length_bl``, ``glide_tau_s`` and ``glide_power``."""
+    t = np.asarray(times_s, dtype=float)
+    p = _positions(positions)
+    bl = float(body_length_m)
+    vel = velocities(t, p)
+    keep = t >= t[0] + skip_s
+    t, p, vel = t[keep], p[keep], vel[keep]
+    head = headings(vel, min_speed_bl_s * bl)
+    out = {"wall_distance_bl": (wall_distance_m(p, tank_m) / bl).ravel(),
+           "wall_angle_deg": np.degrees(wall_angle_rad(p, head, tank_m)).ravel(),
+           "speed_bl_s": (np.linalg.norm(vel, axis=-1) / bl).ravel()}
+    out["wall_angle_deg"] = out["wall_angle_deg"][np.isfinite(out["wall_angle_deg"])]
+    if p.shape[1] >= 2:
+        rel, dphi = neighbour_frame(p, head)
+        i, j = np.nonzero(~np.eye(p.shape[1], dtype=bool))
+        d3 = np.linalg.norm(p[:, j] - p[:, i], axis=-1)  # (T, P)
+        ok = np.isfinite(head[:, i, 0]) & np.isfinite(head[:, j, 0])
+        out["distance_bl"] = d3[ok] / bl
+        out["heading_difference_deg"] = np.degrees(np.abs(dphi))
+        out["viewing_angle_deg"] = np.degrees(np.abs(np.arctan2(rel[:, 1], rel[:, 0])))
+    seg = kick_segments(t, p, bl, kick_rise_bl_s=kick_rise_bl_s)
+    out.update(kick_duration_s=seg["duration_s"], kick_length_bl=seg["length_m"] / bl,
+               glide_tau_s=seg["glide_tau_s"], glide_power=seg["glide_power"])
+    return out
+
+
+def pair_measures(times_s, positions, body_length_m: float, tank_m, **kwargs) -> dict:
+    """:func:`pair_quantities` summarised for JSON: each array's mean, median, 5th and 95th percentiles, and for the
+    glides the fraction that the exponential fits better (``glide_exponential_fraction``); ``kwargs`` as there."""
+    q = pair_quantities(times_s, positions, body_length_m, tank_m, **kwargs)
+    out = {k: _stats(v) for k, v in q.items() if k != "glide_power"}
+    gp = q["glide_power"]
+    out["kick_duration_s"]["cv"] = (float(q["kick_duration_s"].std() / q["kick_duration_s"].mean())
+                                    if q["kick_duration_s"].size > 1 else float("nan"))
+    out["glide_exponential_fraction"] = float(np.mean(gp == 1)) if gp.size else float("nan")
+    out["kicks"] = int(q["kick_duration_s"].size)
+    return out

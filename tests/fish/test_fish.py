@@ -398,3 +398,15 @@ def test_the_smallest_tank_scale_is_accepted(capsys):
     assert MIN_TANK_SCALE * min(0.5, 1.0) == pytest.approx(2.5 * BODY_LENGTH_M)
     assert main(["fish", "swim", "--n", "1", "--duration", "0.2", "--tank-scale", str(MIN_TANK_SCALE)]) == 0
     assert main(["fish", "swim", "--n", "1", "--duration", "0.2", "--tank-scale", "0.3499"]) == 2
+
+
+def test_the_tank_can_be_given_by_its_sides(tmp_path):
+    """``--tank L,D,H`` (the open tank of the school presets) reaches the tank and its record."""
+    import json
+
+    out = tmp_path / "open"
+    assert main(["fish", "swim", "--preset", "school", "--n", "2", "--duration", "0.5", "--tank", "3,3,1",
+                 "--out", str(out)]) == 0
+    rec = json.loads((out / "measures.json").read_text())
+    assert rec["provenance"]["parameters"]["tank_m"] == [3.0, 3.0, 1.0]
+    assert rec["provenance"]["parameters"]["preset"]["name"] == "school"
