@@ -14,8 +14,15 @@ and gather):
 * ``school`` in the filmed tank and in an open tank (``OPEN_TANK``), ``shoal`` in the open tank.
 
 A startle cascade (``fish.aquarium``, ``cascade=True``): ten ``school`` fish in the open tank, seeds 5-12, swim until
-they are a school (polarisation above 0.8, nearest neighbours under 2.5 BL, looked at every half second from 20 s
-on); then the fish at the front is startled alone, and the benchmark records which fish escape within 1 s, and when.
+they are a school (seven fish or more joined, polarisation above 0.8, looked at every half second from 20 s on).
+Then the fish at the front of the school is startled alone, and the benchmark records which fish escape within 1 s,
+and when. The school: the largest group of fish joined by chains of fish, each within ``LINK_BL`` body lengths of
+the next; a fish swimming apart is not its front.
+
+Food (``fish.aquarium``): on the same seeds, ten ``school`` fish swim 20 s, and a pellet is dropped on the surface
+0.3 m ahead of their centroid; the benchmark records when it is eaten (s after the drop, within 30 s), which fish ate
+it (its rank by distance to the pellet at the drop, 0 the nearest) and how many fish were within 3 body lengths of the
+pellet when it was eaten: with the fish competing (``compete=True``) and without, and for one fish alone.
 
 And the paper's kick intervals again for kick thresholds from 0.1 to 1.5 body lengths per second, since a kick's
 definition (a speed rise of at least that much) sets how many small rises count.
@@ -48,6 +55,8 @@ THRESHOLDS_BL_S = (0.1, 0.3, 0.5, 0.8, 1.0, 1.5)
 
 
 CASCADE_SEEDS = tuple(range(5, 13))
+#: Two fish are in one school when a chain of fish, each within this many body lengths of the next, joins them.
+LINK_BL = 3.0
 
 
 def cascade(seed: int) -> dict:
@@ -55,17 +64,17 @@ def cascade(seed: int) -> dict:
     import numpy as np
 
     from lifelike_mj.fish.aquarium import Aquarium
-    from lifelike_mj.fish.shoal import headings, polarisation
+    from lifelike_mj.fish.shoal import front_of_group, is_school
 
     a = Aquarium(fish.Tank(fish.load_preset("school"), n_fish=10, seed=seed, size=OPEN_TANK), cascade=True)
     a.step(60 * 20)
-    while True:
-        st = a.tank.state()
-        nn = nearest_neighbour_m(st["position_m"][None])
-        if polarisation(headings(st["velocity_m_s"][None], 0.01))[0] > 0.8 and np.median(nn) < 2.5 * BODY_LENGTH_M:
+    for _ in range(240):
+        if is_school((st := a.tank.state())["position_m"], st["velocity_m_s"], LINK_BL * BODY_LENGTH_M, 7):
             break
         a.step(30)
-    front = int(np.argmax(st["position_m"][:, :2] @ st["velocity_m_s"][:, :2].mean(axis=0)))
+    else:
+        raise RuntimeError(f"seed {seed}: the fish did not form a school within two minutes")
+    front, group = front_of_group(st["position_m"], st["velocity_m_s"], LINK_BL * BODY_LENGTH_M)
     t0 = a.time
     a.startle(front)
     first = np.full(10, np.inf)
@@ -74,7 +83,34 @@ def cascade(seed: int) -> dict:
         new = (a.startled_at >= t0 - 1e-9) & np.isinf(first)
         first[new] = a.startled_at[new] - t0
     return {"seed": seed, "startled_at_s": t0, "reached": int(np.isfinite(first).sum()),
+            "school": [int(i) for i in group], "reached_in_school": int(np.isfinite(first[group]).sum()),
             "first_escape_s": [float(v) if np.isfinite(v) else None for v in first]}
+
+
+def feeding(seed: int, n_fish: int, compete: bool) -> dict:
+    """A pellet dropped ahead of ``n_fish`` ``school`` fish (module docstring)."""
+    import numpy as np
+
+    from lifelike_mj.fish.aquarium import Aquarium
+
+    a = Aquarium(fish.Tank(fish.load_preset("school"), n_fish=n_fish, seed=seed, size=OPEN_TANK), cascade=True,
+                 compete=compete)
+    a.step(60 * 20)
+    st = a.tank.state()
+    v = st["velocity_m_s"][:, :2].mean(axis=0)
+    x, y = np.clip(st["position_m"][:, :2].mean(axis=0) + 0.3 * v / max(float(np.linalg.norm(v)), 1e-9), -1.2, 1.2)
+    H = a.tank.scene.size[2]
+    rank = np.argsort(np.argsort(np.linalg.norm(st["position_m"] - np.array([x, y, H]), axis=1)))
+    a.drop_food(float(x), float(y))
+    for k in range(1, 60 * 30 + 1):
+        pellet = a.pellets_m[0].copy()
+        a.step(1)
+        if a.eaten:
+            near = np.linalg.norm(a.tank.snapshot()[0] - pellet, axis=1) <= 3 * BODY_LENGTH_M
+            return {"seed": seed, "fish": n_fish, "compete": compete, "eaten_after_s": k * a.dt,
+                    "eater_rank": int(rank[a.eaters[0]]), "within_3bl": int(near.sum())}
+    return {"seed": seed, "fish": n_fish, "compete": compete, "eaten_after_s": None, "eater_rank": None,
+            "within_3bl": None}
 
 
 def main(argv=None) -> None:
@@ -104,7 +140,13 @@ def main(argv=None) -> None:
     cascades = [cascade(seed) for seed in CASCADE_SEEDS]
     for c in cascades:
         last = max(v for v in c["first_escape_s"] if v is not None)
-        print(f"cascade, seed {c['seed']}: {c['reached']} of 10 escaped within 1 s (the last after {last:.2f} s)")
+        print(f"cascade, seed {c['seed']}: {c['reached_in_school']} of the school's {len(c['school'])} ({c['reached']} of "
+              f"10) escaped within 1 s (the last after {last:.2f} s)")
+    feeds = [feeding(seed, n, compete) for n, compete in ((10, True), (10, False), (1, True)) for seed in CASCADE_SEEDS]
+    for f in feeds:
+        print(f"food, {f['fish']} fish, {'competing' if f['compete'] else 'not competing'}, seed {f['seed']}: " + (
+            f"eaten after {f['eaten_after_s']:.1f} s by the fish ranked {f['eater_rank']} by distance, "
+            f"{f['within_3bl']} fish within 3 BL" if f["eaten_after_s"] is not None else "not eaten within 30 s"))
     for s in sweep:
         if s["seed"] == SEEDS[0]:
             print(f"threshold {s['threshold_bl_s']:.1f} BL/s: mean {s['mean']:.2f} s, CV {s['cv']:.2f}, 5th percentile "
@@ -112,7 +154,8 @@ def main(argv=None) -> None:
     write_json(args.out, {"provenance": provenance(benchmark="fish_group", seeds=list(SEEDS), duration_s=DURATION_S,
                                                    thresholds_bl_s=list(THRESHOLDS_BL_S), variants=VARIANTS),
                           "machine": machine_info(), "wall_time_s": time.perf_counter() - start, "runs": runs,
-                          "kick_threshold_sweep": sweep, "cascades": cascades})
+                          "kick_threshold_sweep": sweep, "cascades": cascades,
+                          "feeding": feeds})
 
 
 if __name__ == "__main__":

@@ -11,6 +11,10 @@ have in mind), as two stated rules on top of the four motion units. Nothing else
   accelerate, it pushes toward the nearest pellet it notices (with the preset's mean push,
   ``(r_min_N + r_max_N) / 2``) instead of in a drawn direction; its timing stays the chain's. The first fish
   whose centre comes within :data:`EAT_RADIUS_M` of a pellet eats it.
+* **Fish compete for food** (``compete=True``; off by default): when two fish or more go for the same pellet, each
+  pushes toward it with the strongest push the preset draws (``r_max_N``) in place of the mean: a scramble, the
+  nearest fish arriving first and its rivals pressing behind. A fish that heeds its neighbours (a social preset) keeps
+  its social turn on top of the push toward the pellet, so a school follows the fish that go for food.
 
 * **A startle spreads** (``cascade=True``; off by default): a fish that sees a neighbour start an escape may
   startle too, as startles spread through real schools (Rosenthal et al. 2015). It sees a neighbour within
@@ -76,11 +80,12 @@ class Aquarium:
     ``tank``: the tank (made with no policies of its own). ``tap(point_m)`` and ``drop_food(x_m, y_m)`` act now;
     ``pellets_m`` holds the pellets still in the water; ``startled`` says which fish are startled."""
 
-    def __init__(self, tank: Tank, cascade: bool = False) -> None:
+    def __init__(self, tank: Tank, cascade: bool = False, compete: bool = False) -> None:
         if tank.mu_policy is not None or tank.push_policy is not None:
             raise UserError("the aquarium needs a tank without policies of its own.")
         self.tank = tank
         self.cascade = bool(cascade)
+        self.compete = bool(compete)
         #: When each fish's last escape began (s; -inf: none), and the escapes each fish has judged.
         self.startled_at = np.full(tank.n_fish, -np.inf)
         self._judged = np.zeros((tank.n_fish, tank.n_fish), dtype=bool)
@@ -91,6 +96,8 @@ class Aquarium:
         self._startle_from = np.zeros((tank.n_fish, 3))
         self.pellets_m = np.zeros((0, 3))
         self.eaten = 0
+        #: Which fish ate each pellet eaten, in order.
+        self.eaters: list[int] = []
 
     # ---- the stepper shape ----------------------------------------------------------------------
     @property
@@ -117,6 +124,7 @@ class Aquarium:
         self._cascade_rng = np.random.default_rng([self.tank.seed, 28])
         self.pellets_m = np.zeros((0, 3))
         self.eaten = 0
+        self.eaters = []
 
     def step(self, n: int = 1) -> None:
         for _ in range(checks.whole("the number of steps", n, 0)):
@@ -224,15 +232,14 @@ class Aquarium:
             return out
         pos, quat = tank.snapshot()
         R = np.empty(9)
+        going = self.going_for()
         for i in range(tank.n_fish):
             if startled[i]:
                 target, r = pos[i] + (pos[i] - self._startle_from[i]), p.r_max_N  # away from the tap
-            elif len(self.pellets_m):
-                dist = np.linalg.norm(self.pellets_m - pos[i], axis=1)
-                k = int(np.argmin(dist))
-                if dist[k] > FOOD_SIGHT_M:
-                    continue
-                target, r = self.pellets_m[k], 0.5 * (p.r_min_N + p.r_max_N)
+            elif going[i] >= 0:
+                k = int(going[i])
+                rivals = self.compete and int(np.sum(going == k)) > 1
+                target, r = self.pellets_m[k], p.r_max_N if rivals else 0.5 * (p.r_min_N + p.r_max_N)
             else:
                 continue
             d = target - pos[i]
@@ -244,6 +251,20 @@ class Aquarium:
             out[i] = (r, theta, phi)
         return out
 
+    def going_for(self) -> np.ndarray:
+        """Per fish, the pellet it goes for (an index into ``pellets_m``: the nearest it notices, within
+        :data:`FOOD_SIGHT_M`), or -1: none, or the fish is startled."""
+        out = np.full(self.tank.n_fish, -1)
+        if len(self.pellets_m) == 0:
+            return out
+        pos, _ = self.tank.snapshot()
+        dist = np.linalg.norm(pos[:, None, :] - self.pellets_m[None, :, :], axis=-1)
+        k = np.argmin(dist, axis=1)
+        sees = dist[np.arange(len(pos)), k] <= FOOD_SIGHT_M
+        out[sees] = k[sees]
+        out[self.startled] = -1
+        return out
+
     def _food(self) -> None:
         if len(self.pellets_m) == 0:
             return
@@ -251,20 +272,25 @@ class Aquarium:
         pos, _ = self.tank.snapshot()
         gone = np.zeros(len(self.pellets_m), dtype=bool)
         for k, pellet in enumerate(self.pellets_m):
-            if np.min(np.linalg.norm(pos - pellet, axis=1)) <= EAT_RADIUS_M:
+            dist = np.linalg.norm(pos - pellet, axis=1)
+            if np.min(dist) <= EAT_RADIUS_M:
                 gone[k] = True
+                self.eaters.append(int(np.argmin(dist)))
         self.eaten += int(gone.sum())
         self.pellets_m = self.pellets_m[~gone]
 
 
 #: The aquarium's keys and what each does (none of them is one of MuJoCo's viewer's own).
-KEYS = (("Space", "tap the front glass"), ("Enter", "drop a food pellet"))
+KEYS = (("Space", "tap the front glass"), ("Enter", "drop a food pellet"),
+        ("Right", "a shadow looms over one fish: it alone startles"))
 
 
 def controls(aquarium: Aquarium, seed: int = 0) -> list:
     """The aquarium's keys and buttons (:data:`KEYS`; :class:`lifelike_mj.render.viewer.Control`): Space taps the
     front glass (the side the viewers look from, y < 0) level with a fish drawn at random, Enter drops a pellet at
-    a random place along the middle of the surface. ``seed`` draws the places."""
+    a random place along the middle of the surface, Right startles one fish drawn at random alone
+    (:meth:`Aquarium.startle`; with the cascade on, its neighbours may follow). ``seed`` draws the places and
+    fish."""
     from lifelike_mj.render.viewer import Control
 
     rng = np.random.default_rng(seed)
@@ -278,4 +304,7 @@ def controls(aquarium: Aquarium, seed: int = 0) -> list:
     def food() -> None:
         aquarium.drop_food(float(rng.uniform(-0.4 * L, 0.4 * L)), 0.0)
 
-    return [Control(key, label, act) for (key, label), act in zip(KEYS, (tap, food), strict=True)]
+    def loom() -> None:
+        aquarium.startle(int(rng.integers(aquarium.tank.n_fish)))
+
+    return [Control(key, label, act) for (key, label), act in zip(KEYS, (tap, food, loom), strict=True)]

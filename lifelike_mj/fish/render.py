@@ -345,8 +345,9 @@ def view_fish(params: FishParams, n_fish: int = 10, seed: int = 0, size=None, du
 
     from lifelike_mj.fish.aquarium import Aquarium, controls
 
-    if tank.mu_policy is None and tank.push_policy is None:  # the virtual aquarium: Space taps, Enter feeds
-        aquarium = Aquarium(tank, cascade=tank.params.social)  # fish that heed each other pass a startle on
+    if tank.mu_policy is None and tank.push_policy is None:  # the virtual aquarium: Space taps, Enter feeds, Right looms
+        # fish that heed each other pass a startle on and compete for food
+        aquarium = Aquarium(tank, cascade=tank.params.social, compete=tank.params.social)
         view(aquarium, 1.0 / tank.dt, end, setup, web=web, controls=controls(aquarium, seed))
     else:
         view(tank, 1.0 / tank.dt, end, setup, web=web)

@@ -334,3 +334,44 @@ def pair_measures(times_s, positions, body_length_m: float, tank_m, **kwargs) ->
     out["glide_exponential_fraction"] = float(np.mean(gp == 1)) if gp.size else float("nan")
     out["kicks"] = int(q["kick_duration_s"].size)
     return out
+
+
+def largest_group(positions, link_m: float) -> np.ndarray:
+    """The fish of the largest group at one moment: ``positions`` (F, 3) m; two fish are in one group when a chain of
+    fish, each within ``link_m`` of the next, joins them. Returns the group's fish indices, sorted (ties: the group
+    of the lowest index)."""
+    p = np.asarray(positions, dtype=float).reshape(-1, 3)
+    F = p.shape[0]
+    near = np.linalg.norm(p[:, None] - p[None], axis=-1) <= link_m
+    label = np.full(F, -1)
+    for s in range(F):
+        if label[s] >= 0:
+            continue
+        label[s], stack = s, [s]
+        while stack:
+            i = stack.pop()
+            for j in np.flatnonzero(near[i] & (label < 0)):
+                label[j] = s
+                stack.append(j)
+    sizes = np.bincount(label, minlength=F)
+    return np.flatnonzero(label == int(np.argmax(sizes)))
+
+
+def front_of_group(positions, velocities, link_m: float) -> tuple[int, np.ndarray]:
+    """The fish at the front of the largest group (:func:`largest_group`) and the group: the member farthest along the
+    group's mean horizontal velocity (``velocities`` (F, 3) m/s)."""
+    p = np.asarray(positions, dtype=float).reshape(-1, 3)
+    g = largest_group(p, link_m)
+    v = np.asarray(velocities, dtype=float).reshape(-1, 3)[g, :2].mean(axis=0)
+    return int(g[int(np.argmax(p[g, :2] @ v))]), g
+
+
+def is_school(positions, velocities, link_m: float, min_fish: int, min_polarisation: float = 0.8) -> bool:
+    """Whether fish at one moment (``positions``, ``velocities`` (F, 3)) swim as a school: the largest group
+    (:func:`largest_group`) holds at least ``min_fish`` fish, and their horizontal headings' polarisation exceeds
+    ``min_polarisation``."""
+    g = largest_group(positions, link_m)
+    if len(g) < min_fish:
+        return False
+    head = headings(np.asarray(velocities, dtype=float).reshape(-1, 3)[g][None], 0.0)
+    return bool(polarisation(head)[0] > min_polarisation)

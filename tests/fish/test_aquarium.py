@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from lifelike_mj.errors import UserError
-from lifelike_mj.fish import Tank
+from lifelike_mj.fish import Tank, shoal
 from lifelike_mj.fish.aquarium import EAT_RADIUS_M, FOOD_SINK_M_S, TAP_RADIUS_M, Aquarium
 
 
@@ -90,13 +90,10 @@ def test_taps_and_food_outside_the_tank_are_refused():
 
 
 def _school_now(a):
-    """Whether the aquarium's fish swim as a school now: polarised and close."""
-    from lifelike_mj.fish import shoal
-
+    """Whether the aquarium's fish swim as a school now: seven or more joined by chains of fish 3 BL apart at most,
+    polarised."""
     st = a.tank.state()
-    head = shoal.headings(st["velocity_m_s"][None], 0.01)
-    nn = shoal.nearest_neighbour_m(st["position_m"][None])
-    return shoal.polarisation(head)[0] > 0.8 and np.median(nn) < 2.5 * 0.07
+    return shoal.is_school(st["position_m"], st["velocity_m_s"], 3 * 0.07, 7)
 
 
 @pytest.mark.parametrize("seed", [5, 6, 7])
@@ -107,11 +104,14 @@ def test_a_startle_at_the_front_of_a_school_runs_through_it_within_a_second(seed
     for cascade in (True, False):
         a = Aquarium(Tank(load_preset("school"), n_fish=10, seed=seed, size=(3.0, 3.0, 1.0)), cascade=cascade)
         a.step(60 * 20)
-        while not _school_now(a):  # the same moment in both runs: the cascade changes nothing before the startle
+        for _ in range(240):  # the same moment in both runs: the cascade changes nothing before the startle
+            if _school_now(a):
+                break
             a.step(30)
+        else:
+            pytest.fail("the fish did not form a school within two minutes")
         st = a.tank.state()
-        h = st["velocity_m_s"][:, :2].mean(axis=0)
-        front = int(np.argmax(st["position_m"][:, :2] @ h))
+        front, group = shoal.front_of_group(st["position_m"], st["velocity_m_s"], 3 * 0.07)
         t0 = a.time
         a.startle(front)
         first = np.full(10, np.inf)
@@ -124,6 +124,23 @@ def test_a_startle_at_the_front_of_a_school_runs_through_it_within_a_second(seed
             a.step(60)  # two seconds after the startle: nobody caught a second escape
             assert np.all(a.startled_at - t0 < 1.0 + 1e-9)
     reached = np.isfinite(runs[True])
-    assert reached.sum() > 5  # most of the school (issue 28), within the second
+    assert len(group) >= 5 and reached[group].sum() > len(group) / 2  # most of the school (issue 28), within the second
     assert np.all(runs[True][reached] >= 0.0) and np.sort(runs[True][reached])[1] >= 0.05 - 1e-9  # after a latency
     assert np.isfinite(runs[False]).sum() == 1  # without the cascade only the fish startled
+
+
+def test_fish_going_for_the_same_pellet_race_for_it():
+    """With ``compete`` two fish that go for one pellet both push with the strongest push; alone, or without
+    ``compete``, a fish pushes with the mean push (the rule in fish/aquarium.py)."""
+    from lifelike_mj.fish import load_preset
+
+    for compete in (True, False):
+        a = Aquarium(Tank(load_preset("school"), n_fish=2, seed=3, size=(1.0, 1.0, 0.5)), compete=compete)
+        a.drop_food(0.0, 0.0)
+        p = a.tank.params
+        assert list(a.going_for()) == [0, 0]
+        r = a._push(a.tank)[:, 0]
+        np.testing.assert_allclose(r, p.r_max_N if compete else 0.5 * (p.r_min_N + p.r_max_N))
+    a = Aquarium(Tank(load_preset("school"), n_fish=1, seed=3, size=(1.0, 1.0, 0.5)), compete=True)
+    a.drop_food(0.0, 0.0)
+    np.testing.assert_allclose(a._push(a.tank)[:, 0], 0.5 * (p.r_min_N + p.r_max_N))

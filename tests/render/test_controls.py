@@ -89,3 +89,11 @@ def test_the_aquariums_keys_tap_and_feed():
     assert a.startled.any()
     _press(keys, "Enter")
     assert len(a.pellets_m) == 1 and len(a.marks()) == 1
+
+
+def test_the_aquariums_right_key_startles_one_fish_alone():
+    a = Aquarium(Tank(n_fish=10, seed=2))
+    _press(controls(a, seed=0), "Right")
+    assert a.startled.sum() == 1
+    a.step(1)
+    assert a.startled.sum() == 1  # without the cascade no neighbour follows
