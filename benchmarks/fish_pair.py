@@ -6,8 +6,9 @@ Run: ``python benchmarks/fish_pair.py`` (about half a minute). Writes ``benchmar
 The ``pair`` preset, one fish alone and two fish together, each for 300 s on seeds 11-18 (the preset's settings are
 the ``school``'s, chosen on seeds 1-4), in a shallow box tank 16 body lengths across and 4 deep
 (``PAIR_TANK``: Calovi et al.'s circular tank is 25 cm in radius for 3.1 cm fish, 16 body lengths across). The
-paper's ``B-D`` fish alone in the same tank, for their glides. The first 10 s are left out. Measured from the tracks
-alone by ``fish.shoal.pair_quantities`` (pooled over the seeds) and ``pair_measures`` (per run).
+paper's ``B-D`` fish, alone and two together (fish that ignore each other), in the same tank. The first 10 s are left
+out. Measured from the tracks alone by ``fish.shoal.pair_quantities`` (pooled over the seeds) and ``pair_measures``
+(per run).
 """
 
 from __future__ import annotations
@@ -32,7 +33,8 @@ SKIP_S = 10.0
 #: (length, depth, height) m: 16 x 16 x 4.3 body lengths of 7 cm.
 PAIR_TANK = (1.12, 1.12, 0.3)
 #: name -> (preset, number of fish)
-RUNS = {"pair, one fish": ("pair", 1), "pair, two fish": ("pair", 2), "B-D, one fish": ("B-D", 1)}
+RUNS = {"pair, one fish": ("pair", 1), "pair, two fish": ("pair", 2), "B-D, one fish": ("B-D", 1),
+        "B-D, two fish": ("B-D", 2)}
 
 
 def main(argv=None) -> None:

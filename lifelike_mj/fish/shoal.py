@@ -196,6 +196,8 @@ def group_measures(times_s, positions, body_length_m: float, tank_m=None, *, ski
     * ``polarisation`` and ``milling``: their means over samples, and the fractions of samples polarised, milling
       or swarming by Tunstrom et al.'s thresholds;
     * ``cohesion_bl``: the mean distance from the centroid (body lengths), its mean over samples;
+    * ``depth_spread_bl``: the standard deviation of the fish's depths (body lengths), its mean over samples: how
+      flat the group is (neighbours in real schools keep to a similar depth, Partridge et al. 1980);
     * ``kick_interval_s``: the intervals between a fish's consecutive kicks, pooled: mean, CV (standard deviation over
       mean), minimum, 5th percentile, median and count;
     * ``speed_bl_s``: the speed's mean, median, 5th and 95th percentiles (body lengths per second);
@@ -224,6 +226,7 @@ def group_measures(times_s, positions, body_length_m: float, tank_m=None, *, ski
         "milling": float(np.mean((orr[ok] > 0.65) & (op[ok] < 0.35))) if ok.any() else nan,
         "swarm": float(np.mean((op[ok] < 0.35) & (orr[ok] < 0.35))) if ok.any() else nan}
     out["cohesion_bl"] = float(cohesion_m(p).mean() / bl)
+    out["depth_spread_bl"] = float(np.std(p[..., 2], axis=1).mean() / bl)
     iv = kick_intervals_s(t, speed, kick_rise_bl_s * bl)
     out["kick_interval_s"] = {
         "count": int(iv.size), "mean": float(iv.mean()) if iv.size else nan,

@@ -65,8 +65,8 @@ EMPTY = textwrap.dedent("""
     sys.exit(main(sys.argv[1:]))
 """)
 #: Each creature's command, and the buttons pressed between the two pictures (the fish's panel: "drop a food
-#: pellet", then "tap the front glass").
-SCENES = {"fish": (["fish", "--seed", "1"], "126,128 126,102"), "butterfly": (["butterfly"], ""),
+#: pellet", then "tap the front glass", then the shadow that looms over one fish).
+SCENES = {"fish": (["fish", "--seed", "1"], "126,128 126,102 126,154"), "butterfly": (["butterfly"], ""),
           "butterfly3d": (["butterfly3d"], ""), "boids": (["boids", "--n", "100"], "")}
 
 
@@ -102,8 +102,10 @@ def test_the_web_viewer_draws_the_live_creature_on_localhost_only(chromium, tmp_
     assert chromium.changed_pixels(first, later) > 20  # and moves
     if scene != "fish":
         return
-    assert keys == "keys: Space tap the front glass; Enter drop a food pellet"
-    assert "drop a food pellet\ntap the front glass" in out  # the buttons reached the aquarium, in order
+    assert keys == ("keys: Space tap the front glass; Enter drop a food pellet; Right a shadow looms over one fish: it "
+                    "alone startles")
+    # the buttons reached the aquarium, in order
+    assert "drop a food pellet\ntap the front glass\na shadow looms over one fish: it alone startles" in out
 
 
 @pytest.mark.skipif(not Path("/proc/net/tcp").exists(), reason="reads the listening sockets from Linux's /proc")

@@ -188,6 +188,9 @@ def test_the_school_and_shoal_presets_in_an_open_tank(seed):
     assert out["school"]["polarisation"] >= 0.7 and out["school"]["nn_distance_bl"]["median"] <= 2.0
     assert out["shoal"]["polarisation"] < 0.5 and out["shoal"]["nn_distance_bl"]["median"] <= 3.0
     assert out["shoal"]["cohesion_bl"] < 8.0 and out["school"]["cohesion_bl"] < 8.0
+    # the school is flat (its fish at a similar depth, as in real schools); the shoal, which barely pulls to its
+    # neighbours' depth, is not
+    assert out["school"]["depth_spread_bl"] < 2.5 < out["shoal"]["depth_spread_bl"]
 
 
 def test_wall_angle_reads_the_heading_against_the_nearest_wall():
