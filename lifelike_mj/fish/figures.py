@@ -240,10 +240,12 @@ __all__ = ["PATTERN_ORDER", "accel_histogram_figure", "patterns_figure", "side_a
 
 
 def group_figure(result: SwimResult, out_path: str | os.PathLike | None = None, body_length_m: float = 0.07) -> Figure:
-    """The measures of fish living together (:mod:`lifelike_mj.fish.shoal`), from the tracks alone, in six panels:
-    the nearest-neighbour distance, the polarisation and milling over time, the intervals between kicks, the speed,
-    the distance to the nearest side wall (histograms, body lengths and seconds), and where the neighbours are in a
-    fish's own frame (ahead, to its left; a 2-D histogram within 10 body lengths, the maps of Calovi et al. 2018)."""
+    """The measures of fish living together (:mod:`lifelike_mj.fish.shoal`), from the tracks alone, in eight panels:
+    the nearest-neighbour distance, the polarisation and milling over time, the cohesion and the spread of depths over
+    time, the intervals between kicks, the speed, the distance to the nearest side wall (histograms, body lengths and
+    seconds), where the neighbours are in a fish's own frame (ahead, to its left; a 2-D histogram within 10 body
+    lengths, the maps of Calovi et al. 2018) and how they head relative to it (a histogram of the heading
+    difference)."""
     from lifelike_mj.fish import shoal
 
     if not checks.is_number(body_length_m) or not body_length_m > 0:
@@ -256,8 +258,8 @@ def group_figure(result: SwimResult, out_path: str | os.PathLike | None = None, 
     head = shoal.headings(vel, shoal.MIN_SPEED_BL_S * bl)
     speed = np.linalg.norm(vel, axis=-1)
     iv = shoal.kick_intervals_s(t, speed, shoal.KICK_RISE_BL_S * bl)
-    fig = _new_figure(13.0, 7.5)
-    axs = fig.subplots(2, 3)
+    fig = _new_figure(17.0, 7.5)
+    axs = fig.subplots(2, 4)
     name = result.params.name or "custom"
     fig.suptitle(f"{result.n_fish} {name} fish, {float(t[-1] - t[0]):g} s (seed {result.seed}): living together, "
                  "from the tracks alone")
@@ -280,6 +282,13 @@ def group_figure(result: SwimResult, out_path: str | os.PathLike | None = None, 
     ax.set_ylabel("order parameter")
     ax.legend(fontsize=8, loc="upper right")
     ax = axs[0, 2]
+    ax.plot(t, shoal.cohesion_m(p) / bl, lw=0.8, color="tab:brown", label=f"cohesion (mean {m['cohesion_bl']:.1f} BL)")
+    ax.plot(t, np.std(p[..., 2], axis=1) / bl, lw=0.8, color="tab:cyan",
+            label=f"spread of depths (mean {m['depth_spread_bl']:.1f} BL)")
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("body lengths")
+    ax.legend(fontsize=8, loc="upper right")
+    ax = axs[0, 3]
     k = m["kick_interval_s"]
     if iv.size:
         ax.hist(iv, bins=np.arange(0.0, max(2.0, float(np.percentile(iv, 99))) + 0.05, 1.0 / 30.0), color="tab:green",
@@ -302,7 +311,7 @@ def group_figure(result: SwimResult, out_path: str | os.PathLike | None = None, 
     ax.set_xlabel("distance to the nearest side wall (body lengths)")
     ax.set_ylabel("fish x samples")
     ax = axs[1, 2]
-    rel, _ = shoal.neighbour_frame(p, head)
+    rel, dphi = shoal.neighbour_frame(p, head)
     rel = rel / bl
     if rel.size:
         ax.hist2d(rel[:, 1], rel[:, 0], bins=40, range=[[-10, 10], [-10, 10]], cmap="viridis")
@@ -311,6 +320,14 @@ def group_figure(result: SwimResult, out_path: str | os.PathLike | None = None, 
     ax.set_xlabel("neighbour to the fish's left (body lengths)")
     ax.set_ylabel("neighbour ahead (body lengths)")
     ax.invert_xaxis()
+    ax = axs[1, 3]
+    if dphi.size:
+        ad = np.degrees(np.abs(dphi))
+        ax.hist(ad, bins=np.linspace(0.0, 180.0, 37), color="tab:gray", alpha=0.8,
+                label=f"median {np.median(ad):.0f} deg")
+        ax.legend(fontsize=8)
+    ax.set_xlabel("a neighbour's heading less the fish's, |dphi| (deg)")
+    ax.set_ylabel("fish pairs x samples")
     return finish(fig, out_path, "group figure")
 
 
