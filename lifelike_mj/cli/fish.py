@@ -13,6 +13,8 @@ NAME = "fish"
 #: Bounds of the command line: fish in a tank, simulated seconds, the smallest tank (2.5 body lengths a side).
 MAX_DURATION_S = 3600.0
 MIN_TANK_SCALE = 0.35
+#: The longest side ``--tank`` takes (m): twice the longest of ``--tank-scale``'s largest tank.
+MAX_TANK_SIDE_M = 100.0
 SWIM_FILES = ("tracks.npz", "tracks.csv", "tracks.png", "accel_histogram.png", "measures.json")
 HELP = "the tropical fish of Satoi et al. 2015"
 VIEW_HELP = "a tank of fish, live: a virtual aquarium whose fish flee a tap on the glass and go for food"
@@ -33,7 +35,8 @@ def _preset(args):
 
 
 def _tank_type(text: str) -> tuple[float, float, float]:
-    """An argparse ``type``: a tank's ``length,depth,height`` in m, each side at least 2.5 body lengths."""
+    """An argparse ``type``: a tank's ``length,depth,height`` in m, each side at least 2.5 body lengths and at most
+    :data:`MAX_TANK_SIDE_M`."""
     from lifelike_mj.fish.scene import check_tank
 
     try:
@@ -41,9 +44,12 @@ def _tank_type(text: str) -> tuple[float, float, float]:
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected three lengths in m, as 3,3,1, got {text!r}") from None
     try:
-        return check_tank(vals)
+        vals = check_tank(vals)
     except UserError as e:
         raise argparse.ArgumentTypeError(str(e).rstrip(".")) from None
+    if max(vals) > MAX_TANK_SIDE_M:
+        raise argparse.ArgumentTypeError(f"every side of the tank must be at most {MAX_TANK_SIDE_M:g} m, got {text!r}")
+    return vals
 
 
 _tank_type.__name__ = "tank size"
@@ -73,7 +79,8 @@ def _add_fish(p) -> None:
                         "(every side at least 2.5 body lengths)")
     p.add_argument("--tank", type=_tank_type, default=None, metavar="L,D,H",
                    help="tank size in m, length,depth,height (e.g. 3,3,1: the open tank the school and shoal presets "
-                        "were measured in; 1.12,1.12,0.3 for pair); in place of --tank-scale")
+                        "were measured in; 1.12,1.12,0.3 for pair), each side 2.5 body lengths to 100 m; in place of "
+                        "--tank-scale")
 
 
 def cmd_swim(args) -> None:

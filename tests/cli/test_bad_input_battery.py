@@ -179,6 +179,7 @@ CASES = [
     (SWIM + ["--tank", "3,3,0.1"], "2.5 body lengths", {}),
     (SWIM + ["--tank", "3,3,nan"], "three positive lengths", {}),
     (SWIM + ["--tank", "3,3,1", "--tank-scale", "2"], "not both", {}),
+    (SWIM + ["--tank", "1e6,1,1"], "at most 100 m", {}),
     (SWIM + ["--seed", "-3"], "--seed", {}),
     (SWIM + ["--preset", "nosuch"], "unknown fish preset", {}),
     (SWIM + ["--preset", "p.json"], "must have 3 numbers", {"p.json": _with(FISH, p_brake_dS_v_m2=[1, 2])}),
