@@ -232,7 +232,7 @@ class Aquarium:
             return out
         pos, quat = tank.snapshot()
         R = np.empty(9)
-        going = self.going_for()
+        going = self._going_for(pos)
         for i in range(tank.n_fish):
             if startled[i]:
                 target, r = pos[i] + (pos[i] - self._startle_from[i]), p.r_max_N  # away from the tap
@@ -254,10 +254,13 @@ class Aquarium:
     def going_for(self) -> np.ndarray:
         """Per fish, the pellet it goes for (an index into ``pellets_m``: the nearest it notices, within
         :data:`FOOD_SIGHT_M`), or -1: none, or the fish is startled."""
+        return self._going_for(self.tank.snapshot()[0])
+
+    def _going_for(self, pos: np.ndarray) -> np.ndarray:
+        """:meth:`going_for` for the fish's positions ``pos`` (F, 3) m, already read."""
         out = np.full(self.tank.n_fish, -1)
         if len(self.pellets_m) == 0:
             return out
-        pos, _ = self.tank.snapshot()
         dist = np.linalg.norm(pos[:, None, :] - self.pellets_m[None, :, :], axis=-1)
         k = np.argmin(dist, axis=1)
         sees = dist[np.arange(len(pos)), k] <= FOOD_SIGHT_M
