@@ -283,7 +283,7 @@ def group_figure(result: SwimResult, out_path: str | os.PathLike | None = None, 
     ax.legend(fontsize=8, loc="upper right")
     ax = axs[0, 2]
     ax.plot(t, shoal.cohesion_m(p) / bl, lw=0.8, color="tab:brown", label=f"cohesion (mean {m['cohesion_bl']:.1f} BL)")
-    ax.plot(t, np.std(p[..., 2], axis=1) / bl, lw=0.8, color="tab:cyan",
+    ax.plot(t, shoal.depth_spread_m(p) / bl, lw=0.8, color="tab:cyan",
             label=f"spread of depths (mean {m['depth_spread_bl']:.1f} BL)")
     ax.set_xlabel("time (s)")
     ax.set_ylabel("body lengths")

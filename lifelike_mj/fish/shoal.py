@@ -16,6 +16,7 @@ Distances between fish are three-dimensional.
   polarised when ``O_P > 0.65`` and ``O_R < 0.35``, milling when ``O_R > 0.65`` and ``O_P < 0.35``, a swarm when
   both are below 0.35.
 * **Cohesion** (:func:`cohesion_m`): the mean distance of the fish from their centroid.
+* **Spread of depths** (:func:`depth_spread_m`): the standard deviation of the fish's heights, how flat a group is.
 * **Kicks** (:func:`kick_times`): the onsets of speed rises. A kick is a local minimum of a fish's speed followed by a
   rise of at least ``rise_bl_s`` body lengths per second before the speed next falls: a burst-and-coast fish's
   kicks, as Calovi et al. (2018) segment their tetras' tracks (heading and speed change at the kick, then a glide).
@@ -109,6 +110,11 @@ def cohesion_m(positions) -> np.ndarray:
     """Per sample (T,), the mean distance (m) of the fish from their centroid."""
     p = _positions(positions)
     return np.linalg.norm(p - p.mean(axis=1, keepdims=True), axis=-1).mean(axis=1)
+
+
+def depth_spread_m(positions) -> np.ndarray:
+    """Per sample (T,), the standard deviation (m) of the fish's depths: how flat the group is."""
+    return np.std(_positions(positions)[..., 2], axis=1)
 
 
 def kick_times(times_s, speed, rise_m_s: float) -> np.ndarray:
@@ -226,7 +232,7 @@ def group_measures(times_s, positions, body_length_m: float, tank_m=None, *, ski
         "milling": float(np.mean((orr[ok] > 0.65) & (op[ok] < 0.35))) if ok.any() else nan,
         "swarm": float(np.mean((op[ok] < 0.35) & (orr[ok] < 0.35))) if ok.any() else nan}
     out["cohesion_bl"] = float(cohesion_m(p).mean() / bl)
-    out["depth_spread_bl"] = float(np.std(p[..., 2], axis=1).mean() / bl)
+    out["depth_spread_bl"] = float(depth_spread_m(p).mean() / bl)
     iv = kick_intervals_s(t, speed, kick_rise_bl_s * bl)
     out["kick_interval_s"] = {
         "count": int(iv.size), "mean": float(iv.mean()) if iv.size else nan,
@@ -236,7 +242,6 @@ def group_measures(times_s, positions, body_length_m: float, tank_m=None, *, ski
     out["speed_bl_s"] = _stats(speed / bl)
     out["wall_distance_bl"] = _stats(wall_distance_m(p, tank_m) / bl) if tank_m is not None else None
     return out
-
 
 
 def wall_angle_rad(positions, head, tank_m) -> np.ndarray:
@@ -262,7 +267,7 @@ def kick_segments(times_s, positions, body_length_m: float, *, kick_rise_bl_s: f
     ``glide_tau_s`` is the time constant ``tau`` of an exponential decay ``v = v_k exp(-t / tau)`` (Calovi et al.'s
     glide, linear drag), fitted to ``ln v``; ``glide_power`` says which law fits the segment better, 1 for the
     exponential and 2 for the hyperbolic decay ``v = v_k / (1 + t / t_h)`` of quadratic drag (a straight line in
-    ``1 / v``), by the smaller relative residual."""
+    ``1 / v``), by the smaller root-mean-square residual in speed."""
     t = np.asarray(times_s, dtype=float)
     p = _positions(positions)
     vel = velocities(t, p)
@@ -360,21 +365,21 @@ def largest_group(positions, link_m: float) -> np.ndarray:
     return np.flatnonzero(label == int(np.argmax(sizes)))
 
 
-def front_of_group(positions, velocities, link_m: float) -> tuple[int, np.ndarray]:
+def front_of_group(positions, vel, link_m: float) -> tuple[int, np.ndarray]:
     """The fish at the front of the largest group (:func:`largest_group`) and the group: the member farthest along the
-    group's mean horizontal velocity (``velocities`` (F, 3) m/s)."""
+    group's mean horizontal velocity (``vel`` (F, 3) m/s)."""
     p = np.asarray(positions, dtype=float).reshape(-1, 3)
     g = largest_group(p, link_m)
-    v = np.asarray(velocities, dtype=float).reshape(-1, 3)[g, :2].mean(axis=0)
+    v = np.asarray(vel, dtype=float).reshape(-1, 3)[g, :2].mean(axis=0)
     return int(g[int(np.argmax(p[g, :2] @ v))]), g
 
 
-def is_school(positions, velocities, link_m: float, min_fish: int, min_polarisation: float = 0.8) -> bool:
-    """Whether fish at one moment (``positions``, ``velocities`` (F, 3)) swim as a school: the largest group
+def is_school(positions, vel, link_m: float, min_fish: int, min_polarisation: float = 0.8) -> bool:
+    """Whether fish at one moment (``positions``, velocities ``vel`` (F, 3)) swim as a school: the largest group
     (:func:`largest_group`) holds at least ``min_fish`` fish, and their horizontal headings' polarisation exceeds
     ``min_polarisation``."""
     g = largest_group(positions, link_m)
     if len(g) < min_fish:
         return False
-    head = headings(np.asarray(velocities, dtype=float).reshape(-1, 3)[g][None], 0.0)
+    head = headings(np.asarray(vel, dtype=float).reshape(-1, 3)[g][None], 0.0)
     return bool(polarisation(head)[0] > min_polarisation)
