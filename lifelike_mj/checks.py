@@ -65,6 +65,16 @@ def whole(name: str, v: object, lo: int | None = None, hi: int | None = None) ->
     return int(v)
 
 
+def flag(name: str, v: object) -> bool:
+    """``v`` as a bool; a :class:`UserError` unless it is ``True`` or ``False`` (or a NumPy bool): a string such as
+    ``"no"`` or a number would otherwise switch a flag on by being truthy."""
+    import numpy as np
+
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    raise UserError(f"{name} must be True or False, got {v!r}.")
+
+
 def vector(name: str, v: object, n: int, unit: str = "") -> tuple[float, ...]:
     """``v`` as a tuple of ``n`` floats; a :class:`UserError` unless it is a sequence of ``n`` finite numbers."""
     try:

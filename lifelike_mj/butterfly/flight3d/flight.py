@@ -175,12 +175,12 @@ class Flight3D(StepCounter):
                         "assist": assist, "drive_hz": checks.positive("drive_hz", drive_hz, "Hz"),
                         "n_strips": n_strips, "n_chord": n_chord, "animal": self.animal}
         self.masses, self.omega_c, self.pitch_law = masses, omega_c, pitch_law
-        self.end_on_tumble = bool(end_on_tumble)
+        self.end_on_tumble = checks.flag("end_on_tumble", end_on_tumble)
         #: The blossoms' centres (``(n, 3)``, m), or ``None``.
         self.flowers = None if flowers is None else np.array(checks.points("flowers", flowers, "m"))
         if ground_m is not None:
             ground_m = checks.number("ground_m", ground_m, -1000.0, 1000.0, unit="m")
-        self.contact = bool(contact) or self.flowers is not None
+        self.contact = checks.flag("contact", contact) or self.flowers is not None
         self._model = _model if _model is not None else mj3d.build_model(self.params, masses, self.animal,
                                                                           contact=self.contact, flowers=self.flowers,
                                                                           ground_m=ground_m)

@@ -24,7 +24,7 @@ from lifelike_mj.butterfly.flight3d import model as mj3d
 from lifelike_mj.butterfly.flight3d import tasks as t3
 from lifelike_mj.butterfly.flight3d.controllers import Controller3D, load_controller
 from lifelike_mj.butterfly.flight3d.flight import DT_S
-from lifelike_mj.butterfly.flight3d.flowers import add_flowers, landing_surface, place_flowers
+from lifelike_mj.butterfly.flight3d.flowers import add_flowers, check_room, landing_surface, place_flowers
 from lifelike_mj.butterfly.flight3d.kinematics import Kinematics
 from lifelike_mj.butterfly.flight3d.landing import on_blossom
 from lifelike_mj.butterfly.flight3d.loop import Batch, attitude, take_off_kinematics
@@ -129,10 +129,12 @@ class Garden(StepCounter):
         self.controller = controller if isinstance(controller, Controller3D) else load_controller(controller)
         self.seed = checks.whole("seed", seed, 0, 2**32 - 1)
         self.size_m = checks.number("garden size", size_m, 2.0, 100.0, unit="m")
-        self.blossoms = flowers(self.seed, checks.whole("the number of flowers", n_flowers, 2, 200), self.size_m)
+        n_flowers = checks.whole("n_flowers", n_flowers, 2, 200)
+        check_room(n_flowers, self.size_m, "n_flowers", "size_m")
+        self.blossoms = flowers(self.seed, n_flowers, self.size_m)
         self.dt = checks.positive("time step dt_s", dt_s, "s")
         #: Whether the butterflies land on the flowers (else they pass them by).
-        self.land = lands(self.controller) if land is None else bool(land)
+        self.land = lands(self.controller) if land is None else checks.flag("land", land)
         wind = checks.one_wind("Garden", wind_to_m_s, wind_from_m_s, wind_m_s, "to") or (0.0, 0.0, 0.0)
         speed_m_s = checks.positive("speed_m_s", speed_m_s, "m/s")
         weather = {"wind_to_m_s": wind, "gust_m_s": gust_m_s, "gust_vertical_m_s": gust_vertical_m_s,
