@@ -98,12 +98,27 @@ def _existing_parent(path: Path) -> Path:
     return parent
 
 
+def _missing_folders(p: Path, what: str, levels: int, target: Path | None = None) -> Path:
+    """The nearest existing folder above ``p``; a :class:`UserError` if more than ``levels`` folders would have to
+    be made to reach ``p`` (a mistyped path is not made silently, least of all at the top of the file system)."""
+    parent = _existing_parent(p)
+    try:
+        missing = len(p.absolute().relative_to(parent).parts) - 1
+    except ValueError:
+        missing = 0
+    if missing > levels:
+        first = next((q for q in reversed(p.parents) if not _exists(q)), p.parent)  # as the user wrote it
+        raise UserError(f"{what} {target or p} cannot be written: the folder {first} does not exist (make it first, "
+                        "or give a path in a folder that exists).")
+    return parent
+
+
 def check_writable(path: str | Path, what: str = "output") -> Path:
     """Before any work: :class:`UserError` unless a file could be written at ``path`` (its folder exists
-    or can be made, and is writable; ``path`` itself is not a folder or another kind of file)."""
+    and is writable; ``path`` itself is not a folder or another kind of file)."""
     p = Path(path)
-    parent = _existing_parent(p)
-    _check_name(p, parent, what)
+    _check_name(p, _existing_parent(p), what)
+    parent = _missing_folders(p, what, 0)
     if p.exists() and p.is_dir():
         raise UserError(f"{what} {p} is a folder; give a file name.")
     if p.exists() and not p.is_file():
@@ -175,13 +190,14 @@ def check_output_file(path: str | Path, what: str, *, suffixes: Iterable[str] = 
 
 
 def check_output_dir(path: str | Path, what: str, names: Iterable[str] = (), *, overwrite: bool = False,
-                     claim: bool = True) -> Path:
-    """Before any work: the folder ``path`` may be made or written into, and none of the files ``names``
-    it will hold exists yet unless ``overwrite``; the folder is claimed for this process
-    (:func:`lifelike_mj.io.claim`), as :func:`check_output_file` claims a file."""
+                     claim: bool = True, make: int = 1) -> Path:
+    """Before any work: the folder ``path`` may be made or written into (at most ``make`` folders made to reach
+    it: by default ``path`` itself, in a folder that exists), and none of the files ``names`` it will hold exists
+    yet unless ``overwrite``; the folder is claimed for this process (:func:`lifelike_mj.io.claim`), as
+    :func:`check_output_file` claims a file."""
     p = Path(path)
-    parent = p if _exists(p) else _existing_parent(p)
-    _check_name(p / "x", parent, what)
+    _check_name(p / "x", p if _exists(p) else _existing_parent(p), what)
+    parent = p if _exists(p) else _missing_folders(p / "x", what, make, target=p)
     if p.exists() and not p.is_dir():
         raise UserError(f"{what} {p} is a file; give a folder.")
     _probe(parent, p, what, "made")
@@ -201,20 +217,35 @@ def check_output_dir(path: str | Path, what: str, names: Iterable[str] = (), *, 
     return p
 
 
-def read_json(path: str | Path, what: str) -> object:
-    """The content of the JSON file ``path``, as plain data. Reading never runs code; a file that is
-    not readable UTF-8 JSON, or larger than :data:`MAX_JSON_BYTES`, is a :class:`UserError`."""
+def read_json(path: str | Path, what: str, max_bytes: int | None = None) -> object:
+    """The content of the JSON file ``path``, as plain data. Reading never runs code; a file that is missing, a
+    folder, not readable UTF-8 JSON, or larger than ``max_bytes`` (:data:`MAX_JSON_BYTES` by default, checked
+    before it is read) is a :class:`UserError` saying which."""
     p = Path(path)
+    limit = MAX_JSON_BYTES if max_bytes is None else int(max_bytes)
+    if p.is_dir():
+        raise UserError(f"{what} file {p} is a folder, not a file.")
     try:
-        too_big = p.stat().st_size > MAX_JSON_BYTES
-        if not too_big:
+        size = p.stat().st_size
+        if size <= limit:
             return json.loads(p.read_text(encoding="utf-8"), parse_constant=_no_constant)
-    except (OSError, ValueError) as exc:  # UnicodeDecodeError and JSONDecodeError are ValueErrors
-        raise UserError(f"{what} file {p} is not readable JSON ({exc.__class__.__name__}).") from None
+    except FileNotFoundError:
+        raise UserError(f"{what} file {p} does not exist.") from None
+    except UnicodeDecodeError:
+        raise UserError(f"{what} file {p} is not a JSON file (not UTF-8 text).") from None
+    except json.JSONDecodeError as exc:
+        raise UserError(f"{what} file {p} is not a JSON file ({exc.msg.lower()} at line {exc.lineno}, column "
+                        f"{exc.colno}).") from None
+    except _NotStrict as exc:
+        raise UserError(f"{what} file {p} is not strict JSON ({exc}).") from None
+    except (OSError, ValueError) as exc:
+        why = exc.strerror.lower() if isinstance(exc, OSError) and exc.strerror else exc.__class__.__name__
+        raise UserError(f"{what} file {p} cannot be read as JSON ({why}).") from None
     except RecursionError:  # json's decoder recurses once per level of nesting
         raise UserError(f"{what} file {p} is nested too deeply to be one (more than about "
                         f"{sys.getrecursionlimit()} levels of lists or objects).") from None
-    raise UserError(f"{what} file {p} is larger than {MAX_JSON_BYTES // 1_000_000} MB; it cannot be one.")
+    shown = f"{limit / 1e6:g} MB" if limit >= 1_000_000 else f"{limit / 1e3:g} kB"
+    raise UserError(f"{what} file {p} is {size / 1e6:.1f} MB, larger than any {what} file can be (at most {shown}).")
 
 
 def load_named_json(creature: str, name_or_path: str | Path, what: str) -> tuple[object, Path]:
@@ -223,5 +254,9 @@ def load_named_json(creature: str, name_or_path: str | Path, what: str) -> tuple
     return read_json(path, what), path
 
 
+class _NotStrict(ValueError):
+    """A constant (NaN, Infinity) that Python's JSON reader takes and strict JSON does not."""
+
+
 def _no_constant(name: str) -> float:
-    raise ValueError(f"{name} is not a number in strict JSON")
+    raise _NotStrict(f"{name} is not a number in strict JSON")

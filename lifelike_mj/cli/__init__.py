@@ -167,7 +167,9 @@ def cmd_reproduce(args) -> None:
     for claim in (False, True):  # every folder checked before the first stage starts, then claimed
         for what in whats:
             out = Path(args.out or "reports") / what if (args.what == "all" or not args.out) else Path(args.out)
-            check_output_dir(out, "--out", ("report.md", "results.json"), overwrite=args.overwrite, claim=claim)
+            make = 2 if (args.what == "all" or not args.out) else 1  # OUT (or reports) and its creature's folder
+            check_output_dir(out, "--out", ("report.md", "results.json"), overwrite=args.overwrite, claim=claim,
+                             make=make)
     import time
 
     from lifelike_mj.progress import duration_text
@@ -179,6 +181,16 @@ def cmd_reproduce(args) -> None:
         print(f"report written to {out / 'report.md'}")
     if len(whats) > 1:
         print(f"all reports written in {duration_text(time.perf_counter() - t0)}")
+
+
+def _leaf(parser: argparse.ArgumentParser, args: argparse.Namespace) -> argparse.ArgumentParser:
+    """The parser of the command ``args`` ran (``lifelike-mj fish swim``'s, not the top one)."""
+    while True:
+        sub = next((a for a in parser._actions if isinstance(a, argparse._SubParsersAction)), None)
+        name = getattr(args, sub.dest, None) if sub is not None else None
+        if sub is None or name not in sub.choices:
+            return parser
+        parser = sub.choices[name]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -198,7 +210,10 @@ def main(argv: list[str] | None = None) -> int:
     from lifelike_mj import progress
 
     try:
-        args = build_parser().parse_args(join_negative_values(argv))
+        parser = build_parser()
+        args, extra = parser.parse_known_args(join_negative_values(argv))
+        if extra:  # said by the command's own parser, which knows its options' names
+            _leaf(parser, args).error(f"unrecognized arguments: {' '.join(extra)}")
         progress.set_enabled(not getattr(args, "quiet", False))
         t0 = time.perf_counter()
         args.func(args)

@@ -46,7 +46,37 @@ class Parser(argparse.ArgumentParser):
         return super().format_help()
 
     def error(self, message: str):  # one sentence, exit 2 (argparse prints usage otherwise)
-        raise UserError(f"{message} (see '{self.prog} --help').")
+        raise UserError(f"{self._plain(message)} (see '{self.prog} --help').")
+
+    def _plain(self, message: str) -> str:
+        """argparse's message in the user's words: a misspelt command or choice, or an unknown option, named with
+        the nearest known one."""
+        import difflib
+        import re
+
+        def near(word: str, known) -> str:
+            close = difflib.get_close_matches(word, list(known), n=1, cutoff=0.6)
+            return f" (did you mean {close[0]!r}?)" if close else ""
+
+        m = re.match(r"argument (\S+): invalid choice: '?(.*?)'? \(choose from (.*)\)$", message)
+        if m:
+            dest, word = m.group(1), m.group(2)
+            action = next((a for a in self._actions if dest in (a.dest, a.metavar, *a.option_strings)), None)
+            known = [str(c) for c in (action.choices or ())] if action is not None else []
+            if isinstance(action, argparse._SubParsersAction):
+                return (f"{self.prog} has no command {word!r}{near(word, known)}; its commands are "
+                        f"{', '.join(known)}")
+            return f"{dest} {word!r} is not one of {', '.join(known)}{near(word, known)}"
+        m = re.match(r"unrecognized arguments: (.*)$", message)
+        if m:
+            word = m.group(1).split()[0].split("=")[0]
+            if word.startswith("-"):
+                known = {o[2:]: o for o in self._option_string_actions if o.startswith("--")}
+                close = difflib.get_close_matches(word.lstrip("-"), list(known), n=1, cutoff=0.75)
+                hint = f" (did you mean {known[close[0]]!r}?)" if close else ""
+                return f"{self.prog} has no option {word!r}{hint}"
+            return f"{self.prog} takes no argument {word!r} here"
+        return message
 
 
 def num(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False, unit: str = ""):
@@ -75,13 +105,14 @@ def num(lo: float | None = None, hi: float | None = None, *, lo_open: bool = Fal
 
 def count(lo: int = 0, hi: int | None = None):
     """An argparse ``type``: a whole number in ``[lo, hi]`` (``1e6`` is accepted when it is whole)."""
+    rng = f"from {lo:,} to {hi:,}" if hi is not None else f"of at least {lo:,}"
+
     def parse(text: str) -> int:
         try:
             v = float(text) if any(c in text for c in ".eE") else int(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+            raise argparse.ArgumentTypeError(f"must be a whole number {rng}, got {text!r}") from None
         if v != v or v in (float("inf"), float("-inf")) or int(v) != v or v < lo or (hi is not None and v > hi):
-            rng = f"from {lo:,} to {hi:,}" if hi is not None else f"of at least {lo:,}"
             raise argparse.ArgumentTypeError(f"must be a whole number {rng}, got {text!r}")
         return int(v)
 

@@ -171,17 +171,23 @@ def parameters_of(args: argparse.Namespace) -> dict:
 
 
 def check_window(start: float, duration: float, per_unit: float, dt: float, unit: str = "s", bodies: int = 1,
-                 limit: int | None = None, body_unit: str = "body-steps") -> None:
+                 limit: int | None = None, body_unit: str = "body-steps", drawn: int = 1) -> None:
     """Before the simulation is built: the window's frames (:func:`~lifelike_mj.export.poses.frames_of`: at least
-    2, at most :data:`~lifelike_mj.checks.MAX_FRAMES`) and the steps of ``dt`` of ``bodies`` simulated bodies over
+    2, at most :data:`~lifelike_mj.checks.MAX_FRAMES`), the poses recorded (every step of ``dt`` in ``duration``
+    of at least ``drawn`` drawn bodies: at most :data:`~lifelike_mj.checks.MAX_RECORD_ROWS`, checked exactly once
+    the model is built, by :meth:`Window.plan`) and the steps of ``dt`` of ``bodies`` simulated bodies over
     ``start + duration`` (at most ``limit``, :data:`~lifelike_mj.checks.MAX_BODY_STEPS` by default)."""
     from lifelike_mj import checks
     from lifelike_mj.export.poses import frames_of
 
-    frames_of(duration, per_unit, unit)
+    n_frames = frames_of(duration, per_unit, unit)
     total = checks.steps_of(start + duration, dt) * bodies
     checks.work(f"simulating {start + duration:g} {unit} of {bodies:,} {'bodies' if bodies > 1 else 'body'}",
                 total, checks.MAX_BODY_STEPS if limit is None else limit, body_unit, "a shorter --start or --duration")
+    steps = int(round((n_frames - 1) / per_unit / dt)) + 1  # as plan_recording counts them: every step to the last frame
+    checks.work(f"recording {steps:,} poses of at least {drawn:,} {'bodies' if drawn > 1 else 'body'}",
+                float(steps) * drawn, checks.MAX_RECORD_ROWS, "body poses",
+                "a shorter window, fewer frames per second or fewer creatures")
 
 
 @dataclass
@@ -196,6 +202,14 @@ class Window:
     per_unit: float
     time_scale: float = 1.0
     unit: str = "s"
+
+    def plan(self) -> int:
+        """Check the recording before any simulation (:func:`~lifelike_mj.export.poses.plan_recording`): the body
+        poses it will keep, or a :class:`~lifelike_mj.errors.UserError` if that is too many."""
+        from lifelike_mj.export.poses import plan_recording
+
+        bodies, _, targets = plan_recording(self.stepper, self.duration, self.per_unit)
+        return len(bodies) * len(targets)
 
     def record(self):
         """Simulate and record the window: its :class:`~lifelike_mj.export.poses.Poses`."""

@@ -87,7 +87,17 @@ def load_scene(path: str | Path) -> dict:
     return data
 
 
-def _tokens(options: dict, where: str) -> list[str]:
+def _tokens(options: dict, parser: argparse.ArgumentParser, creature: str, where: str) -> list[str]:
+    """A part's ``options`` as the command line's words for ``parser`` (``lifelike-mj export CREATURE``): each as
+    ``--name=value``, so that a value starting with a minus sign (``"wind_from": [-0.5, 0, 0]``) is read as the
+    command line reads ``--wind-from -0.5,0,0``; an unknown name gets the nearest known one, a flag takes only
+    ``true`` or ``false``, and a number or a list is written as it reads back (``repr`` of a float)."""
+    from lifelike_mj.errors import unknown_name
+
+    actions = {a.dest: a for a in parser._actions if a.option_strings and a.dest != "help"}
+    by_flag = parser._option_string_actions
+    known = sorted({o[2:].replace("-", "_") for o in by_flag if o.startswith("--") and o != "--help"}
+                   - set(SET_BY_SCENE))
     out = []
     for key, value in options.items():
         name = key.replace("-", "_")
@@ -95,14 +105,23 @@ def _tokens(options: dict, where: str) -> list[str]:
             raise UserError(f"{where}: the scene sets {key!r} itself (its duration_s, fps and the command's "
                             "output options); leave it out of the part's options.")
         flag = "--" + name.replace("_", "-")
-        if value is True:
-            out.append(flag)
-        elif value is False:
+        action = by_flag.get(flag)
+        if action is None or action.dest not in actions:
+            raise unknown_name(f"{where}: lifelike-mj export {creature} has no option", key, known)
+        if isinstance(action, argparse._StoreTrueAction):
+            if not isinstance(value, bool):
+                raise UserError(f"{where}: option {key!r} is a flag: give true or false, got {value!r}.")
+            if value:
+                out.append(flag)
             continue
-        elif isinstance(value, list):
-            out += [flag, ",".join(repr(float(v)) if isinstance(v, float) else str(v) for v in value)]
+        if isinstance(value, bool):
+            raise UserError(f"{where}: option {key!r} takes a value ({action.metavar or action.dest.upper()}), "
+                            f"not {str(value).lower()}.")
+        if isinstance(value, list):
+            text = ",".join(repr(float(v)) if isinstance(v, float) else str(v) for v in value)
         else:
-            out += [flag, str(value)]
+            text = repr(float(value)) if isinstance(value, float) else str(value)
+        out.append(f"{flag}={text}")
     return out
 
 
@@ -114,8 +133,9 @@ def _parse_part(part: dict, scene: dict, where: str) -> argparse.Namespace:
     mod = _module(creature)
     p = Parser(prog=f"lifelike-mj export {creature}", add_help=False)
     mod.add_export_args(p)
+    tokens = _tokens(part.get("options", {}), p, creature, where)
     try:
-        args = p.parse_args(_tokens(part.get("options", {}), where))
+        args = p.parse_args(tokens)
     except UserError as exc:
         raise UserError(f"{where}: {exc}") from None
     fps = int(scene.get("fps", 30))
@@ -162,8 +182,10 @@ def scene_parts(scene: dict | str | Path, where: str = "the scene", quiet: bool 
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:
         raise UserError(f"{where}: each part has its own name; {', '.join(map(repr, twice))} is used twice.")
-    planned = []
-    for part in scene["parts"]:  # every part checked and built before any runs
+    from lifelike_mj import checks
+
+    planned, rows = [], 0
+    for part in scene["parts"]:  # every part checked and built, and its recording planned, before any runs
         at = f"{where}, part {part['name']!r}"
         args = _parse_part(part, scene, at)
         try:
@@ -171,7 +193,13 @@ def scene_parts(scene: dict | str | Path, where: str = "the scene", quiet: bool 
         except UserError as exc:
             raise UserError(f"{at}: {exc}") from None
         _check_follow(part, window.stepper.model, at)
+        try:
+            rows += window.plan()
+        except UserError as exc:
+            raise UserError(f"{at}: {exc}") from None
         planned.append((part, window, parameters))
+    checks.work(f"{where}: recording its {len(planned)} parts", rows, checks.MAX_RECORD_ROWS, "body poses",
+                "fewer parts, a shorter duration_s or a lower fps")
     parts = []
     for part, window, parameters in planned:
         t0 = time.perf_counter()

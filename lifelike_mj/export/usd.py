@@ -204,7 +204,9 @@ def _texture(stage, mat, look, images: dict) -> None:
     as the diffuse colour, its alpha times the look's as the opacity."""
     from pxr import Gf, Sdf, UsdShade
 
-    file = f"textures/{mat.GetPath().name}.png"
+    # "./" marks the path as the layer's own: usd-core's packager keeps it as it is (a bare "textures/x.png" is
+    # moved to "0/x.png" in the package, with a warning that it cannot resolve the moved path)
+    file = f"./textures/{mat.GetPath().name}.png"
     images[file] = look.image
     reader = UsdShade.Shader.Define(stage, mat.GetPath().AppendChild("st"))
     reader.CreateIdAttr("UsdPrimvarReader_float2")

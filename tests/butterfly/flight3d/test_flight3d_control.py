@@ -185,7 +185,7 @@ def test_a_controller_file_round_trips_and_bad_ones_are_one_sentence(tmp_path):
         flight3d.controller_from_dict(dict(good, base={"flap_hz": 10.0}))
     path = tmp_path / "c.json"
     path.write_text(json.dumps(dict(good, weights=[float("nan")] + good["weights"][1:])).replace("NaN", "NaN"))
-    with pytest.raises(UserError, match="not readable JSON"):
+    with pytest.raises(UserError, match="not strict JSON"):
         flight3d.load_controller(path)
 
 
