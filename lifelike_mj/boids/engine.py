@@ -138,6 +138,38 @@ def parse_matrix(text: str, name: str = "matrix") -> tuple:
 # ---- initial state -------------------------------------------------------------------------------
 
 
+#: The most neighbour visits (each agent's neighbours within R_c, summed over the agents and the steps) one run may
+#: ask for: about half an hour of the compiled engine on two cores (measured: 6-8 x 10^7 visits per second on one
+#: core, 10,000-30,000 agents in the paper's box). The agent-steps bound alone does not hold the cost: in the paper's
+#: fixed box the neighbours grow with the agents, so a million agents there see about 48,000 each.
+MAX_NEIGHBOUR_VISITS = 1.0e11
+
+
+def neighbours_each(params: BoidParams, n: int) -> float:
+    """The neighbours within ``R_c`` each of ``n`` agents has when they fill ``params``' box evenly (as they start:
+    :func:`initial_state`): ``(n - 1)`` times the zone's share of the box (a sphere of radius ``R_c`` in a cube, or
+    a disc in a square in 2D), at most ``n - 1``. A cohesive pattern gathers them closer, so this is the least."""
+    import math
+
+    d = int(params.dims)
+    zone = 4.0 / 3.0 * math.pi * params.r_c**3 if d == 3 else math.pi * params.r_c**2
+    return (n - 1) * min(1.0, zone / float(params.box) ** d)
+
+
+def check_cost(params: BoidParams, n: int, steps: int, what: str, limit: float = MAX_NEIGHBOUR_VISITS) -> float:
+    """Before any work: the neighbour visits of ``n`` agents over ``steps`` steps (:func:`neighbours_each`, at least
+    one per agent-step), or a :class:`~lifelike_mj.errors.UserError` naming ``what``, the neighbours each agent sees
+    and :data:`MAX_NEIGHBOUR_VISITS`."""
+    each = neighbours_each(params, n)
+    visits = float(n) * max(each, 1.0) * float(steps)
+    if visits > limit:
+        raise UserError(f"{what}: {n:,} agents in a box {float(params.box):g} units wide see about {each:,.0f} "
+                        f"neighbours each, {visits:.3g} neighbour visits over {steps:,} step{'s' if steps != 1 else ''}; at most "
+                        f"{limit:.3g} "
+                        "are allowed (fewer agents or steps, or a wider box: a preset's \"box\").")
+    return visits
+
+
 def initial_state(params: BoidParams, n: int, seed: int, margin: float | None = None,
                   type_probs=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Random positions in ``[margin, L - margin]^D`` (default margin ``R_c``: well away from the

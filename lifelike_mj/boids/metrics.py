@@ -120,10 +120,25 @@ def _pair_d2_chunks(x: np.ndarray, chunk: int = 1024):
         yield i0, d2
 
 
+#: Above this many agents the neighbour measures search a k-d tree (``scipy.spatial.cKDTree``: time and memory
+#: about linear in n) instead of the chunked all-pairs distances (time in n^2), which give the same neighbours and
+#: are kept below it so that the paper's runs measure bit for bit as before (``tests/boids/test_boids_metrics.py``
+#: checks that both agree).
+DENSE_MAX = 4096
+
+
 def knn(x: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
     """Indices (n, k) and distances (n, k) of each agent's ``k`` nearest other agents (unsorted)."""
     n = len(x)
     k = min(k, n - 1)
+    if n > DENSE_MAX:
+        from scipy.spatial import cKDTree
+
+        dist, idx = cKDTree(x).query(x, k=k + 1)  # the first is the agent itself (or a twin at distance 0)
+        own = idx == np.arange(n)[:, None]
+        keep = ~own
+        keep[~own.any(axis=1), -1] = False  # a twin listed before the agent: drop the farthest instead
+        return idx[keep].reshape(n, k).astype(np.int64), dist[keep].reshape(n, k)
     idx = np.empty((n, k), dtype=np.int64)
     dist = np.empty((n, k))
     for i0, d2 in _pair_d2_chunks(x):
@@ -135,6 +150,15 @@ def knn(x: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
 
 def pairs_within(x: np.ndarray, r: float) -> tuple[np.ndarray, np.ndarray]:
     """All pairs ``i < j`` with ``|x_i - x_j| < r``."""
+    if len(x) > DENSE_MAX:
+        from scipy.spatial import cKDTree
+
+        pairs = cKDTree(x).query_pairs(r, output_type="ndarray")  # |d| <= r; the strict bound below
+        i, j = pairs[:, 0].astype(np.int64), pairs[:, 1].astype(np.int64)
+        d = x[i] - x[j]
+        inside = np.einsum("ij,ij->i", d, d) < r * r
+        order = np.lexsort((j[inside], i[inside]))
+        return i[inside][order], j[inside][order]
     ii, jj = [], []
     for i0, d2 in _pair_d2_chunks(x):
         a, b = np.nonzero(d2 < r * r)

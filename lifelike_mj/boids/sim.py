@@ -21,6 +21,7 @@ from lifelike_mj.boids.engine import (
     BoidRun,
     _as3,
     _steps,
+    check_cost,
     diverged_speed,
     divergence_message,
     initial_state,
@@ -86,6 +87,7 @@ class Flock(StepCounter):
         the step and the likely cause."""
         n = checks.whole("the number of steps", n, 0)
         if n:
+            check_cost(self.params, self.n, n, f"Flock.step({n})")
             self._run(n)
 
     def state(self) -> dict[str, np.ndarray]:
@@ -101,6 +103,7 @@ class Flock(StepCounter):
         the flock's step numbers."""
         n_steps = checks.whole("the number of steps", n_steps, 1)
         every = checks.whole("record_every", every, 1)
+        check_cost(self.params, self.n, n_steps, f"recording {n_steps:,} steps")
         frames = (n_steps - min(max(int(record_from), 0), n_steps)) // every + 1 + len(extra_steps)
         checks.work(f"recording {self.n:,} agents every {every} steps over {n_steps:,} steps", float(frames) * self.n,
                     checks.MAX_RECORD_ROWS, "agent rows", "fewer agents, or recording less often or less")

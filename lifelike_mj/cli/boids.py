@@ -52,15 +52,21 @@ def _add_boids(p) -> None:
     p.add_argument("--dims", type=int, default=3, choices=(3, 2), help="3 or 2 (section 4.3)")
 
 
-def _check_size(n: int, steps: int | None) -> int:
+def _check_size(n: int, steps: int | None, params=None) -> int:
     """The agent-steps of one run of ``n`` agents for ``steps`` (default the paper's), refused above
-    :data:`~lifelike_mj.checks.MAX_AGENT_STEPS`."""
+    :data:`~lifelike_mj.checks.MAX_AGENT_STEPS`, and with ``params`` its neighbour visits, refused above
+    :data:`~lifelike_mj.boids.engine.MAX_NEIGHBOUR_VISITS` (:func:`~lifelike_mj.boids.engine.check_cost`)."""
     from lifelike_mj import checks
     from lifelike_mj.boids.metrics import RUN_STEPS
 
     steps = steps or RUN_STEPS
-    return checks.work(f"--n {n:,} for {steps:,} steps", n * steps, checks.MAX_AGENT_STEPS, "agent-steps",
-                       "fewer agents or steps")
+    out = checks.work(f"--n {n:,} for {steps:,} steps", n * steps, checks.MAX_AGENT_STEPS, "agent-steps",
+                      "fewer agents or steps")
+    if params is not None:
+        from lifelike_mj.boids.engine import check_cost
+
+        check_cost(params, n, steps, f"--n {n:,} for {steps:,} steps")
+    return out
 
 
 def _params(args):
@@ -102,8 +108,8 @@ def _axis(spec: str) -> tuple[str, list[float]]:
 def cmd_run(args) -> None:
     from lifelike_mj.boids.experiments import measured_run, write_run
 
-    _check_size(args.n, args.steps)
     params = _params(args)
+    _check_size(args.n, args.steps, params)
     if args.record_every is not None and not args.out:
         raise UserError("--record-every only applies with --out (it chooses what the trajectory files keep).")
     check_outputs(args, files={"--plot": (".png",)}, folders={"--out": RUN_FILES})
@@ -128,7 +134,7 @@ def cmd_sweep(args) -> None:
     from lifelike_mj.boids.presets import homogeneous, load_grid
 
     check_executor(args)
-    per_run = _check_size(args.n, args.steps)
+    per_run = _check_size(args.n, args.steps, homogeneous(1.0, 0.0, dims=args.dims) if args.grid else _params(args))
     seed_list = seeds(args.seeds)
     if args.grid:
         g = load_grid(args.grid)
@@ -217,7 +223,9 @@ def add_render_args(p: argparse.ArgumentParser) -> None:
 def render(args) -> dict:
     from lifelike_mj.boids.render import render_boids
 
-    return render_boids(args.out, _params(args), n=args.n, n_steps=args.steps or 3000, seed=args.seed, fps=args.fps,
+    params = _params(args)
+    _check_size(args.n, args.steps or 3000, params)
+    return render_boids(args.out, params, n=args.n, n_steps=args.steps or 3000, seed=args.seed, fps=args.fps,
                         width=args.width, height=args.height, camera=args.camera, progress=True)
 
 
@@ -264,11 +272,11 @@ def export_window(args):
     from lifelike_mj.boids.sim import Flock
     from lifelike_mj.cli.export import Window, check_window, parameters_of
 
-    _check_size(args.n, args.start + args.steps)
+    _check_size(args.n, args.start + args.steps, _params(args))
     if args.steps < args.steps_per_frame:
         raise UserError(f"--steps {args.steps} is fewer than one frame of --steps-per-frame {args.steps_per_frame}.")
     check_window(args.start, args.steps, 1.0 / args.steps_per_frame, 1.0, unit="steps", bodies=args.n,
-                 limit=checks.MAX_AGENT_STEPS, body_unit="agent-steps")
+                 limit=checks.MAX_AGENT_STEPS, body_unit="agent-steps", drawn=args.n)
     flock = Flock(_params(args), args.n, args.seed)
     return (Window(flock, args.start, args.steps, 1.0 / args.steps_per_frame,
                    1.0 / (args.steps_per_frame * args.fps), unit="steps"), parameters_of(args))
