@@ -122,6 +122,7 @@ def validate(data: object, schema: dict, where: str, arrays: Callable | None = N
     from jsonschema.exceptions import best_match
 
     cls = _validator_class() if arrays is None else _with_arrays(arrays)
+    too_long(data, schema, where)  # a list longer than allowed is refused by its length, before its items are looked at
     try:
         errors = list(cls(schema).iter_errors(data))
         # an unknown key first: a misspelt key also leaves a required one missing, and the typo is the news
@@ -131,6 +132,55 @@ def validate(data: object, schema: dict, where: str, arrays: Callable | None = N
         raise UserError(f"{where} is nested too deeply to be one of ours.") from None
     if err is not None:
         raise UserError(sentence(err, where))
+
+
+def too_long(data: object, schema: dict, where: str) -> None:
+    """A :class:`UserError` for the first list in ``data`` longer than ``schema`` allows (``maxItems``), in the
+    sentence :func:`validate` gives it, found without looking at the items of a list too long: the validator itself
+    checks every item of a list before its length (a file of millions of numbers took a minute to refuse)."""
+    found = _too_long(data, schema)
+    if found is None:
+        return
+    from collections import deque
+
+    from jsonschema.exceptions import ValidationError
+
+    path, node, items = found
+    raise UserError(sentence(ValidationError(f"too long: {len(items)} items", validator="maxItems",
+                                             validator_value=node["maxItems"], instance=items, schema=node,
+                                             path=deque(path)), where))
+
+
+def _too_long(data: object, schema: object, path: tuple = ()):
+    """The first list in ``data`` longer than its schema's ``maxItems``: ``(path, schema, list)``, or ``None``; it
+    looks inside a list only when the list itself is within its bound, so that its cost never grows past the bounds."""
+    if not isinstance(schema, dict):
+        return None
+    if isinstance(data, list):
+        bound = schema.get("maxItems")
+        if bound is None:
+            return None
+        if len(data) > bound:
+            return path, schema, data
+        items = schema.get("items")
+        for i, v in enumerate(data if isinstance(items, dict) else ()):
+            found = _too_long(v, items, (*path, i))
+            if found is not None:
+                return found
+        return None
+    props = schema.get("properties")
+    if isinstance(data, dict) and isinstance(props, dict):
+        for k, v in data.items():
+            found = _too_long(v, props.get(k), (*path, k))
+            if found is not None:
+                return found
+    for sub in schema.get("allOf", ()):  # the branches that apply (if/then/else on small schemas: cheap)
+        if isinstance(sub, dict) and "if" in sub:
+            sub = sub.get("then") if _validator_class()(sub["if"]).is_valid(data) else sub.get("else")
+        found = _too_long(data, sub, path)
+        if found is not None:
+            return found
+    return None
 
 
 def path_text(path: Sequence) -> str:

@@ -97,11 +97,13 @@ def cmd_fly3d(args) -> None:
 
 def cmd_evolve3d(args) -> None:
     from lifelike_mj.butterfly.flight3d.controllers import load_controller
-    from lifelike_mj.butterfly.flight3d.evolution import TASK_SETS, evolve
+    from lifelike_mj.butterfly.flight3d.evolution import TASK_SETS, check_time_step, evolve
 
     check_executor(args)
     layers = [11 if args.speed_input else 10, *args.hidden, 9]
     start = load_controller(args.start) if args.start else None
+    if start is not None:
+        check_time_step(args.dt, start.base.frequency_hz, "--dt")
     if start is not None and args.hidden:
         raise UserError("--hidden does not apply with --start (the network is the start controller's).")
     if args.mode is not None and start is None:
@@ -129,11 +131,13 @@ def cmd_evolve3d(args) -> None:
 
 def cmd_assess3d(args) -> None:
     from lifelike_mj.butterfly.flight3d.controllers import load_controller
+    from lifelike_mj.butterfly.flight3d.evolution import check_time_step
     from lifelike_mj.butterfly.flight3d.validate import check_window, course_check, level_check, turn_check
 
     check_window("the level flight (--duration)", args.duration, LEVEL_SETTLE_S, 1.0,
                  "it measures the speed each second after settling")
     ctrl = load_controller(args.controller)
+    check_time_step(args.dt, ctrl.base.frequency_hz, "--dt")
     with stage("level flight, turns of 90 and 180 deg, courses"):
         level = level_check(ctrl, args.speed, args.duration, LEVEL_SETTLE_S, dt_s=args.dt)
         turns = [turn_check(ctrl, a, speed_m_s=args.speed, dt_s=args.dt) for a in (90.0, -90.0, 180.0)]
@@ -153,10 +157,12 @@ def cmd_assess3d(args) -> None:
 
 def cmd_measure3d(args) -> None:
     from lifelike_mj.butterfly.flight3d.controllers import load_controller
+    from lifelike_mj.butterfly.flight3d.evolution import check_time_step
     from lifelike_mj.butterfly.flight3d.measures import check_window, level_measures
 
     check_window("the measures", args.settle + args.window, args.settle, 0.5, "they measure whole wing beats")
     ctrl = load_controller(args.controller)
+    check_time_step(args.dt, ctrl.base.frequency_hz, "--dt")
     with stage(f"level flight at {args.speed:g} m/s, {args.settle + args.window:g} s"):
         m = level_measures(ctrl, args.speed, args.settle, args.window, dt_s=args.dt)
     d = {"controller": ctrl.name or args.controller, **m}
@@ -191,9 +197,10 @@ def cmd_strobe3d(args) -> None:
 
 def cmd_land3d(args) -> None:
     from lifelike_mj.butterfly.flight3d.controllers import load_controller
-    from lifelike_mj.butterfly.flight3d.flowers import place_flowers
+    from lifelike_mj.butterfly.flight3d.flowers import check_room, place_flowers
     from lifelike_mj.butterfly.flight3d.landing import visit_flowers
 
+    check_room(args.flowers, args.size, "--flowers", "--size")
     check_outputs(args, files={"--picture": (".png",)})
     if args.picture:
         from lifelike_mj.render.video import check_size
@@ -234,6 +241,7 @@ def cmd_garden(args) -> None:
 
     from lifelike_mj import checks
     from lifelike_mj.butterfly.flight3d.controllers import load_controller
+    from lifelike_mj.butterfly.flight3d.evolution import check_time_step
     from lifelike_mj.butterfly.flight3d.garden import Garden, film_garden
 
     checks.work(f"a garden of {args.n} butterflies for {args.duration:g} s",
@@ -242,6 +250,7 @@ def cmd_garden(args) -> None:
         checks.work(f"a video of {args.duration:g} s at {args.fps} frames/s", checks.steps_of(args.duration, 1 / args.fps),
                     checks.MAX_FRAMES, "frames", "a shorter garden or fewer frames per second")
     ctrl = load_controller(args.controller)
+    check_time_step(args.dt, ctrl.base.frequency_hz, "--dt")
     check_outputs(args, files={"--out": (".mp4", ".gif"), "--paths": (".png",)})
     garden = Garden(args.n, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_to_m_s=args.wind,
                     gust_vertical_m_s=args.vertical_gusts, dt_s=args.dt)
@@ -282,12 +291,12 @@ def _add_weather(p, what: str, seed: str) -> None:
                         "Dryden model gives half)")
 
 
-def _add_dt(p, fine: bool = False) -> None:
-    """``--dt``: the 3D flight's time step (``fine``: default 1/1200 s, for exports, whose keys sample every step and
-    whose loops end on a step)."""
+def _add_dt(p, fine: bool = False, hi_s: float = 1.0 / 80.0) -> None:
+    """``--dt``: the 3D flight's time step, at most ``hi_s`` (``fine``: default 1/1200 s, for exports, whose keys sample
+    every step and whose loops end on a step)."""
     from lifelike_mj.butterfly.flight3d.timing import DT_FINE_S, DT_S
 
-    p.add_argument("--dt", type=num(1e-5, 1.0 / 80.0, unit="s"), default=DT_FINE_S if fine else DT_S,
+    p.add_argument("--dt", type=num(1e-5, hi_s, unit="s"), default=DT_FINE_S if fine else DT_S,
                    help="time step, s (1/1200 is the step the shipped controllers were evolved at; at most 1/8 of a "
                         "wing beat)" + ("; an export keeps 1/1200 by default, so that its keys and a loop's seam "
                                         "follow the wings closely" if fine else ""))
@@ -380,7 +389,7 @@ def add_commands(bf) -> None:
     p.add_argument("--generations", type=count(1, 1_000_000), default=300, help="generations")
     p.add_argument("--duration", type=num(0, 60, lo_open=True, unit="s"), default=4.0,
                    help="seconds of each training flight")
-    _add_dt(p)
+    _add_dt(p, hi_s=0.01)  # an evolution's training flights: FlightProblem3D's bound
     add_executor(p, "serial", "this process, which flies a generation on every core")
     add_seed(p)
     add_run_files(p, "controller file to write (.json)")
@@ -486,7 +495,7 @@ def export_window(args):
     from lifelike_mj.butterfly.flight3d.controllers import load_controller
     from lifelike_mj.cli.export import Window, check_window, parameters_of
 
-    check_window(args.start, args.duration, args.fps, args.dt, bodies=args.garden or 1)
+    check_window(args.start, args.duration, args.fps, args.dt, bodies=args.garden or 1, drawn=4 * (args.garden or 1))
     ctrl = load_controller(args.controller)
     if args.garden:
         from lifelike_mj.butterfly.flight3d.garden import Garden

@@ -80,6 +80,14 @@ MODE_REACH = {"land": 0.6, "take_off": 1.0}
 NETWORKS = ("flight", *MODES)
 #: The largest reach of a behaviour network (m or s).
 MAX_REACH = 100.0
+#: The largest 3D controller file (bytes), checked before it is read: the largest legitimate controller as lifelike-mj
+#: writes it (indented JSON, one number a line): a flight network of :data:`MAX_LAYERS` layers of :data:`MAX_WIDTH`
+#: neurons and a behaviour network of its shape for each of :data:`MODES`, every weight as long as a float's text can
+#: be (24 characters: ``-2.2250738585072014e-308``) on a line indented 4 (the flight network's) or 8 spaces (a
+#: behaviour's), and 2 MB for the rest (the base, the scales and the provenance: some 10,000 generations' fitness
+#: history). 21.9 MB.
+MAX_FILE_BYTES = (n_weights([N_OBS, *[MAX_WIDTH] * (MAX_LAYERS - 2), N_ACT]) * ((4 + 24 + 2) + len(MODES) * (8 + 24 + 2))
+                  + 2_000_000)
 #: Default ``scale`` of the actions (rad; Hz for the frequency).
 DEFAULT_SCALE = {"offset_sym": 0.3, "offset_asym": 0.3, "amplitude_sym": 0.3, "amplitude_asym": 0.3, "feather_sym": 0.5,
                  "feather_asym": 0.3, "feather_amplitude": 0.3, "abdomen_mean": 0.8, "frequency": 3.0}
@@ -125,28 +133,19 @@ class Controller3D:
         from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
         from lifelike_mj.errors import UserError
 
+        if not isinstance(name, str):
+            raise UserError(f"a 3D controller's name is a text, got {_short(name)}.")
         self.name = name
         where = f"3D controller {name}" if name else "3D controller"
-        try:
-            given = list(layers)
-        except TypeError:
-            given = None
-        ok = (given is not None and 2 <= len(given) <= MAX_LAYERS and all(checks.is_whole(v) for v in given)
-              and given[0] in INPUT_COUNTS and given[-1] == N_ACT and all(1 <= v <= MAX_WIDTH for v in given))
-        if not ok:
-            raise UserError(f"{where}: layers must be whole numbers running from {INPUT_COUNTS[0]} or {INPUT_COUNTS[1]} "
-                            f"inputs to {N_ACT} outputs, "
-                            f"at most {MAX_LAYERS} layers of at most {MAX_WIDTH} neurons, got {layers!r}.")
-        layers = [int(v) for v in given]
+        layers = _check_layers(layers, where)
         self.layers = np.array(layers, dtype=np.int64)
         try:
+            if weights is None or isinstance(weights, (str, bytes, dict)):
+                raise TypeError
             self.weights = np.ascontiguousarray(weights, dtype=np.float64).reshape(-1)
         except (TypeError, ValueError):
-            raise UserError(f"{where}: the weights must be numbers, got {weights!r}.") from None
-        if len(self.weights) != n_weights(layers) or not np.all(np.abs(self.weights) <= MAX_WEIGHT):
-            raise UserError(f"{where}: layers {layers} need {n_weights(layers)} finite weights, each within "
-                            f"+-{MAX_WEIGHT:g}, got {len(self.weights)}"
-                            + ("" if len(self.weights) != n_weights(layers) else " with one beyond") + ".")
+            raise UserError(f"{where}: the weights must be numbers, got {_short(weights)}.") from None
+        _check_count(where, layers, len(self.weights), bool(np.all(np.abs(self.weights) <= MAX_WEIGHT)))
         self.base = base if base is not None else default_base(animal)
         if not isinstance(self.base, KinematicsCommand):
             raise UserError(f"{where}: the base is a KinematicsCommand, got {self.base!r}.")
@@ -176,9 +175,11 @@ class Controller3D:
         if force_law not in FORCE_LAWS_FLOWN:
             raise UserError(f"{where}: force_law is {', '.join(repr(v) for v in FORCE_LAWS_FLOWN)}, got {force_law!r}.")
         self.force_law = force_law
+        if provenance is not None and not isinstance(provenance, dict):
+            raise UserError(f"{where}: provenance is a mapping (the record of how it was made), got {_short(provenance)}.")
         self.provenance = dict(provenance or {})
         if modes is not None and not isinstance(modes, dict):
-            raise UserError(f"{where}: modes is a mapping of behaviours to networks, got {modes!r}.")
+            raise UserError(f"{where}: modes is a mapping of behaviours to networks, got {_short(modes)}.")
         #: The behaviour networks (module docstring): name -> ``{"weights": array, reach name: float}``.
         self.modes = {}
         for mode, spec in (modes or {}).items():
@@ -188,14 +189,14 @@ class Controller3D:
                 raise unknown_name(f"{where}: unknown behaviour", mode, tuple(MODES), "in modes")
             reach = MODES[mode]
             if not isinstance(spec, dict) or set(spec) - {"weights", reach}:
-                raise UserError(f"{where}: the {mode} behaviour is a mapping of weights and {reach}, got {spec!r}.")
+                raise UserError(f"{where}: the {mode} behaviour is a mapping of weights and {reach}, got {_short(spec)}.")
             try:
-                w = np.ascontiguousarray(spec.get("weights"), dtype=np.float64).reshape(-1)
+                if spec.get("weights") is None or isinstance(spec["weights"], (str, bytes, dict)):
+                    raise TypeError
+                w = np.ascontiguousarray(spec["weights"], dtype=np.float64).reshape(-1)
             except (TypeError, ValueError):
                 raise UserError(f"{where}: the {mode} behaviour's weights must be numbers.") from None
-            if len(w) != len(self.weights) or not np.all(np.abs(w) <= MAX_WEIGHT):
-                raise UserError(f"{where}: the {mode} behaviour needs {len(self.weights)} finite weights (its network "
-                                f"is the flight network's shape), each within +-{MAX_WEIGHT:g}.")
+            _check_count(where, layers, len(w), bool(np.all(np.abs(w) <= MAX_WEIGHT)), mode)
             self.modes[mode] = {"weights": w, reach: checks.number(f"{where}: the {mode} behaviour's {reach}",
                                                                     spec.get(reach, MODE_REACH[mode]), 0.0, MAX_REACH,
                                                                     lo_open=True, unit="m" if mode == "land" else "s")}
@@ -283,6 +284,10 @@ class Controller3D:
 
     def mode_weights(self, mode: str) -> np.ndarray:
         """The weights that fly behaviour ``mode`` (:data:`MODES`): its own network's, else the flight network's."""
+        if mode not in MODES:
+            from lifelike_mj.errors import unknown_name
+
+            raise unknown_name("unknown behaviour", mode, tuple(MODES))
         return self.modes[mode]["weights"] if mode in self.modes else self.weights
 
     def all_weights(self) -> np.ndarray:
@@ -293,6 +298,47 @@ class Controller3D:
     def mode_reach(self) -> np.ndarray:
         """Each behaviour's reach in the order of :data:`MODES` (m, s): 0 where it has no network of its own."""
         return np.array([self.modes[m][r] if m in self.modes else 0.0 for m, r in MODES.items()])
+
+
+def _short(v: object) -> str:
+    """``repr(v)``, shortened for a sentence (a list of millions of weights is shown by its first few)."""
+    import reprlib
+
+    return reprlib.repr(v)
+
+
+def _check_layers(layers: object, where: str) -> list[int]:
+    """``layers`` as a list of ints, or a :class:`~lifelike_mj.errors.UserError`: from 10 or 11 inputs to 9 outputs, at
+    most :data:`MAX_LAYERS` layers of at most :data:`MAX_WIDTH` neurons (a long list is refused by its length alone)."""
+    from lifelike_mj import checks
+    from lifelike_mj.errors import UserError
+
+    try:
+        given = list(layers)  # type: ignore[call-overload]
+    except TypeError:
+        given = None
+    ok = (given is not None and 2 <= len(given) <= MAX_LAYERS and all(checks.is_whole(v) for v in given)
+          and given[0] in INPUT_COUNTS and given[-1] == N_ACT and all(1 <= v <= MAX_WIDTH for v in given))
+    if not ok:
+        raise UserError(f"{where}: layers must be whole numbers running from {INPUT_COUNTS[0]} or {INPUT_COUNTS[1]} "
+                        f"inputs to {N_ACT} outputs, "
+                        f"at most {MAX_LAYERS} layers of at most {MAX_WIDTH} neurons, got {_short(layers)}.")
+    return [int(v) for v in given]
+
+
+def _check_count(where: str, layers: list[int], got: int, within: bool = True, mode: str = "") -> None:
+    """A :class:`~lifelike_mj.errors.UserError` unless a network of ``layers`` (the flight network, or the behaviour
+    ``mode``'s, which has its shape) has ``got`` weights, all ``within`` :data:`MAX_WEIGHT`."""
+    from lifelike_mj.errors import UserError
+
+    n = n_weights(layers)
+    if got == n and within:
+        return
+    tail = f"got {got}" if got != n else f"got {got} with one beyond"
+    if mode:
+        raise UserError(f"{where}: the {mode} behaviour needs {n} finite weights (its network is the flight network's "
+                        f"shape, layers {layers}), each within +-{MAX_WEIGHT:g}, {tail}.")
+    raise UserError(f"{where}: layers {layers} need {n} finite weights, each within +-{MAX_WEIGHT:g}, {tail}.")
 
 
 def json_schema() -> dict:
@@ -341,15 +387,45 @@ def json_schema() -> dict:
                            "kinematics, with the base command and the actions' scales.")
 
 
+def _check_shapes(d: dict, schema: dict, where: str) -> dict:
+    """Before a controller's numbers are checked one by one (:func:`controller_from_dict`): the lengths of its lists
+    (:func:`~lifelike_mj.schema.too_long`: a list too long is refused by its length alone), then its ``layers``.
+    Returns the document with each network's weights cut to one more than the layers need, whose numbers are then
+    checked before their count (:func:`_check_count`): a bad number is named as before, and the work never grows
+    beyond the network's shape."""
+    from lifelike_mj.schema import too_long, validate
+
+    too_long(d, schema, where)
+    if "layers" not in d:
+        return d  # the full check names what is missing
+    validate({"layers": d["layers"]}, {"type": "object", "properties": {"layers": schema["properties"]["layers"]}},
+             where)
+    n = n_weights(_check_layers(d["layers"], where)) + 1
+    cut = dict(d)
+    if isinstance(d.get("weights"), list):
+        cut["weights"] = d["weights"][:n]
+    if isinstance(d.get("modes"), dict):
+        cut["modes"] = {m: ({**spec, "weights": spec["weights"][:n]} if isinstance(spec, dict)
+                            and isinstance(spec.get("weights"), list) else spec) for m, spec in d["modes"].items()}
+    return cut
+
+
 def controller_from_dict(data: object, name: str = "") -> Controller3D:
     """A :class:`Controller3D` from plain data (a parsed controller file); one sentence for anything wrong
-    (checked against :func:`json_schema` before any value is used)."""
+    (checked against :func:`json_schema` before any value is used: first the lengths of its lists, then its layers,
+    then the numbers of as many weights as the layers need and one more, then their count: the work never grows
+    beyond the network's shape)."""
     from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
     from lifelike_mj.schema import check_header, validate
 
     where = f"3D controller {name}" if name else "3D controller"
     d = check_header(data, FORMAT, f"file {name}" if name else "the data", kind="3D controller file")
-    validate(d, json_schema(), where)
+    schema = json_schema()
+    validate(_check_shapes(d, schema, where), schema, where)
+    layers = _check_layers(d["layers"], where)
+    _check_count(where, layers, len(d["weights"]))
+    for mode, spec in d.get("modes", {}).items():
+        _check_count(where, layers, len(spec["weights"]), mode=mode)
     base = d.get("base")
     if base is not None:
         base = KinematicsCommand(**{k: float(v) for k, v in base.items()})
@@ -375,9 +451,11 @@ def withdrawn_file(name: str):
     """The kept file (a :class:`~pathlib.Path`) of the withdrawn controller ``name`` (``steer`` or ``wind``), in a
     checkout of the repository (:data:`WITHDRAWN_DIR`; a wheel does not carry them): for benchmarks and tests that
     reproduce their numbers."""
-    from lifelike_mj.errors import UserError
+    from lifelike_mj.errors import UserError, unknown_name
     from lifelike_mj.paths import controllers_dir
 
+    if name not in WITHDRAWN:
+        raise unknown_name("no withdrawn 3D controller", name, tuple(WITHDRAWN))
     path = controllers_dir().parent / WITHDRAWN_DIR / f"{name}.json"
     if not path.is_file():
         raise UserError(f"no withdrawn 3D controller file {name!r} here ({WITHDRAWN_DIR} is in a checkout of the "
@@ -387,16 +465,18 @@ def withdrawn_file(name: str):
 
 def load_controller(name_or_path) -> Controller3D:
     """A shipped 3D controller by name (``controllers/butterfly3d/``) or any 3D controller file by path. A withdrawn
-    controller's name (:data:`WITHDRAWN`) gets a :class:`~lifelike_mj.errors.UserError` that says why."""
+    controller's name (:data:`WITHDRAWN`) gets a :class:`~lifelike_mj.errors.UserError` that says why; a file larger
+    than :data:`MAX_FILE_BYTES` is refused by its size before it is read, and its lists by their lengths before their
+    numbers (:func:`controller_from_dict`)."""
     from pathlib import Path
 
     from lifelike_mj.errors import UserError
-    from lifelike_mj.paths import load_named_json
+    from lifelike_mj.paths import read_json, resolve
 
     text = str(name_or_path)
     if text in WITHDRAWN and not Path(text).exists():
         kept = (f"its file is kept in the repository, {WITHDRAWN_DIR}/{text}.json (load it by path)"
                 if text != "cruise" else "its file is in the repository's history")
         raise UserError(f"the 3D controller {text!r} was withdrawn: {WITHDRAWN[text]}; use 'monarch', or {kept}.")
-    data, path = load_named_json("butterfly3d", name_or_path, "3D controller")
-    return controller_from_dict(data, path.stem)
+    path = resolve("butterfly3d", name_or_path, "3D controller")
+    return controller_from_dict(read_json(path, "3D controller", max_bytes=MAX_FILE_BYTES), path.stem)

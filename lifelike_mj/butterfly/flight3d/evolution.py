@@ -23,7 +23,7 @@ import numpy as np
 
 from lifelike_mj import checks
 from lifelike_mj.butterfly.flight3d import controllers as c3
-from lifelike_mj.butterfly.flight3d.flight import DT_S
+from lifelike_mj.butterfly.flight3d.flight import DT_S, MIN_STEPS_PER_BEAT
 from lifelike_mj.butterfly.flight3d.loop import TUMBLE_RAD, Batch
 from lifelike_mj.butterfly.flight3d.tasks import (
     DRYDEN_VERTICAL_RATIO,
@@ -123,6 +123,76 @@ def unnatural(st: dict, task: Task3D) -> float:
     return sum(terms, 0.0)
 
 
+def check_time_step(dt_s: object, frequency_hz: float, what: str = "time step") -> float:
+    """``dt_s`` (s) as a float, or a :class:`~lifelike_mj.errors.UserError` unless it is positive and resolves a wing beat
+    of ``frequency_hz`` in at least :data:`~lifelike_mj.butterfly.flight3d.flight.MIN_STEPS_PER_BEAT` steps: the rule
+    (and the sentence) of :class:`~lifelike_mj.butterfly.flight3d.flight.Flight3D`, for a command or an evolution to
+    check before any flight begins. ``what`` names the time step (``"--dt"``)."""
+    dt = checks.positive(f"{what} dt_s" if what == "time step" else what, dt_s, "s")
+    period = 1.0 / float(frequency_hz)
+    if dt > period / MIN_STEPS_PER_BEAT:
+        raise UserError(f"{what} {dt:g} s does not resolve the {period:g} s wing beat: it must be at most "
+                        f"1/{MIN_STEPS_PER_BEAT} of it ({period / MIN_STEPS_PER_BEAT:g} s).")
+    return dt
+
+
+def _short(v: object) -> str:
+    """``repr(v)`` shortened for a sentence."""
+    import reprlib
+
+    return reprlib.repr(v)
+
+
+def check_tasks(tasks: object) -> tuple[Task3D, ...]:
+    """``tasks`` as a tuple of at least one :class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`, or a
+    :class:`~lifelike_mj.errors.UserError` (a task set is given by its tasks: ``TASK_SETS["steer"]()``)."""
+    name = tasks if isinstance(tasks, str) and tasks in TASK_SETS else "steer"
+    given = None
+    if not isinstance(tasks, (str, bytes, dict)):
+        try:
+            given = tuple(tasks)  # type: ignore[arg-type]
+        except TypeError:
+            pass
+    if given is None or not all(isinstance(t, Task3D) for t in given):
+        raise UserError(f"tasks are Task3D objects (flight3d.level, turn, course, land; a task set's are "
+                        f"TASK_SETS[{name!r}]()), got {_short(tasks)}.")
+    if not given:
+        raise UserError("an evolution needs at least one task.")
+    return given
+
+
+def exercising_sets(mode: str) -> list[str]:
+    """The names of the :data:`TASK_SETS` whose flights fly the behaviour ``mode`` (without ``take_off``)."""
+    return [name for name, make in TASK_SETS.items() if exercised(mode, make(), False)]
+
+
+def exercised(mode: str, tasks, take_off: bool) -> bool:
+    """Whether a training flight on ``tasks`` (with ``take_off``: each starting perched and taking off) can fly the
+    behaviour network ``mode`` (:data:`~lifelike_mj.butterfly.flight3d.controllers.MODES`; ``""``, the flight network,
+    always): ``land`` flies only near a landing task's flower, ``take_off`` only after a take-off."""
+    if mode == "land":
+        return any(t.kind == "land" for t in tasks)
+    if mode == "take_off":
+        return bool(take_off)
+    return True
+
+
+def check_exercised(mode: str, tasks, take_off: bool, task_set: str = "") -> None:
+    """Before an evolution of the behaviour ``mode``: a :class:`~lifelike_mj.errors.UserError` unless its flights
+    (the task set ``task_set``, or ``tasks`` as given) fly that behaviour's network (:func:`exercised`): one that never
+    flies would score every candidate alike and come out changed and untested."""
+    if exercised(mode, tasks, take_off):
+        return
+    named = task_set and task_set != "custom"
+    if mode == "take_off":
+        raise UserError(f"the take_off behaviour (--mode take_off) flies only after a take-off, and no flight of "
+                        f"{f'the task set {task_set!r}' if named else 'the tasks given'} takes off: add take_off=True "
+                        "(--take-off), with which every task set exercises it.")
+    raise UserError(f"the {mode} behaviour (--mode {mode}) flies only on landing tasks, and "
+                    f"{f'the task set {task_set!r} has' if named else 'the tasks given have'} none: evolve it on a task "
+                    f"set with landings ({', '.join(exercising_sets(mode))}).")
+
+
 def start_blossom(animal: str) -> tuple[float, float, float]:
     """The centre of the flower a :class:`FlightProblem3D` with ``take_off`` starts on (m): right under the start, its
     butterfly's thorax at the origin standing on it."""
@@ -182,20 +252,41 @@ class FlightProblem3D:
     mode: str = ""
 
     def __post_init__(self) -> None:
-        if not self.tasks:
-            raise UserError("an evolution needs at least one task.")
+        from lifelike_mj.butterfly.flight3d.model import _check_panels
+
+        self.tasks = check_tasks(self.tasks)
+        if not isinstance(self.template, c3.Controller3D):
+            raise UserError(f"the template is a 3D controller (Controller3D, load_controller), got "
+                            f"{_short(self.template)}.")
+        if not isinstance(self.params, ButterflyParams):
+            raise UserError(f"params is a ButterflyParams, got {_short(self.params)}.")
+        if self.force_law not in c3.FORCE_LAWS_FLOWN:
+            raise UserError(f"force_law is {', '.join(repr(v) for v in c3.FORCE_LAWS_FLOWN)}, got {_short(self.force_law)}.")
+        _check_panels(self.n_strips, self.n_chord)
+        self.natural = checks.flag("natural", self.natural)
+        self.take_off = checks.flag("take_off", self.take_off)
+        if not isinstance(self.mode, str) or (self.mode and self.mode not in c3.MODES):
+            raise UserError(f"mode is '' (the flight network) or one of {', '.join(c3.MODES)}, got {_short(self.mode)}.")
         if self.mode and self.mode not in self.template.modes:
             raise UserError(f"the {self.mode} behaviour to evolve is not in the controller (give it with_mode first).")
+        check_exercised(self.mode, self.tasks, self.take_off)
         checks.number("duration_s", self.duration_s, 0.0, 3600.0, lo_open=True, unit="s")
         checks.number("dt_s", self.dt_s, 0.0, 0.01, lo_open=True, unit="s")
+        check_time_step(self.dt_s, self.template.base.frequency_hz, "dt_s")
         checks.number("gene_bound", self.gene_bound, 0.0, 1e6, lo_open=True)
         checks.work(f"a training flight of {self.duration_s:g} s at {self.dt_s:g} s", checks.steps_of(self.duration_s,
                     self.dt_s), checks.MAX_BODY_STEPS, "time steps")
-        if not self.prior:
+        if self.prior is None or (hasattr(self.prior, "__len__") and len(self.prior) == 0):
             self.prior = tuple(float(v) for v in (self.template.mode_weights(self.mode) if self.mode
                                                   else self.template.weights))
-        if len(self.prior) != self.dim:
-            raise UserError(f"the prior has {len(self.prior)} weights, the network {self.dim}.")
+        try:
+            prior = np.asarray(self.prior, dtype=np.float64)
+        except (TypeError, ValueError):
+            prior = np.full(1, np.nan)
+        if prior.ndim != 1 or len(prior) != self.dim or not np.all(np.abs(prior) <= c3.MAX_WEIGHT):
+            raise UserError(f"the prior must be the network's {self.dim} weights, each a finite number within "
+                            f"+-{c3.MAX_WEIGHT:g}, got {_short(self.prior)}.")
+        self.prior = tuple(float(v) for v in prior)
         self._model = None
 
     def __getstate__(self) -> dict:
@@ -385,6 +476,42 @@ def _landings(points=_GARDEN_LANDING_POINTS) -> tuple[Task3D, ...]:
     return tuple(land(p, h) for p in points)
 
 
+class _Spread:
+    """An evaluator that passes each batch of candidates on to ``evaluator`` unchanged and keeps the lowest and the
+    highest score it returned (NaN counted as the worst, as the optimisers count it), for :func:`evolve` to tell a run
+    whose candidates all scored the same (:meth:`all_same`)."""
+
+    def __init__(self, evaluator) -> None:
+        self.evaluator = evaluator
+        self.problem = getattr(evaluator, "problem", None)
+        self.n, self.lo, self.hi = 0, np.inf, -np.inf
+
+    def __call__(self, X: np.ndarray) -> np.ndarray:
+        f = self.evaluator(X)
+        g = np.asarray(f, dtype=np.float64).reshape(-1)
+        if len(g):
+            g = np.where(np.isnan(g), -np.inf, g)
+            self.n += len(g)
+            self.lo, self.hi = min(self.lo, float(g.min())), max(self.hi, float(g.max()))
+        return f
+
+    def all_same(self, history: list[dict]) -> float | None:
+        """The score every candidate of the run got, if they all got the same one; else ``None``. The candidates this
+        evaluator saw must all have scored alike, and every generation's record (those of a resumed run's earlier
+        sessions too) must say the same: its best so far that score, its mean that score to the rounding of a mean."""
+        import math
+
+        if self.n and self.lo != self.hi:
+            return None
+        if not self.n and not history:
+            return None
+        v = self.hi if self.n else float(history[0]["best"])
+        for h in history:
+            if h["best"] != v or not math.isclose(h["mean"], v, rel_tol=1e-12, abs_tol=0.0):
+                return None
+        return v
+
+
 def pd_prior(layers, animal: str = "swallowtail") -> np.ndarray:
     """The hand-made starting point of a linear controller. The swallowtail: the feathering follows the body's
     pitch (1 rad of feathering, leading edge down, per rad nose up), which alone keeps the body upright for
@@ -442,21 +569,44 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     ``speed_input``: the networks also see the forward speed asked (the eleventh observation of
     :mod:`~lifelike_mj.butterfly.flight3d.controllers`): a new controller's ``layers`` then start at 11, a start's
     networks gain the input with zero weights (:meth:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D.
-    with_speed_input`)."""
+    with_speed_input`).
+
+    Refused before any work, each with one sentence (:class:`~lifelike_mj.errors.UserError`): a flag (``natural``,
+    ``take_off``, ``speed_input``, ``resume``, ``progress``, ``overwrite``) that is not ``True`` or ``False`` (a string
+    such as ``"no"`` would switch it on), ``tasks`` that are not :class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`
+    objects, and a ``mode`` whose network the tasks never fly (:func:`check_exercised`: ``land`` needs landing tasks,
+    ``take_off`` needs ``take_off=True``). A run whose candidates all scored the same (changing the network evolved
+    changed no score) ends in a :class:`~lifelike_mj.errors.UserError` saying so, not in a result: no controller is
+    written, and the checkpoint it started is removed (a resumed one is kept)."""
     from lifelike_mj import provenance as _prov
     from lifelike_mj.evolve import make_evaluator, optimize
     from lifelike_mj.evolve.checkpoint import guarded_run_files
     from lifelike_mj.io import write_json
     from lifelike_mj.machine import machine_info
 
+    # natural and take_off are FlightProblem3D's, checked there
+    speed_input, resume, progress, overwrite = (checks.flag("speed_input", speed_input), checks.flag("resume", resume),
+                                                checks.flag("progress", progress), checks.flag("overwrite", overwrite))
+    if not isinstance(task_set, str):
+        raise UserError(f"task_set is the name the provenance gives the tasks (a text), got {_short(task_set)}.")
+    if on_generation is not None and not callable(on_generation):
+        raise UserError(f"on_generation is a function of each generation's record, got {_short(on_generation)}.")
+    for key, path in (("out", out), ("checkpoint", checkpoint)):
+        if not (isinstance(path, (str, Path)) or (key == "checkpoint" and path is None)):
+            raise UserError(f"{key} is the path of a file (a text or a Path), got {_short(path)}.")
+    if start is not None and not isinstance(start, c3.Controller3D):
+        raise UserError(f"start is a 3D controller (load_controller('monarch')), got {_short(start)}.")
     if tasks is None:
         task_set = "steer"
         tasks = TASK_SETS["steer"]()
+    tasks = check_tasks(tasks)
     if mode is not None and mode not in c3.MODES:
         raise UserError(f"the behaviour to evolve is {' or '.join(c3.MODES)}, got {mode!r}.")
     if mode is not None and start is None:
         raise UserError(f"evolving the {mode} behaviour needs a controller to start from, whose flight network flies "
                         "the rest.")
+    if mode is not None:
+        check_exercised(mode, tasks, take_off, task_set)
     if start is not None:
         template = start.with_speed_input() if speed_input else start
         layers = [int(v) for v in template.layers]
@@ -466,24 +616,33 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
         if mode is not None:
             template = template.with_mode(mode, template.mode_weights(mode), reach)
     else:
-        layers = [int(v) for v in layers]
+        layers = c3._check_layers(layers, "3D controller")
         if speed_input and layers:
             layers[0] = c3.N_OBS
         animal = animal or "swallowtail"
         template = c3.Controller3D(layers, pd_prior(layers, animal) if len(layers) >= 2 and layers[0] in c3.INPUT_COUNTS
                                    else [], c3.default_base(animal), inputs=inputs or "ground", animal=animal,
                                    force_law=force_law or "exact")
-    problem = FlightProblem3D(tuple(tasks), template, duration_s=duration_s, gene_bound=gene_bound, dt_s=dt_s,
-                              natural=bool(natural), force_law=template.force_law, take_off=bool(take_off),
-                              mode=mode or "")
+    problem = FlightProblem3D(tasks, template, duration_s=duration_s, gene_bound=gene_bound, dt_s=dt_s,
+                              natural=natural, force_law=template.force_law, take_off=take_off, mode=mode or "")
     out = Path(out)
     with guarded_run_files(out, checkpoint, resume=resume, overwrite=overwrite) as ckpt:
+        started_here = not (resume and ckpt.exists())
         with make_evaluator(problem, executor=executor, workers=workers, ray_address=ray_address) as ev:
+            spread = _Spread(ev)
             res = optimize(problem, optimizer, seed=seed, population=population, generations=generations,
-                           evaluator=ev, checkpoint=ckpt, resume=resume, progress=progress, overwrite=overwrite,
+                           evaluator=spread, checkpoint=ckpt, resume=resume, progress=progress, overwrite=overwrite,
                            on_generation=on_generation)
         if not np.all(np.isfinite(res.best_x)):
             return res, None
+        same = spread.all_same(res.history)
+        if same is not None:
+            if started_here:
+                ckpt.unlink(missing_ok=True)
+            raise UserError(f"every one of the {res.evaluations:,} candidates of this evolution scored {same:.6g}: "
+                            f"changing its {mode or 'flight'} network changed no score (are its flights, "
+                            f"{duration_s:g} s each, long enough to fly it?), so "
+                            + ("nothing was written." if started_here else "no controller was written."))
         prov = _prov.provenance(task_set=task_set, optimizer=res.optimizer, seed=res.seed, population=res.population,
                                 generations=generations, duration_s=duration_s, gene_bound=gene_bound, layers=layers)
         prov.update({"source": "lifelike-mj butterfly evolve3d", "problem": problem.describe(),
