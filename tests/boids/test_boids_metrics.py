@@ -293,3 +293,31 @@ def test_measures_work_in_2d(rng):
     m = M.frame_measures(x, rng.normal(size=(200, 2)), np.repeat([0, 1], 100))
     assert m["segregation_index"] > 0.99 and m["n_groups"] == 2 and m["plane_split"] == 1.0
     assert m["elongation"] > 2.0
+
+
+@pytest.mark.parametrize("dims", [3, 2])
+def test_the_tree_finds_the_neighbours_the_all_pairs_path_finds(dims, monkeypatch, rng):
+    """Above DENSE_MAX agents the measures search a k-d tree; on the same positions (clumped, with twins at one point)
+    it finds the same k nearest neighbours, distances and pairs within a radius as the all-pairs path, in the same
+    order; and without ties, every measure of a frame agrees to rounding."""
+    x = np.concatenate([rng.uniform(0, 20, size=(3000, dims)), rng.normal(10, 0.3, size=(2000, dims))])
+    x[4000:4003] = x[4003]  # four agents at one point
+    v, types = rng.normal(size=x.shape), rng.integers(0, 2, len(x))
+    monkeypatch.setattr(M, "DENSE_MAX", 100)
+    i_tree, d_tree = M.knn(x, 7)
+    p_tree = M.pairs_within(x, 1.0)
+    monkeypatch.setattr(M, "DENSE_MAX", 10**9)
+    i_all, d_all = M.knn(x, 7)
+    p_all = M.pairs_within(x, 1.0)
+    np.testing.assert_allclose(np.sort(d_tree, axis=1), np.sort(d_all, axis=1), atol=1e-9)
+    far = np.sort(d_all, axis=1)
+    unique = far[:, -1] < np.partition(np.sqrt(((x[:, None] - x[None]) ** 2).sum(-1))[:, :], 8, axis=1)[:, 8] - 1e-9
+    assert np.array_equal(np.sort(i_tree, axis=1)[unique], np.sort(i_all, axis=1)[unique])  # no tie at the k-th
+    assert len(p_tree[0]) > 1000 and all(np.array_equal(a, b) for a, b in zip(p_tree, p_all))
+    x[4000:4003] += 1e-6 * rng.normal(size=(3, dims))  # no ties among neighbours: either would be a k-th one
+    m_tree = M.frame_measures(x, v, types)
+    monkeypatch.setattr(M, "DENSE_MAX", 100)
+    m_all, m_tree = m_tree, M.frame_measures(x, v, types)
+    assert m_tree.keys() == m_all.keys()
+    for k in m_all:
+        assert m_tree[k] == pytest.approx(m_all[k], rel=1e-9, abs=1e-12, nan_ok=True), k
