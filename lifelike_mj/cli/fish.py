@@ -13,7 +13,8 @@ NAME = "fish"
 #: Bounds of the command line: fish in a tank, simulated seconds, the smallest tank (2.5 body lengths a side).
 MAX_DURATION_S = 3600.0
 MIN_TANK_SCALE = 0.35
-#: The longest side ``--tank`` takes (m): twice the longest of ``--tank-scale``'s largest tank.
+#: The longest side ``--tank`` takes (m): twice the longest of ``--tank-scale``'s largest tank (the Python API takes the
+#: same, ``fish.scene.MAX_TANK_SIDE_M``; tests/fish/test_fish_trust.py holds them equal).
 MAX_TANK_SIDE_M = 100.0
 SWIM_FILES = ("tracks.npz", "tracks.csv", "tracks.png", "accel_histogram.png", "measures.json")
 HELP = "the tropical fish of Satoi et al. 2015"
@@ -36,20 +37,19 @@ def _preset(args):
 
 def _tank_type(text: str) -> tuple[float, float, float]:
     """An argparse ``type``: a tank's ``length,depth,height`` in m, each side at least 2.5 body lengths and at most
-    :data:`MAX_TANK_SIDE_M`."""
-    from lifelike_mj.fish.scene import check_tank
+    :data:`MAX_TANK_SIDE_M` (:func:`lifelike_mj.fish.scene.tank_problem`, as the Python API checks it)."""
+    from lifelike_mj.fish.scene import MIN_TANK_SIDE_M, tank_problem
 
     try:
         vals = tuple(float(v) for v in text.split(","))
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected three lengths in m, as 3,3,1, got {text!r}") from None
-    try:
-        vals = check_tank(vals)
-    except UserError as e:
-        raise argparse.ArgumentTypeError(str(e).rstrip(".")) from None
-    if max(vals) > MAX_TANK_SIDE_M:
-        raise argparse.ArgumentTypeError(f"every side of the tank must be at most {MAX_TANK_SIDE_M:g} m, got {text!r}")
-    return vals
+        raise argparse.ArgumentTypeError(
+            f"expected three lengths L,D,H in m (length, depth, height: numbers, as 3,3,1), each "
+            f"{MIN_TANK_SIDE_M:.3f} m (2.5 body lengths) to {MAX_TANK_SIDE_M:g} m, got {text!r}") from None
+    sides, problem = tank_problem(vals, given=text)
+    if sides is None:
+        raise argparse.ArgumentTypeError(problem)
+    return sides
 
 
 _tank_type.__name__ = "tank size"
@@ -65,13 +65,33 @@ def _tank(args):
     return tank_size(positive("--tank-scale", args.tank_scale))
 
 
+class _Count(int):
+    """A number given on the command line, with the spelling of the option that gave it (``flag``)."""
+
+    flag = ""
+
+
+class _OneSpelling(argparse.Action):
+    """Stores a number given under one of two spellings (``--n`` or ``--fish``); both at once are refused (else the
+    last would win unseen). The same spelling twice keeps argparse's rule: the last wins."""
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        before = getattr(namespace, self.dest, None)
+        if isinstance(before, _Count) and before.flag != option_string:
+            raise argparse.ArgumentError(self, f"give the number of fish once, as {before.flag} or {option_string}, "
+                                               f"not both (got {before.flag} {int(before)} and {option_string} {values})")
+        v = _Count(values)
+        v.flag = option_string or ""
+        setattr(namespace, self.dest, v)
+
+
 def _add_fish(p) -> None:
     p.add_argument("--preset", default="default",
                    help="fish motion preset: the paper's NB-ND, NB-D, B-ND, B-D; school, shoal or pair (fish that heed each "
                         "other); or a JSON file (default: B-D, also called 'default')")
     from lifelike_mj.fish.params import MAX_FISH
 
-    p.add_argument("--n", "--fish", dest="fish", type=count(1, MAX_FISH), default=10,
+    p.add_argument("--n", "--fish", dest="fish", type=count(1, MAX_FISH), default=10, action=_OneSpelling,
                    help=f"number of fish, 1 to {MAX_FISH:,} (--n as for boids; --fish is the older spelling)")
     add_seed(p)
     p.add_argument("--tank-scale", type=num(MIN_TANK_SCALE, 10.0), default=1.0,
@@ -216,7 +236,7 @@ def export_window(args):
 
     params = _preset(args)
     check_window(args.start, args.duration, args.fps, params.control_dt_s, bodies=args.fish * params.substeps,
-                 body_unit="fish-steps (substeps included)")
+                 body_unit="fish-steps (substeps included)", drawn=args.fish)
     tank = Tank(params, args.fish, args.seed, _tank(args))
     return Window(tank, args.start, args.duration, args.fps), parameters_of(args)
 

@@ -77,15 +77,23 @@ def _angles(direction_body: np.ndarray) -> tuple[float, float]:
 class Aquarium:
     """A :class:`~lifelike_mj.fish.sim.Tank` with taps and food (module docstring), in the stepper shape.
 
-    ``tank``: the tank (made with no policies of its own). ``tap(point_m)`` and ``drop_food(x_m, y_m)`` act now;
+    ``tank``: the tank (a :class:`~lifelike_mj.fish.sim.Tank` made with no policies of its own); ``cascade`` and
+    ``compete`` (True or False, nothing else): the rules of the module docstring. ``tap(point_m)`` and
+    ``drop_food(x_m, y_m)`` act now;
     ``pellets_m`` holds the pellets still in the water; ``startled`` says which fish are startled."""
 
+    @checks.known_keywords
     def __init__(self, tank: Tank, cascade: bool = False, compete: bool = False) -> None:
+        if not isinstance(tank, Tank):
+            what = repr(tank) if len(repr(tank)) <= 60 else f"a {type(tank).__name__}"
+            raise UserError(f"tank must be a fish Tank (lifelike_mj.fish.Tank(params, n_fish, seed, size)), got {what}.")
+        cascade = checks.flag("cascade", cascade)
+        compete = checks.flag("compete", compete)
         if tank.mu_policy is not None or tank.push_policy is not None:
             raise UserError("the aquarium needs a tank without policies of its own.")
         self.tank = tank
-        self.cascade = bool(cascade)
-        self.compete = bool(compete)
+        self.cascade = cascade
+        self.compete = compete
         #: When each fish's last escape began (s; -inf: none), and the escapes each fish has judged.
         self.startled_at = np.full(tank.n_fish, -np.inf)
         self._judged = np.zeros((tank.n_fish, tank.n_fish), dtype=bool)

@@ -8,7 +8,8 @@ Distances between fish are three-dimensional.
 
 * **Velocity** (:func:`velocities`): central differences of the positions (one-sided at the ends).
 * **Nearest-neighbour distance** (:func:`nearest_neighbour_m`): per fish and sample, the distance to the closest
-  other fish's centre.
+  other fish's centre, found with a k-d tree (:class:`scipy.spatial.cKDTree`) sample by sample for many fish, so
+  that the memory grows with the number of fish, not with its square times the samples.
 * **Polarisation** ``O_P = |mean_i h_i|`` (:func:`polarisation`), ``h_i`` the unit horizontal heading: 1 when all
   swim the same way, about ``sqrt(pi / (4 N))`` for ``N`` fish heading independently (0.28 for ten).
 * **Milling** ``O_R = |mean_i (r_i x h_i)_z|`` (:func:`milling`), ``r_i`` the unit horizontal vector from the
@@ -36,6 +37,12 @@ import numpy as np
 MIN_SPEED_BL_S = 0.05
 #: A kick is a speed rise of at least this much (body lengths per second) from a local minimum.
 KICK_RISE_BL_S = 0.5
+#: Above this many fish, the neighbours of a fish are found with a k-d tree (:class:`scipy.spatial.cKDTree`) rather
+#: than among all pairs (faster for a few fish); both give the same numbers.
+TREE_MIN_FISH = 32
+#: The most memory (bytes) that one chunk of pairs of fish may take while a measure is computed: measures over pairs
+#: go through the frames (and, for many fish, the fish) in chunks of this size rather than all at once.
+PAIR_CHUNK_BYTES = 32 * 2**20
 
 
 def _positions(positions) -> np.ndarray:
@@ -69,14 +76,53 @@ def headings(vel, min_speed_m_s: float = 0.0) -> np.ndarray:
 
 
 def nearest_neighbour_m(positions) -> np.ndarray:
-    """Per sample and fish (T, F), the distance (m) to the nearest other fish's centre (NaN for a lone fish)."""
+    """Per sample and fish (T, F), the distance (m) to the nearest other fish's centre (NaN for a lone fish).
+
+    Frame by frame (memory grows with ``F``, not ``F^2`` or ``T``): all pairs of a chunk of frames for
+    :data:`TREE_MIN_FISH` fish or fewer, a k-d tree (:class:`scipy.spatial.cKDTree`) above; either way the distance
+    returned is ``|p_i - p_j|`` computed as the all-pairs distance was, so both give the same numbers. A frame with a
+    position that is not finite is measured over all pairs (a NaN makes its frame NaN, as there)."""
     p = _positions(positions)
     T, F, _ = p.shape
     if F < 2:
         return np.full((T, F), np.nan)
-    d = np.linalg.norm(p[:, :, None, :] - p[:, None, :, :], axis=-1)
-    d[:, np.arange(F), np.arange(F)] = np.inf
-    return d.min(axis=2)
+    out = np.empty((T, F))
+    if F <= TREE_MIN_FISH:
+        step = max(1, PAIR_CHUNK_BYTES // (24 * F * F))
+        for a in range(0, T, step):
+            d = np.linalg.norm(p[a : a + step, :, None, :] - p[a : a + step, None, :, :], axis=-1)
+            d[:, np.arange(F), np.arange(F)] = np.inf
+            out[a : a + step] = d.min(axis=2)
+        return out
+    from scipy.spatial import cKDTree
+
+    me = np.arange(F)
+    for k in range(T):
+        q = p[k]
+        if not np.isfinite(q).all():
+            out[k] = _nearest_all_pairs(q)
+            continue
+        _, j = cKDTree(q).query(q, k=2)
+        other = np.where(j[:, 0] == me, j[:, 1], j[:, 0])  # two fish at one place: either is the other's nearest
+        out[k] = np.linalg.norm(q[other] - q, axis=-1)
+    return out
+
+
+def _row_blocks(F: int):
+    """Blocks of rows ``(start, stop)`` of an ``F x F`` table of 3-vectors within :data:`PAIR_CHUNK_BYTES`."""
+    step = max(1, PAIR_CHUNK_BYTES // (24 * F))
+    return ((a, min(a + step, F)) for a in range(0, F, step))
+
+
+def _nearest_all_pairs(q: np.ndarray) -> np.ndarray:
+    """:func:`nearest_neighbour_m` of one frame ``q`` (F, 3) over all pairs, a block of fish at a time."""
+    F = q.shape[0]
+    out = np.empty(F)
+    for a, b in _row_blocks(F):
+        d = np.linalg.norm(q[a:b, None, :] - q[None, :, :], axis=-1)
+        d[np.arange(b - a), np.arange(a, b)] = np.inf
+        out[a:b] = d.min(axis=1)
+    return out
 
 
 def polarisation(head) -> np.ndarray:
@@ -164,20 +210,46 @@ def wall_distance_m(positions, tank_m) -> np.ndarray:
 def neighbour_frame(positions, head) -> tuple[np.ndarray, np.ndarray]:
     """Where the other fish are as each fish sees them: ``(rel, dphi)`` with ``rel`` (M, 2), a neighbour's horizontal
     position in the focal fish's frame (m: ahead, to its left) and ``dphi`` (M,) its heading less the focal fish's
-    (rad, in ``(-pi, pi]``), for every sample and ordered pair whose two headings exist."""
+    (rad, in ``(-pi, pi]``), for every sample and ordered pair whose two headings exist (sample by sample, then pair
+    by pair: ``M`` is up to ``T F (F - 1)``, and the work goes through the frames in chunks of
+    :data:`PAIR_CHUNK_BYTES`)."""
     p = _positions(positions)[..., :2]
     h = np.asarray(head, dtype=float)
     T, F, _ = p.shape
     if F < 2:
         return np.zeros((0, 2)), np.zeros(0)
     i, j = np.nonzero(~np.eye(F, dtype=bool))
-    d = p[:, j] - p[:, i]  # (T, P, 2)
-    hi, hj = h[:, i], h[:, j]
-    ahead = d[..., 0] * hi[..., 0] + d[..., 1] * hi[..., 1]
-    left = -d[..., 0] * hi[..., 1] + d[..., 1] * hi[..., 0]
-    dphi = np.arctan2(hi[..., 0] * hj[..., 1] - hi[..., 1] * hj[..., 0], hi[..., 0] * hj[..., 0] + hi[..., 1] * hj[..., 1])
-    ok = np.isfinite(ahead) & np.isfinite(dphi)
-    return np.stack([ahead[ok], left[ok]], axis=-1), dphi[ok]
+    rels, dphis = [np.zeros((0, 2))], [np.zeros(0)]
+    for a, b in _frame_chunks(T, 128 * i.size):
+        d = p[a:b, j] - p[a:b, i]  # (frames, P, 2)
+        hi, hj = h[a:b, i], h[a:b, j]
+        ahead = d[..., 0] * hi[..., 0] + d[..., 1] * hi[..., 1]
+        left = -d[..., 0] * hi[..., 1] + d[..., 1] * hi[..., 0]
+        dphi = np.arctan2(hi[..., 0] * hj[..., 1] - hi[..., 1] * hj[..., 0],
+                          hi[..., 0] * hj[..., 0] + hi[..., 1] * hj[..., 1])
+        ok = np.isfinite(ahead) & np.isfinite(dphi)
+        rels.append(np.stack([ahead[ok], left[ok]], axis=-1))
+        dphis.append(dphi[ok])
+    return np.concatenate(rels), np.concatenate(dphis)
+
+
+def _frame_chunks(T: int, bytes_per_frame: int):
+    """Chunks of frames ``(start, stop)`` of ``T`` frames, each within :data:`PAIR_CHUNK_BYTES`."""
+    step = max(1, PAIR_CHUNK_BYTES // max(1, bytes_per_frame))
+    return ((a, min(a + step, T)) for a in range(0, T, step))
+
+
+def _pair_distances_m(positions: np.ndarray, head: np.ndarray) -> np.ndarray:
+    """The 3D distances (m) between the centres of every ordered pair of fish whose two headings exist, sample by
+    sample (as :func:`neighbour_frame` orders them), in chunks of frames."""
+    T, F, _ = positions.shape
+    i, j = np.nonzero(~np.eye(F, dtype=bool))
+    out = [np.zeros(0)]
+    for a, b in _frame_chunks(T, 64 * i.size):
+        d3 = np.linalg.norm(positions[a:b, j] - positions[a:b, i], axis=-1)  # (frames, P)
+        ok = np.isfinite(head[a:b, i, 0]) & np.isfinite(head[a:b, j, 0])
+        out.append(d3[ok])
+    return np.concatenate(out)
 
 
 def _stats(x: np.ndarray) -> dict:
@@ -319,10 +391,7 @@ def pair_quantities(times_s, positions, body_length_m: float, tank_m, *, skip_s:
     out["wall_angle_deg"] = out["wall_angle_deg"][np.isfinite(out["wall_angle_deg"])]
     if p.shape[1] >= 2:
         rel, dphi = neighbour_frame(p, head)
-        i, j = np.nonzero(~np.eye(p.shape[1], dtype=bool))
-        d3 = np.linalg.norm(p[:, j] - p[:, i], axis=-1)  # (T, P)
-        ok = np.isfinite(head[:, i, 0]) & np.isfinite(head[:, j, 0])
-        out["distance_bl"] = d3[ok] / bl
+        out["distance_bl"] = _pair_distances_m(p, head) / bl
         out["heading_difference_deg"] = np.degrees(np.abs(dphi))
         out["viewing_angle_deg"] = np.degrees(np.abs(np.arctan2(rel[:, 1], rel[:, 0])))
     seg = kick_segments(t, p, bl, kick_rise_bl_s=kick_rise_bl_s)
@@ -347,22 +416,47 @@ def pair_measures(times_s, positions, body_length_m: float, tank_m, **kwargs) ->
 def largest_group(positions, link_m: float) -> np.ndarray:
     """The fish of the largest group at one moment: ``positions`` (F, 3) m; two fish are in one group when a chain of
     fish, each within ``link_m`` of the next, joins them. Returns the group's fish indices, sorted (ties: the group
-    of the lowest index)."""
+    of the lowest index). The pairs within ``link_m`` come from a k-d tree above :data:`TREE_MIN_FISH` fish (memory
+    that grows with the pairs found, not with ``F^2``), their distances computed as over all pairs."""
     p = np.asarray(positions, dtype=float).reshape(-1, 3)
     F = p.shape[0]
-    near = np.linalg.norm(p[:, None] - p[None], axis=-1) <= link_m
-    label = np.full(F, -1)
-    for s in range(F):
-        if label[s] >= 0:
-            continue
-        label[s], stack = s, [s]
-        while stack:
-            i = stack.pop()
-            for j in np.flatnonzero(near[i] & (label < 0)):
-                label[j] = s
-                stack.append(j)
+    a, b = _pairs_within(p, link_m)
+    # each group labelled by its lowest index (what a search from each unlabelled fish in turn gives)
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    _, comp = connected_components(coo_matrix((np.ones(a.size, dtype=bool), (a, b)), shape=(F, F)), directed=False)
+    lowest = np.full(comp.max() + 1, F)
+    np.minimum.at(lowest, comp, np.arange(F))
+    label = lowest[comp]
     sizes = np.bincount(label, minlength=F)
     return np.flatnonzero(label == int(np.argmax(sizes)))
+
+
+def _pairs_within(p: np.ndarray, link_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs ``(a, b)`` of fish (``a < b``) whose centres ``p`` (F, 3) lie within ``link_m`` of each other, by
+    ``|p_a - p_b| <= link_m``: from a k-d tree (candidates a hair beyond ``link_m``, then that test) above
+    :data:`TREE_MIN_FISH` fish with finite positions, else over all pairs, a block of fish at a time."""
+    F = p.shape[0]
+    none = np.zeros(0, dtype=np.int64)
+    if not link_m >= 0.0:
+        return none, none
+    if F > TREE_MIN_FISH and np.isfinite(p).all():
+        from scipy.spatial import cKDTree
+
+        cand = cKDTree(p).query_pairs(float(link_m) * (1.0 + 1e-9), output_type="ndarray").astype(np.int64)
+        if not cand.size:
+            return none, none
+        keep = np.linalg.norm(p[cand[:, 1]] - p[cand[:, 0]], axis=-1) <= link_m
+        return cand[keep, 0], cand[keep, 1]
+    A, B = [none], [none]
+    for lo, hi in _row_blocks(F):
+        near = np.linalg.norm(p[lo:hi, None, :] - p[None, :, :], axis=-1) <= link_m
+        r, c = np.nonzero(near)
+        r = r + lo
+        A.append(r[r < c])
+        B.append(c[r < c])
+    return np.concatenate(A), np.concatenate(B)
 
 
 def front_of_group(positions, vel, link_m: float) -> tuple[int, np.ndarray]:

@@ -45,7 +45,7 @@ from numba import njit
 from lifelike_mj import checks
 from lifelike_mj.errors import Diverged, UserError
 from lifelike_mj.fish.params import ACCELERATE, BRAKE, CRUISE, MU_NAMES, FishParams
-from lifelike_mj.fish.scene import BODY_LENGTH_M, FishScene, box_areas, build_scene
+from lifelike_mj.fish.scene import BODY_LENGTH_M, FishScene, box_areas, build_scene, check_tank, tank_size
 from lifelike_mj.physics import mjabi
 from lifelike_mj.physics.callbacks import passive_callback
 from lifelike_mj.physics.fluid import normal_drag_scalar
@@ -543,8 +543,11 @@ class Tank(StepCounter):
     """A tank of fish (Satoi 2015), in the stepper shape every creature shares (:mod:`lifelike_mj.stepper`).
 
     ``params``: a preset (:class:`~lifelike_mj.fish.params.FishParams`; default ``B-D``); ``n_fish``
-    fish in a tank of ``size`` (L, D, H) m (default the filmed 5 x 0.5 x 1 m); ``seed`` fixes the
-    start and every random draw. One step is one control step (``params.control_hz``, 60 per second:
+    fish (1 to :data:`~lifelike_mj.fish.params.MAX_FISH`) in a tank of ``size`` (L, D, H) m (default the filmed
+    5 x 0.5 x 1 m; each side 2.5 body lengths to 100 m, as ``--tank`` takes), or in a ``scene`` built already
+    (:func:`~lifelike_mj.fish.scene.build_scene`; then no ``size``); ``seed`` (0 to 2^32 - 1) fixes the
+    start and every random draw. Each argument is checked before anything is built: a wrong one is a
+    :class:`~lifelike_mj.errors.UserError` naming it. One step is one control step (``params.control_hz``, 60 per second:
     look, choose the motion unit, push), then ``params.substeps`` MuJoCo steps. One tank per thread
     (it owns its ``MjData``).
 
@@ -564,10 +567,27 @@ class Tank(StepCounter):
     @checks.known_keywords
     def __init__(self, params: FishParams | None = None, n_fish: int = 10, seed: int = 0, size=None,
                  scene: FishScene | None = None, mu_policy=None, push_policy=None):
-        from lifelike_mj.fish.params import load_preset
+        from lifelike_mj.fish.params import MAX_FISH, load_preset
 
+        # every argument checked before the scene is built (seconds for thousands of fish), each in one sentence
+        if params is not None and not isinstance(params, FishParams):
+            raise UserError(f"params must be a fish preset (a FishParams, as fish.load_preset('B-D') gives) or None "
+                            f"for B-D, got {_kind(params)}.")
+        if not checks.is_whole(n_fish) or not 1 <= n_fish <= MAX_FISH:
+            raise UserError(f"the number of fish must be a whole number from 1 to {MAX_FISH:,} (n_fish), got "
+                            f"{_kind(n_fish)}.")
+        seed = _check_seed(seed)
+        if scene is not None and not isinstance(scene, FishScene):
+            raise UserError(f"scene must be a FishScene (fish.scene.build_scene) or None, got {_kind(scene)}.")
+        if scene is not None and size is not None:
+            raise UserError("give the tank either as scene or as size, not both.")
+        if scene is None:
+            size = check_tank(size if size is not None else tank_size(), "size")
+        for name, fn in (("mu_policy", mu_policy), ("push_policy", push_policy)):
+            if fn is not None and not callable(fn):
+                raise UserError(f"{name} must be a function of the tank, got {_kind(fn)}.")
         self.params = params if params is not None else load_preset("B-D")
-        self._seed = _check_seed(seed)
+        self._seed = seed
         self.scene = scene if scene is not None else build_scene(n_fish, size, nuserdata=U_FISH + FISH_BLOCK * n_fish)
         self.scene.model.opt.timestep = self.params.timestep_s
         if self.scene.model.nuserdata < U_FISH + FISH_BLOCK * self.scene.n:
@@ -580,9 +600,6 @@ class Tank(StepCounter):
             m.body_conaffinity[self.scene.body] |= 1  # the broad phase filters bodies by these (the OR of their geoms')
         self.vision_data = mujoco.MjData(self.scene.vision_model)
         mujoco.mj_kinematics(self.scene.vision_model, self.vision_data)
-        for name, fn in (("mu_policy", mu_policy), ("push_policy", push_policy)):
-            if fn is not None and not callable(fn):
-                raise UserError(f"{name} must be a function of the tank, got {fn!r}.")
         self.mu_policy, self.push_policy = mu_policy, push_policy
         self.reset()
 
@@ -768,6 +785,8 @@ class Tank(StepCounter):
 
         if (n_steps is None) == (duration_s is None):
             raise UserError("give either n_steps or duration_s.")
+        chunk_steps = checks.whole("chunk_steps", chunk_steps, 1)
+        progress = checks.flag("progress", progress)
         total = (checks.whole("the number of steps", n_steps, 1) if n_steps is not None
                  else checks.steps_of(checks.positive("duration", duration_s, "s"), self.params.control_dt_s))
         check_swim_work(self.params, self.n_fish, total)
@@ -848,7 +867,14 @@ class Tank(StepCounter):
 
 
 def _check_seed(seed) -> int:
-    return checks.whole("seed", seed, 0)
+    """A seed as the command line takes it (``--seed``): a whole number from 0 to 2^32 - 1."""
+    return checks.whole("seed", seed, 0, 2**32 - 1)
+
+
+def _kind(v: object) -> str:
+    """``v`` for an error sentence: its repr when short, else its type ("a FishParams")."""
+    text = repr(v)
+    return text if len(text) <= 60 else f"a {type(v).__name__}"
 
 
 def check_swim_work(params: FishParams, n_fish: int, steps: int, recorded: bool = True) -> None:
@@ -868,8 +894,9 @@ def swim(params: FishParams, n_fish: int = 10, duration_s: float = 30.0, seed: i
     """Simulate ``n_fish`` fish for ``duration_s`` seconds; the tracks at every control step
     (:meth:`Tank.record` of a new :class:`Tank`)."""
     checks.positive("duration", duration_s, "s")
+    checks.positive("chunk_s", chunk_s, "s")
     tank = Tank(params, n_fish, seed, size)
-    return tank.record(duration_s=duration_s, chunk_steps=max(1, int(round(chunk_s * params.control_hz))),
+    return tank.record(duration_s=duration_s, chunk_steps=max(1, int(round(chunk_s * tank.params.control_hz))),
                        progress=progress)
 
 
