@@ -13,16 +13,22 @@ code can be served. Folders unused for 30 days are removed.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import shutil
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 _PKG = Path(__file__).resolve().parent
 #: Cache folders not used for this many days are removed.
 KEEP_DAYS = 30
+#: The keyed folder :func:`configure` chose for this process (``None``: the user's own, or none).
+_FOLDER: Path | None = None
+#: The groups of compiled functions :func:`compile_notice` has seen compiled (or found compiled) in this process.
+_SEEN: set[str] = set()
 
 
 def source_key(root: Path = _PKG) -> str:
@@ -62,8 +68,47 @@ def configure() -> Path | None:
     except OSError:
         return None
     os.environ["NUMBA_CACHE_DIR"] = str(folder)
+    global _FOLDER
+    _FOLDER = folder
     _prune(root, folder)
     return folder
+
+
+def _marker(name: str) -> Path | None:
+    return None if _FOLDER is None else _FOLDER / f"compiled-{name}"
+
+
+def compiled(name: str) -> bool | None:
+    """Whether the group of compiled functions ``name`` (``"flight3d-fly"``) has been compiled into this source's
+    cache folder (:func:`compile_notice` marks it); ``None`` when that cannot be told (the user's own
+    ``NUMBA_CACHE_DIR``, whose entries numba keys on each file's time stamp alone, or no cache folder)."""
+    marker = _marker(name)
+    return None if marker is None else marker.is_file()
+
+
+@contextlib.contextmanager
+def compile_notice(name: str, what: str, seconds: float) -> Iterator[None]:
+    """Around the first call of a group of cached compiled functions: when this source's cache folder does not hold
+    them yet, one line on stderr before the call, ``compiling the 3D flight (first run only, about 40 s)`` (``what``,
+    ``seconds``: the measured compile), so that a first run is not silent while it compiles; when the block ends
+    without an error, a marker file in the folder records the group as compiled. Nothing is printed when the group
+    is compiled already, when it cannot be told (:func:`compiled` is ``None``), a second time in one process, or
+    with progress off (``--quiet``: :func:`lifelike_mj.progress.enabled`)."""
+    if name in _SEEN:
+        yield
+        return
+    state = compiled(name)
+    if state is False:
+        from lifelike_mj import progress
+
+        progress.line(f"compiling {what} (first run only, about {seconds:.0f} s)")
+    yield
+    _SEEN.add(name)
+    if state is False:
+        try:
+            _marker(name).touch()  # type: ignore[union-attr]
+        except OSError:
+            pass
 
 
 def _prune(root: Path, keep: Path) -> None:

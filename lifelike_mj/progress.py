@@ -32,6 +32,20 @@ def enabled() -> bool:
     return _ENABLED
 
 
+def line(text: str) -> None:
+    """One line on stderr, unless progress is off, that leaves a bar being drawn intact (through ``tqdm.write`` once
+    a bar has been made, which clears the bar, prints the line and draws the bar again below it)."""
+    if not _ENABLED:
+        return
+    if "tqdm" in sys.modules:
+        from tqdm import tqdm
+
+        tqdm.write(text, file=sys.stderr)
+        sys.stderr.flush()
+    else:
+        print(text, file=sys.stderr, flush=True)
+
+
 def done_line(what: str, seconds: float) -> None:
     """The closing line of a command on stderr, ``<what>: done in 12.3 s``, unless progress is off."""
     if _ENABLED:

@@ -20,7 +20,9 @@ named before the colon) ``gymnasium.make("lifelike_mj.envs:lifelike_mj/Butterfly
   trained through them (by an RL library) as controller files.
 
 Each environment's docstring is its documentation page (spaces with names and units, reward,
-starting state, episode end, arguments, version history).
+starting state, episode end, arguments, version history); :mod:`lifelike_mj.envs.pages` renders those pages,
+``docs/envs/*.md``, from the docstrings and the tables of names and units the environments use
+(``python -m lifelike_mj.envs.pages``).
 """
 
 from __future__ import annotations
@@ -55,7 +57,7 @@ def register_envs() -> None:
 __getattr__, __dir__, _names = attach(__name__, {
     "ButterflyPitchEnv": "butterfly", "ButterflyPitchWindEnv": "butterfly", "ButterflyPitchVectorEnv": "vector",
     "ButterflyFlight3DEnv": "butterfly3d", "ButterflyFlight3DVectorEnv": "butterfly3d",
-    "butterfly": ".", "vector": ".", "policies": ".", "butterfly3d": ".",
+    "butterfly": ".", "vector": ".", "policies": ".", "butterfly3d": ".", "pages": ".",
 }, globals())
 __all__ = ["ENVS", "register_envs", *_names]
 

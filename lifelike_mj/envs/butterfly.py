@@ -11,11 +11,24 @@ from gymnasium import spaces
 
 from lifelike_mj import checks
 from lifelike_mj.butterfly import PAPER_FLAP, ButterflyController, ButterflyParams, Condition, Flight
+from lifelike_mj.envs.pages import Entry, documented, names
 from lifelike_mj.errors import Diverged, UserError
 
-#: Names and units of the observation's six entries (the network's inputs, Oe 2010 section 6.1).
-#: The six inputs, named as a pitch law's observation names them (:class:`~lifelike_mj.butterfly.flight.PitchObservation`).
-OBSERVATION_NAMES = ("phi_rad", "omega_rad_s", "theta_rad", "climb_m_s", "altitude_m", "forward_m_s")
+#: The observation's six entries (the network's inputs, Oe 2010 section 6.1), in order, named as a pitch law's
+#: observation (:class:`~lifelike_mj.butterfly.flight.PitchObservation`) names them, with their units and meanings.
+OBSERVATIONS = (
+    Entry("phi_rad", "rad", "the pitch of the previous step"),
+    Entry("omega_rad_s", "rad/s", "flap rate (positive on the upstroke)"),
+    Entry("theta_rad", "rad", "flap angle"),
+    Entry("climb_m_s", "m/s", "vertical velocity, relative to the air or the ground (`inputs`)"),
+    Entry("altitude_m", "m", "altitude above the target altitude 0 m"),
+    Entry("forward_m_s", "m/s", "forward velocity, relative to the air or the ground (`inputs`)"),
+)
+#: The observation's names, in order (``info["observation_names"]``).
+OBSERVATION_NAMES = names(OBSERVATIONS)
+#: The action's one entry in each ``action_mode``.
+ACTIONS = {"dphi": (Entry("dphi_rad", "rad", "the pitch's change this step, at most `max_dphi_deg` (3 deg)"),),
+           "phi": (Entry("phi_rad", "rad", "the pitch itself"),)}
 #: Their names before 0.3 (kept one release: :func:`observation_index` takes them, with a one-line note).
 OLD_OBSERVATION_NAMES = {"phi_prev_rad": "phi_rad", "v_y_m_s": "climb_m_s", "y_m": "altitude_m",
                          "v_z_m_s": "forward_m_s"}
@@ -28,10 +41,10 @@ def observation_index(name: str) -> int:
         checks.renamed(f"the observation {name!r}", repr(OLD_OBSERVATION_NAMES[name]), "the pitch law's name")
         name = OLD_OBSERVATION_NAMES[name]
     if name not in OBSERVATION_NAMES:
-        from lifelike_mj.errors import UserError
-
         raise UserError(f"the observation has no input {name!r}; its inputs are {', '.join(OBSERVATION_NAMES)}.")
     return OBSERVATION_NAMES.index(name)
+
+
 ACTION_MODES = ("dphi", "phi")
 #: Speeds beyond this end the flight as a runaway (m/s); altitudes are bounded for the space's sake (m).
 RUNAWAY_M_S = 1.0e4
@@ -67,13 +80,58 @@ def check_options(options: Any, known) -> None:
     check_names(options, known, "unknown reset option")
 
 
-def copy_rngs(seed: int | list[int], n: int) -> list[np.random.Generator]:
+#: The largest seed a reset takes: seeds are 0 to 2^32 - 1, as everywhere in the package (``--seed``, a course's).
+MAX_SEED = 2**32 - 1
+
+
+def check_seed(seed: Any) -> int | None:
+    """``reset``'s ``seed``: ``None``, or a whole number from 0 to 2^32 - 1 (a NumPy integer too; not a bool), as an
+    ``int``; a :class:`~lifelike_mj.errors.UserError` naming the seed and that range otherwise."""
+    if seed is None:
+        return None
+    return checks.whole("seed", seed, 0, MAX_SEED)
+
+
+def check_num_envs(num_envs: Any, most: int) -> int:
+    """A vector environment's ``num_envs``: a whole number from 1 to ``most`` (a NumPy integer too; not a bool, a
+    float, a string or an array); a :class:`~lifelike_mj.errors.UserError` naming ``num_envs`` and that range."""
+    return checks.whole("num_envs", num_envs, 1, most)
+
+
+def copy_rngs(seed: Any, n: int) -> list[np.random.Generator]:
     """The random generators of a vector environment's ``n`` copies from ``reset(seed=...)``: copy ``i`` seeded
-    ``seed + i`` (as a single environment reset with that seed), or one seed per copy from a list."""
-    seeds = list(seed) if isinstance(seed, (list, tuple)) else [int(seed) + i for i in range(n)]
-    if len(seeds) != n:
-        raise UserError(f"give one seed or {n} seeds, got {len(seeds)}.")
+    ``seed + i`` (as a single environment reset with that seed), or one seed per copy from a list (or a 1-d array);
+    every seed given is checked by :func:`check_seed`."""
+    if isinstance(seed, (list, tuple)) or (isinstance(seed, np.ndarray) and seed.ndim == 1):
+        seeds = [check_seed(sd) for sd in seed]
+        if len(seeds) != n:
+            raise UserError(f"give one seed or {n} seeds, got {len(seeds)}.")
+    else:
+        first = check_seed(seed)
+        seeds = [first + i for i in range(n)]
     return [gym.utils.seeding.np_random(sd)[0] for sd in seeds]
+
+
+def render_modes() -> list[str]:
+    """The render modes this machine offers: ``rgb_array`` (offscreen, EGL or OSMesa) always, ``human`` (the MuJoCo
+    viewer's window) only where a window can open (:func:`~lifelike_mj.render.viewer.has_display`). An environment's
+    class ``metadata`` lists both (what it implements); an instance's lists these, so that Gymnasium's ``check_env``
+    checks what works here."""
+    from lifelike_mj.render.viewer import has_display
+
+    return ["rgb_array", "human"] if has_display() else ["rgb_array"]
+
+
+def check_render_mode(env: gym.Env, render_mode: Any) -> None:
+    """``render_mode``: ``None``, ``"rgb_array"``, or ``"human"`` where a window can open; a
+    :class:`~lifelike_mj.errors.UserError` otherwise. Sets the instance's ``metadata`` (:func:`render_modes`)."""
+    implemented = type(env).metadata["render_modes"]
+    if render_mode is not None and render_mode not in implemented:
+        raise UserError(f"render_mode must be one of {implemented} or None, got {render_mode!r}.")
+    env.metadata = {**type(env).metadata, "render_modes": render_modes()}
+    if render_mode is not None and render_mode not in env.metadata["render_modes"]:
+        raise UserError("render_mode='human' opens the MuJoCo viewer's window, which needs a display (DISPLAY and "
+                        "WAYLAND_DISPLAY are unset); render_mode='rgb_array' draws offscreen without one.")
 
 
 def check_actions(actions: Any, n: int) -> np.ndarray:
@@ -118,6 +176,7 @@ class Drawn:
             self._viewer = None
 
 
+@documented(OBSERVATIONS, ACTIONS["dphi"])
 class ButterflyPitchEnv(Drawn, gym.Env):
     """``lifelike_mj/ButterflyPitch-v0``: choose the butterfly's pitch once per step so that it flies
     level and fast (Oe 2010 section 6).
@@ -128,24 +187,19 @@ class ButterflyPitchEnv(Drawn, gym.Env):
 
     ## Action space
 
-    ``action_mode="dphi"`` (default): ``Box(-max_dphi, max_dphi, (1,))``, the change of the pitch this
-    step in rad (the paper's network changes it by at most 3 deg per step). ``action_mode="phi"``:
-    ``Box(-phi_limit, phi_limit, (1,))``, the pitch itself in rad. The pitch is always clipped to
-    ``[-phi_limit, phi_limit]`` (30 deg).
+    One number, float64, in rad: with ``action_mode="dphi"`` (default), ``Box(-max_dphi, max_dphi, (1,))``, the
+    change of the pitch this step (the paper's network changes it by at most 3 deg per step); with
+    ``action_mode="phi"``, ``Box(-phi_limit, phi_limit, (1,))``, the pitch itself. The pitch is always clipped to
+    ``[-phi_limit, phi_limit]`` (30 deg). An action that is not a finite real number is refused in one sentence.
+
+    {actions}
 
     ## Observation space
 
-    ``Box((6,))``, float64, SI units (the network's six inputs, section 6.1), bounded by the pitch limit,
-    the flap's range and peak rate, the runaway speed (10^4 m/s, where a flight diverges) and 10^5 m:
+    Six numbers, float64, SI units (the network's six inputs, section 6.1), bounded by the pitch limit, the flap's
+    range and peak rate, the runaway speed (10^4 m/s, where a flight diverges) and 10^5 m:
 
-    | index | name | unit | meaning |
-    |---|---|---|---|
-    | 0 | ``phi_rad`` | rad | the pitch of the previous step |
-    | 1 | ``omega_rad_s`` | rad/s | flap rate (positive on the upstroke) |
-    | 2 | ``theta_rad`` | rad | flap angle |
-    | 3 | ``climb_m_s`` | m/s | vertical velocity, relative to the air or the ground (``inputs``) |
-    | 4 | ``altitude_m`` | m | altitude above the target altitude 0 m |
-    | 5 | ``forward_m_s`` | m/s | forward velocity, relative to the air or the ground (``inputs``) |
+    {observations}
 
     The names are also in ``info["observation_names"]`` at reset. They are the fields of a pitch law's
     observation (:class:`~lifelike_mj.butterfly.flight.PitchObservation`), so a law written from this table runs
@@ -162,7 +216,8 @@ class ButterflyPitchEnv(Drawn, gym.Env):
     ## Starting state
 
     At rest at ``y0_m`` (default 0 m), wings at the top of the stroke, pitch 0. Nothing is random: the
-    episode depends only on the actions (``reset(seed=...)`` is accepted for the common shape).
+    episode depends only on the actions (``reset(seed=...)``, a whole number from 0 to 2^32 - 1, is accepted for
+    the common shape).
     ``reset(options={"condition": (y0_m, (a, b))})`` flies one episode from another start altitude and
     wind (the next plain ``reset()`` goes back to the environment's own).
 
@@ -185,7 +240,8 @@ class ButterflyPitchEnv(Drawn, gym.Env):
     :class:`~lifelike_mj.butterfly.ButterflyParams`, or a dict of overrides in the command line's units
     such as ``{"body_area_cm2": 1.53}``), ``config`` and ``force_mode`` (MuJoCo backend), ``ground_m``;
     rendering: ``render_mode`` (``"rgb_array"``: offscreen frames of ``width`` x ``height`` pixels, EGL or
-    OSMesa, no display needed; ``"human"``: the MuJoCo viewer), ``camera`` (``follow``, ``side``, ``chase``).
+    OSMesa, no display needed; ``"human"``: the MuJoCo viewer, only where a window can open), ``camera``
+    (``follow``, ``side``, ``chase``).
 
     ## Version history
 
@@ -214,8 +270,7 @@ class ButterflyPitchEnv(Drawn, gym.Env):
             raise UserError(f"inputs must be air or ground, got {inputs!r}.")
         if action_mode not in ACTION_MODES:
             raise UserError(f"action_mode must be dphi or phi, got {action_mode!r}.")
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise UserError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}.")
+        check_render_mode(self, render_mode)
         if isinstance(params, dict):
             params = ButterflyParams().with_overrides(**params)
         self.params = params or ButterflyParams()
@@ -255,7 +310,7 @@ class ButterflyPitchEnv(Drawn, gym.Env):
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         check_options(options, RESET_OPTIONS)
-        super().reset(seed=seed)
+        super().reset(seed=check_seed(seed))
         chosen = (options or {}).get("condition")
         self.condition = self._episode_condition() if chosen is None else as_condition(chosen)
         self.flight = self._new_flight(self.condition)

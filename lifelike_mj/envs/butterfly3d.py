@@ -14,8 +14,10 @@ from gymnasium.vector.utils import batch_space
 
 from lifelike_mj import checks
 from lifelike_mj.butterfly import flight3d
+from lifelike_mj.butterfly.flight3d.controllers import ALTITUDE_CLIP_M, DEFAULT_SCALE
 from lifelike_mj.butterfly.params import ButterflyParams
-from lifelike_mj.envs.butterfly import Drawn, check_options, copy_rngs
+from lifelike_mj.envs.butterfly import Drawn, check_num_envs, check_options, check_render_mode, check_seed, copy_rngs
+from lifelike_mj.envs.pages import Entry, documented, names
 from lifelike_mj.errors import Diverged, UserError
 
 #: The tasks an episode can fly (``task=``), besides a :class:`~lifelike_mj.butterfly.flight3d.Task3D` of your own.
@@ -28,22 +30,84 @@ WIND_M_S = 1.0
 GUSTS = {"gust_m_s": 0.5, "gust_vertical_m_s": 0.5 * 0.5}
 #: A course's most waypoints in these episodes (the vector form's task arrays are this wide).
 COURSE_WAYPOINTS = 10
+#: The most copies of the vector form (one ``mjData`` each).
+MAX_NUM_ENVS = 10_000
 
 
 #: The observation's bounds beyond the angles: rates (rad/s) and speeds (m/s). A flight whose speed passes 10^3 m/s
 #: has diverged; rates beyond these are shown as the bound.
 MAX_RATE_RAD_S = 1.0e4
 MAX_SPEED_M_S = 2.0e3
+_PI = math.pi
+
+#: The observation's eleven entries, in order (a 3D controller's network inputs,
+#: :data:`~lifelike_mj.butterfly.flight3d.controllers.OBS_NAMES`), with their units, meanings and bounds (the
+#: observation space's; angles within pi, rates and speeds within :data:`MAX_RATE_RAD_S` and :data:`MAX_SPEED_M_S`,
+#: the altitude error within its clip, 1 m).
+OBSERVATIONS = (
+    Entry("roll_rad", "rad", "roll, right wing down > 0", _PI),
+    Entry("pitch_rad", "rad", "pitch, nose up > 0", _PI),
+    Entry("heading_error_rad", "rad", "the reference heading less the yaw, in (-pi, pi]", _PI),
+    Entry("roll_rate_rad_s", "rad/s", "the thorax's roll rate", MAX_RATE_RAD_S),
+    Entry("pitch_rate_rad_s", "rad/s", "its pitch rate, nose up > 0", MAX_RATE_RAD_S),
+    Entry("yaw_rate_rad_s", "rad/s", "its yaw rate, left > 0", MAX_RATE_RAD_S),
+    Entry("speed_error_m_s", "m/s", "forward speed less the reference speed", MAX_SPEED_M_S),
+    Entry("sideways_m_s", "m/s", "speed to the left", MAX_SPEED_M_S),
+    Entry("climb_m_s", "m/s", "climb rate (over the ground)", MAX_SPEED_M_S),
+    Entry("altitude_error_m", "m", "altitude less the reference, clipped to +-1 m", ALTITUDE_CLIP_M),
+    Entry("speed_ref_m_s", "m/s", "the forward speed asked (the reference's own speed)", MAX_SPEED_M_S),
+)
+#: The observation's names, in order (``info["observation_names"]``; the controllers' ``OBS_NAMES``, tested).
+OBSERVATION_NAMES = names(OBSERVATIONS)
+#: The action's nine entries, in order (:data:`~lifelike_mj.butterfly.flight3d.controllers.ACTION_NAMES`), each in
+#: [-1, 1], multiplied by its scale (a new controller's, :data:`~lifelike_mj.butterfly.flight3d.controllers.DEFAULT_SCALE`;
+#: rad, Hz for the frequency) and added to the base command.
+ACTIONS = tuple(Entry(name, "1", meaning, 1.0, DEFAULT_SCALE[name], "Hz" if name == "frequency" else "rad")
+                for name, meaning in (
+    ("offset_sym", "both wings' stroke offset (the stroke's middle)"),
+    ("offset_asym", "the left wing's offset up, the right's down"),
+    ("amplitude_sym", "both wings' stroke amplitude"),
+    ("amplitude_asym", "the left wing's amplitude up, the right's down"),
+    ("feather_sym", "both wings' mean feathering (leading edge down > 0)"),
+    ("feather_asym", "the left wing's feathering up, the right's down"),
+    ("feather_amplitude", "both wings' feathering amplitude"),
+    ("abdomen_mean", "the abdomen's mean angle"),
+    ("frequency", "the flap frequency"),
+))
+#: The title of the actions' scale column in the tables.
+ACTION_SCALE_TITLE = "scale (default)"
 
 
 def _observation_space() -> spaces.Box:
-    """Angles within [-pi, pi], rates and speeds (the speed asked among them) within their bounds, the altitude error
-    within its clip."""
-    from lifelike_mj.butterfly.flight3d.controllers import ALTITUDE_CLIP_M
+    """Each entry of :data:`OBSERVATIONS` within its bound."""
+    hi = np.array([e.bound for e in OBSERVATIONS])
+    return spaces.Box(-hi, hi, (len(OBSERVATIONS),), dtype=np.float64)
 
-    pi, w, v = math.pi, MAX_RATE_RAD_S, MAX_SPEED_M_S
-    lo = np.array([-pi, -pi, -pi, -w, -w, -w, -v, -v, -v, -ALTITUDE_CLIP_M, -v])
-    return spaces.Box(lo, -lo, (flight3d.N_OBS,), dtype=np.float64)
+
+def check_actions3d(actions: Any, n: int | None = None) -> np.ndarray:
+    """A single environment's action (``n`` None: shape ``(9,)``) or a vector environment's ``n`` actions (shape
+    ``(n, 9)``) as a float64 array: real numbers (no bools, strings or objects) of that shape, each finite; a
+    :class:`~lifelike_mj.errors.UserError` saying which of these fails otherwise (the first entry that is not finite
+    named by its index and action name)."""
+    a = np.asarray(actions)
+    shape = (flight3d.N_ACT,) if n is None else (n, flight3d.N_ACT)
+    what = "an action" if n is None else "the actions"
+    if a.dtype.kind not in "fiu":
+        raise UserError(f"{what} must be real numbers in [-1, 1] of shape {shape}, got {actions!r} (dtype {a.dtype}).")
+    if a.shape != shape:
+        per = "" if n is None else " per copy"
+        raise UserError(f"{what} must have shape {shape} (the {flight3d.N_ACT} actions offset_sym to frequency{per}), "
+                        f"got shape {a.shape}.")
+    a = a.astype(np.float64)
+    bad = np.argwhere(~np.isfinite(a))
+    if len(bad):
+        where = tuple(int(i) for i in bad[0])
+        name = flight3d.ACTION_NAMES[where[-1]]
+        if n is None:
+            raise UserError(f"the action's entry {where[0]} ({name}) is {float(a[where])}, not a finite number.")
+        raise UserError(f"the actions' entry [{where[0]}, {where[1]}] (copy {where[0]}'s {name}) is {float(a[where])}, "
+                        "not a finite number.")
+    return a
 
 
 def _still_controller() -> flight3d.Controller3D:
@@ -52,6 +116,7 @@ def _still_controller() -> flight3d.Controller3D:
                                                                                                 flight3d.N_ACT])))
 
 
+@documented(OBSERVATIONS, ACTIONS, ACTION_SCALE_TITLE)
 class ButterflyFlight3DEnv(Drawn, gym.Env):
     """``lifelike_mj/ButterflyFlight3D-v0``: fly the free 3D butterfly through a task by changing its wing and
     abdomen kinematics, as a 3D controller's network does.
@@ -64,58 +129,46 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
 
     ## Action space
 
-    ``Box(-1, 1, (9,))``, float64: the actions of :data:`~lifelike_mj.butterfly.flight3d.ACTION_NAMES`, each
-    multiplied by its scale (rad; Hz for the frequency) and added to the base command:
+    Nine numbers in [-1, 1], float64, named as a 3D controller's actions
+    (:data:`~lifelike_mj.butterfly.flight3d.controllers.ACTION_NAMES`), each multiplied by its scale (rad; Hz for
+    the frequency) and added to the base command:
 
-    | index | name | scale (default) | what it changes |
-    |---|---|---|---|
-    | 0 | ``offset_sym`` | 0.3 rad | both wings' stroke offset (the stroke's middle) |
-    | 1 | ``offset_asym`` | 0.3 rad | the left wing's offset up, the right's down |
-    | 2 | ``amplitude_sym`` | 0.3 rad | both wings' stroke amplitude |
-    | 3 | ``amplitude_asym`` | 0.3 rad | the left wing's amplitude up, the right's down |
-    | 4 | ``feather_sym`` | 0.5 rad | both wings' mean feathering (leading edge down > 0) |
-    | 5 | ``feather_asym`` | 0.3 rad | the left wing's feathering up, the right's down |
-    | 6 | ``feather_amplitude`` | 0.3 rad | both wings' feathering amplitude |
-    | 7 | ``abdomen_mean`` | 0.8 rad | the abdomen's mean angle |
-    | 8 | ``frequency`` | 3 Hz | the flap frequency |
+    {actions}
 
-    Actions outside ``[-1, 1]`` are clipped. With ``flutter`` the task adds the butterfly's own irregularity to
-    them (as to a network's).
+    Actions outside ``[-1, 1]`` are clipped; one that is not finite, or of another shape, is refused in one
+    sentence naming it. With ``flutter`` the task adds the butterfly's own irregularity to them (as to a
+    network's). The scales, the base command (a 10 Hz flap over [-60, 75] deg, feathered 0.3 rad a quarter beat
+    ahead) and the rate ``every`` are those of the ``controller`` argument (default: a new controller's). So are
+    the butterfly and the wing-force law: ``controller="monarch"`` flies the monarch with its measured wings under
+    the quasi-steady law, and ``animal="monarch"`` picks the butterfly for a new controller.
 
     ## Observation space
 
-    ``Box((10,))``, float64, SI units, in the heading frame (forward, left, up), relative to the task's reference
-    (a heading, an altitude and a speed); rates are bounded by 10^4 rad/s and speeds by 2 x 10^3 m/s (a flight
-    diverges before):
+    Eleven numbers, float64, SI units, in the heading frame (forward, left, up), relative to the task's reference
+    (a heading, an altitude and a speed), named as a 3D controller's inputs
+    (:data:`~lifelike_mj.butterfly.flight3d.controllers.OBS_NAMES`); rates are bounded by 10^4 rad/s and speeds by
+    2 x 10^3 m/s (a flight diverges before):
 
-    | index | name | unit | meaning |
-    |---|---|---|---|
-    | 0 | ``roll_rad`` | rad | roll, right wing down > 0 |
-    | 1 | ``pitch_rad`` | rad | pitch, nose up > 0 |
-    | 2 | ``heading_error_rad`` | rad | the reference heading less the yaw, in (-pi, pi] |
-    | 3 | ``roll_rate_rad_s`` | rad/s | the thorax's roll rate |
-    | 4 | ``pitch_rate_rad_s`` | rad/s | its pitch rate, nose up > 0 |
-    | 5 | ``yaw_rate_rad_s`` | rad/s | its yaw rate, left > 0 |
-    | 6 | ``speed_error_m_s`` | m/s | forward speed less the reference speed |
-    | 7 | ``sideways_m_s`` | m/s | speed to the left |
-    | 8 | ``climb_m_s`` | m/s | climb rate (over the ground) |
-    | 9 | ``altitude_error_m`` | m | altitude less the reference, clipped to +-1 m |
+    {observations}
 
-    The forward and sideways speeds are over the ground, or through the air with ``inputs="air"`` (the air
-    around the butterfly, wind and gusts included). ``info["observation_names"]`` gives the names at reset.
+    The forward and sideways speeds (and the speed asked) are over the ground, or through the air with
+    ``inputs="air"`` (the air around the butterfly, wind and gusts included). ``info["observation_names"]`` gives
+    the names at reset. A controller's network reads the first ten (the shipped ``monarch``) or all eleven.
 
     ## Reward
 
     Each time step's reward in ``[0, 1]`` (0.1 for flying upright, and up to 0.3 more for each of the speed within
     about 0.3 m/s, the altitude within 0.2 m and the heading within 0.3 rad) times the step (s), divided by the
     episode's length (s): the return is the flight's mean reward per second, the evolution's fitness of this
-    task (tested to 1e-9 for the shipped controllers).
+    task (tested to 1e-9 for the evolved controllers). The naturalness that ``evolve3d --natural`` multiplies in
+    per flight (as ``exp(-cost)`` of the style integrals) is not part of it.
 
     ## Starting state
 
     At rest at the origin, level, heading +x, the kinematics at the base command. The task's gusts, flutter and
-    (for ``course`` and ``wind``) waypoints and wind are drawn from the episode's seed; a ``Task3D`` of your own
-    is flown as it is (its own seed draws its gusts and flutter).
+    (for ``course`` and ``wind``) waypoints and wind are drawn from the episode's seed (``reset(seed=...)``, a
+    whole number from 0 to 2^32 - 1); a ``Task3D`` of your own is flown as it is (its own seed draws its gusts
+    and flutter).
 
     ## Episode end
 
@@ -130,13 +183,22 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
     :class:`~lifelike_mj.butterfly.flight3d.Task3D` of your own, or a list of these, one drawn per episode (the
     evolution's task sets: ``task=flight3d.TASK_SETS["steer"]()``); ``reset(options={"task": ...})`` changes it
     for one episode. ``speed_m_s`` (1.5), ``angle_deg`` (90), ``flutter`` (0), ``duration_s`` (4, the evolution's
-    training flights), ``dt_s`` (1/800 s; 1/1200 s is the step the shipped controllers were evolved at).
-    ``controller``: a 3D controller (name, path or object) whose base
+    training flights), ``dt_s`` (1/800 s; 1/1200 s is the step the shipped swallowtail controllers were evolved
+    at). ``controller``: a 3D controller (name, path or object) whose base
     command, action scales, rate ``every``, kinematics bandwidth and ``inputs`` the environment takes (default:
     a new controller's: the paper's 10 Hz flap, ``every=1``, speeds over the ground); ``every`` and ``inputs``
     override it; ``animal`` the butterfly flown (``"swallowtail"`` or ``"monarch"``; default the controller's).
     Rendering: ``render_mode`` ``"rgb_array"`` (offscreen frames of ``width`` x ``height``, EGL or
-    OSMesa, no display needed; a camera following the butterfly) or ``"human"`` (the MuJoCo viewer).
+    OSMesa, no display needed; a camera following the butterfly) or ``"human"`` (the MuJoCo viewer; only where a
+    window can open).
+
+    ## From a policy to a controller file
+
+    :class:`NetworkInputs3D` divides the observation as a controller's network does, and :class:`NetworkActions3D`
+    passes the actions through ``tanh`` as its output layer does. A policy with tanh hidden layers, trained through
+    both wrappers, is then a 3D controller: :func:`network_controller3d` writes its weights in the controller file's
+    form, and ``lifelike-mj butterfly fly3d --controller FILE`` flies it. ``examples/gym_sb3_flight3d.py`` does this
+    with stable-baselines3's PPO.
 
     ## Version history
 
@@ -165,8 +227,7 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
             ctl = ctl.replace(every=ctl.every if every is None else every, inputs=inputs or ctl.inputs,
                               animal=animal or ctl.animal)
         self.controller = ctl
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise UserError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}.")
+        check_render_mode(self, render_mode)
         from lifelike_mj.render.video import check_size
 
         check_size(width, height, "frame")
@@ -183,7 +244,7 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         check_options(options, RESET_OPTIONS)
-        super().reset(seed=seed)
+        super().reset(seed=check_seed(seed))
         chosen = (options or {}).get("task")
         self.episode_task = self.draw_task(self.np_random, self.task if chosen is None else self._check_task(chosen))
         if self._model is None:
@@ -191,15 +252,12 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
         self.flight = flight3d.Flight3D(controller=self.controller, task=self.episode_task, dt_s=self.dt_s,
                                         end_on_tumble=True, _model=self._model)
         obs = self.flight.decide(max_steps=self.n_steps)
-        return self._shown(obs), {"observation_names": flight3d.OBS_NAMES, "task": self.episode_task.name}
+        return self._shown(obs), {"observation_names": OBSERVATION_NAMES, "task": self.episode_task.name}
 
     def step(self, action):
         if self.flight is None:
             raise RuntimeError("call reset() before step()")
-        a = np.asarray(action)
-        if a.dtype.kind not in "fiu" or a.shape != (flight3d.N_ACT,) or not np.isfinite(a).all():
-            raise UserError(f"an action is {flight3d.N_ACT} finite numbers in [-1, 1] (shape ({flight3d.N_ACT},)), "
-                            f"got {action!r}.")
+        a = check_actions3d(action)
         before = self.flight.reward
         info: dict[str, Any] = {}
         terminated = False
@@ -284,15 +342,16 @@ class ButterflyFlight3DVectorEnv(VectorEnv):
     Spaces, reward and episode end are the single environment's, batched; the episodes are those of
     ``num_envs`` single environments seeded ``s + i``, bit for bit (tested). Autoreset is ``NEXT_STEP``: the step
     after an episode ends resets that copy, ignores its action and returns its first observation with reward 0.
-    Keyword arguments are the single environment's (no rendering: render a single environment)."""
+    Keyword arguments are the single environment's (no rendering: render a single environment); ``num_envs`` is a
+    whole number from 1 to 10,000. Made by ``gymnasium.make_vec("lifelike_mj/ButterflyFlight3D-v0", num_envs=N,
+    vectorization_mode="vector_entry_point")``; its speed next to bare ``mj_step`` is in ``docs/performance.md``."""
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
 
     def __init__(self, num_envs: int = 16, **kwargs: Any) -> None:
         if kwargs.get("render_mode") is not None:
             raise UserError("the vector environment does not render; render a single ButterflyFlight3D-v0.")
-        if not (isinstance(num_envs, int) and 1 <= num_envs <= 10_000):
-            raise UserError(f"num_envs must be a whole number from 1 to 10,000, got {num_envs!r}.")
+        num_envs = check_num_envs(num_envs, MAX_NUM_ENVS)
         self.single = ButterflyFlight3DEnv(**kwargs)
         self.num_envs = num_envs
         self.single_observation_space = self.single.observation_space
@@ -324,15 +383,13 @@ class ButterflyFlight3DVectorEnv(VectorEnv):
                                      tumble_rad=flight3d.TUMBLE_RAD)
         self._batch.decide(None, s.n_steps)
         self._ended[:] = False
-        return self.single._shown(self._batch.observations), {"observation_names": flight3d.OBS_NAMES}
+        return self.single._shown(self._batch.observations), {"observation_names": OBSERVATION_NAMES}
 
     def step(self, actions):
         b, s, n = self._batch, self.single, self.num_envs
         if b is None:
             raise RuntimeError("call reset() before step()")
-        a = np.asarray(actions)
-        if a.dtype.kind not in "fiu" or a.shape != (n, flight3d.N_ACT) or not np.isfinite(a).all():
-            raise UserError(f"actions are ({n}, {flight3d.N_ACT}) finite numbers in [-1, 1], got shape {a.shape}.")
+        a = check_actions3d(actions, n)
         live = ~self._ended
         for i in np.flatnonzero(self._ended):  # NEXT_STEP autoreset of the copies whose episode ended last step
             self._reset_one(i)

@@ -19,6 +19,7 @@ from lifelike_mj.envs.butterfly import (
     ButterflyPitchWindEnv,
     as_condition,
     check_actions,
+    check_num_envs,
     check_options,
     copy_rngs,
 )
@@ -74,6 +75,8 @@ def _finish(live, cols, phis, airs, relative, before, after, reset, diverged, ks
 
 #: The options ``reset`` takes.
 RESET_OPTIONS = ("conditions",)
+#: The most copies of the vector form.
+MAX_NUM_ENVS = 1_000_000
 #: Butterfly-steps per call from which the paper backend's batch runs on threads (measured crossover).
 PARALLEL_FROM = 256
 
@@ -191,7 +194,9 @@ class ButterflyPitchVectorEnv(VectorEnv):
     The episodes are those of ``num_envs`` single environments, bit for bit (tested, both backends).
 
     Keyword arguments are the single environment's (``render_mode`` is not offered: render a single
-    environment). ``info["diverged"]`` marks the copies whose episode ended by divergence.
+    environment); ``num_envs`` is a whole number from 1 to 1,000,000. ``info["diverged"]`` marks the copies whose
+    episode ended by divergence. Made by ``gymnasium.make_vec("lifelike_mj/ButterflyPitch-v0", num_envs=N,
+    vectorization_mode="vector_entry_point")`` (or ``ButterflyPitchWind-v0``).
     """
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
@@ -199,8 +204,7 @@ class ButterflyPitchVectorEnv(VectorEnv):
     def __init__(self, num_envs: int = 64, wind: bool = False, **kwargs: Any) -> None:
         if kwargs.get("render_mode") is not None:
             raise UserError("the vector environment does not render; render a single ButterflyPitch-v0.")
-        if not (isinstance(num_envs, int) and 1 <= num_envs <= 1_000_000):
-            raise UserError(f"num_envs must be a whole number from 1 to 1,000,000, got {num_envs!r}.")
+        num_envs = check_num_envs(num_envs, MAX_NUM_ENVS)
         self.single = (ButterflyPitchWindEnv if wind else ButterflyPitchEnv)(**kwargs)
         self.num_envs = num_envs
         self.single_observation_space = self.single.observation_space

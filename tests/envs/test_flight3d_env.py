@@ -135,8 +135,10 @@ def test_bad_arguments_are_one_sentence(kw):
 def test_bad_actions_are_one_sentence():
     env = ButterflyFlight3DEnv(duration_s=0.1)
     env.reset(seed=0)
-    for bad in (np.zeros(8), np.full(9, np.nan), np.array(["a"] * 9)):
-        with pytest.raises(UserError, match="an action is 9 finite numbers"):
+    for bad, says in ((np.zeros(8), r"an action must have shape \(9,\)"),
+                      (np.full(9, np.nan), r"the action's entry 0 \(offset_sym\) is nan, not a finite number"),
+                      (np.array(["a"] * 9), "an action must be real numbers")):
+        with pytest.raises(UserError, match=says):
             env.step(bad)
     with pytest.raises(UserError, match="unknown reset option"):
         env.reset(options={"tasks": "level"})

@@ -586,6 +586,11 @@ def fly_batch(mptr, dptrs, off, nq, nv, n_steps, dt, every, layers, weights, rea
 
 
 
+#: About how long the first run's compilation of the 3D flight's kernels takes (s): the air's callback and one
+#: flight loop, 15-20 s measured on 2 busy cores with an empty cache (the callback 7 s, the loop 8 s, more under
+#: load); said once, when the cache does not hold them yet (:func:`~lifelike_mj._numba_cache.compile_notice`).
+COMPILE_S = 20.0
+
 class Batch:
     """The one owner of the compiled loop's state: one MuJoCo model and, per butterfly, its ``mjData``, its task
     array and run record (:mod:`~lifelike_mj.butterfly.flight3d.tasks`), and its network weights; the network's
@@ -624,11 +629,13 @@ class Batch:
         """Fly every butterfly ``n_steps`` steps (threads over the butterflies), with the model's compiled air
         forces installed. ``path`` (a batch of one only): rows of (t, x, y, z, roll, pitch, yaw) every
         ``path_every`` steps. A flight that has ended (diverged, tumbled) stays where it ended."""
+        from lifelike_mj._numba_cache import compile_notice
         from lifelike_mj.physics.callbacks import passive_callback
         from lifelike_mj.physics.stability import watching
 
         m = self.model
-        with passive_callback(mj3d.COMPILED_PASSIVE), watching():
+        group = "flight3d-steps" if self.n == 1 else "flight3d-batch"
+        with compile_notice(group, "the 3D flight", COMPILE_S), passive_callback(mj3d.COMPILED_PASSIVE), watching():
             if self.n == 1:
                 fly_steps(m._address, int(self.ptrs[0]), mjabi.offsets_tuple(), m.nq, m.nv, n_steps, self.dt,
                           self.every, self.layers, self.weights[0], self.reach, self.base, self.scale, self.tasks[0],
@@ -652,7 +659,10 @@ class Batch:
             actions is not None)
         a = np.zeros((self.n, N_ACT)) if actions is None else np.ascontiguousarray(actions, dtype=np.float64)
         going = np.zeros(self.n, dtype=np.bool_)
-        with passive_callback(mj3d.COMPILED_PASSIVE), watching():
+        from lifelike_mj._numba_cache import compile_notice
+
+        group = "flight3d-decide" if self.n == 1 else "flight3d-decisions"
+        with compile_notice(group, "the 3D flight", COMPILE_S), passive_callback(mj3d.COMPILED_PASSIVE), watching():
             if self.n == 1:
                 going[0] = to_decision(m._address, int(self.ptrs[0]), mjabi.offsets_tuple(), m.nq, m.nv, int(n_max),
                                        self.dt, self.every, a[0], bool(act[0]), self.base, self.scale, self.tasks[0],

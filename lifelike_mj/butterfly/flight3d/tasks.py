@@ -222,7 +222,9 @@ def turn(angle_deg: float, at_s: float = 2.0, speed_m_s: float = 1.5, climb_m: f
 def course(seed: int, n: int = 10, spacing_m: float = 1.5, altitude_span_m: float = 0.6, speed_m_s: float = 1.5,
            radius_m: float = 0.3) -> Task3D:
     """``n`` waypoints drawn by ``seed``: each ``spacing_m`` from the last in a direction at most 90 deg
-    off the previous leg's, at altitudes within ``+-altitude_span_m / 2`` of the start."""
+    off the previous leg's, at altitudes within ``+-altitude_span_m / 2`` of the start. ``seed``: 0 to 2^32-1."""
+    seed = checks.whole("seed", seed, 0, 2**32 - 1)
+    n = checks.whole("the number of waypoints n", n, 1, 10_000)
     rng = np.random.default_rng(seed)
     pts, heading, p = [], 0.0, np.zeros(3)
     for _ in range(n):
