@@ -3,13 +3,15 @@
     python examples/boids_classify.py [PRESET]
 """
 
-import sys
+import argparse
 
 from lifelike_mj import boids
 
 
 def main() -> None:
-    name = sys.argv[1] if len(sys.argv) > 1 else "4c"
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("preset", nargs="?", default="4c", help="a boids preset's name or file (default 4c)")
+    name = ap.parse_args().preset
     params = boids.load_preset(name)
     run, measures, label, reasons = boids.classified_run(params, n=300, seed=0)
     print(f"{name}: classified {label} (segregation index {measures['segregation_index']:.2f}, "

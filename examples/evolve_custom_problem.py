@@ -36,7 +36,7 @@ class SimpleRulePitches:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--executor", default="serial", help="serial, process or ray")
     ap.add_argument("--optimizer", default="cmaes", help="rcga, cmaes, crs2, esch or isres")
     args = ap.parse_args()

@@ -7,12 +7,15 @@ else coast), and the other nine swim exactly as before.
     python examples/fish_tank_measures.py
 """
 
+import argparse
+
 import numpy as np
 
 from lifelike_mj import fish
 
 
 def main() -> None:
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     preset = fish.load_preset("B-D")
     result = fish.Tank(preset, n_fish=10, seed=0).record(duration_s=20.0)
     m = fish.swim_summary(result)

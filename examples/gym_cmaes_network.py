@@ -47,7 +47,7 @@ def episode_returns(weights: np.ndarray, duration_s: float, layers=ann.PAPER_LAY
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--policy", choices=sorted(POLICIES), default="network")
     ap.add_argument("--generations", type=int, default=3)
     ap.add_argument("--popsize", type=int, default=16)

@@ -8,8 +8,8 @@ that `lifelike-mj butterfly fly3d` flies.
 
 The environment is `lifelike_mj/ButterflyFlight3D-v0` on the tasks `evolve3d --tasks steer` evolves on (level
 flight at 1 and 2 m/s, a 90 deg turn, a 180 deg turn with a 0.3 m climb; one drawn per episode of 4 s), acting
-every `--every` time steps (default 12: 100 decisions per second). The policy is a network of the 3D controller
-file's own kind, so that it can leave the RL library: its inputs are the observation scaled as a controller's
+every `--every` time steps (default 12 steps of 1/800 s: about 67 decisions per second). The policy is a network
+of the 3D controller file's own kind, so that it can leave the RL library: its inputs are the observation scaled as a controller's
 network scales them (`NetworkInputs3D`), its hidden layers are tanh, and its actions go through tanh
 (`NetworkActions3D`), as a controller's output layer does. PPO's deterministic action is then exactly the
 controller's output; `network_controller3d` writes the actor's weights out, with the environment's base command,
@@ -26,21 +26,38 @@ from datetime import datetime, timezone
 
 import numpy as np
 
-try:
-    import torch
-    from stable_baselines3 import PPO
-    from stable_baselines3.common.env_util import make_vec_env
-except ImportError as exc:  # the rl extra is optional
-    print(f"gym_sb3_flight3d.py: error: this example needs the rl extra ({exc.name} is missing): "
-          "pip install torch==2.13.0 'lifelike-mj[rl]'", file=sys.stderr)
-    raise SystemExit(2) from None
-
 import lifelike_mj
 from lifelike_mj.butterfly import flight3d
 from lifelike_mj.envs.butterfly3d import ButterflyFlight3DEnv, NetworkActions3D, NetworkInputs3D, network_controller3d
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import write_json
 from lifelike_mj.paths import check_output_file
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The command line (built before the rl extra is imported, so that ``--help`` and a bad option answer without
+    it)."""
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--steps", type=int, default=16_000, help="environment steps to train (each --every time steps)")
+    ap.add_argument("--every", type=int, default=12, help="time steps (1/800 s each) between two decisions (default 12)")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--out", default="gym_sb3_flight3d.json")
+    ap.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
+    return ap
+
+
+if __name__ == "__main__":
+    build_parser().parse_args()  # --help, or a bad option, answers here, before the optional imports below
+
+try:
+    import torch  # noqa: E402 (after the command line)
+    from stable_baselines3 import PPO  # noqa: E402 (after the command line)
+    from stable_baselines3.common.env_util import make_vec_env  # noqa: E402 (after the command line)
+except ImportError as exc:  # the rl extra is optional
+    print(f"gym_sb3_flight3d.py: error: this example needs the rl extra ({exc.name} is missing): "
+          "pip install torch==2.13.0 'lifelike-mj[rl]'", file=sys.stderr)
+    raise SystemExit(2) from None
+
 
 #: Seconds of each training flight: the evolution's.
 DURATION_S = 4.0
@@ -81,12 +98,7 @@ def fitness(ctl: flight3d.Controller3D, task_set: str = "steer") -> float:
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--steps", type=int, default=16_000, help="environment steps to train (each --every time steps)")
-    ap.add_argument("--every", type=int, default=12, help="time steps (1/1200 s) between two decisions")
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--out", default="gym_sb3_flight3d.json")
-    ap.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
+    ap = build_parser()
     args = ap.parse_args()
     try:  # before any work: never replace a file unasked
         check_output_file(args.out, "--out", suffixes=(".json",), overwrite=args.overwrite)

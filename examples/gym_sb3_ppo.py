@@ -26,22 +26,39 @@ from datetime import datetime, timezone
 
 import gymnasium as gym
 
-try:
-    import torch
-    from stable_baselines3 import PPO
-    from stable_baselines3.common.env_util import make_vec_env
-    from stable_baselines3.common.vec_env import VecNormalize
-except ImportError as exc:  # the rl extra is optional
-    print(f"gym_sb3_ppo.py: error: this example needs the rl extra ({exc.name} is missing): "
-          "pip install torch==2.13.0 'lifelike-mj[rl]'", file=sys.stderr)
-    raise SystemExit(2) from None
-
 import lifelike_mj
 from lifelike_mj.envs.butterfly import ButterflyPitchEnv, ButterflyPitchWindEnv
 from lifelike_mj.envs.policies import NetworkActions, NetworkInputs, network_controller
 from lifelike_mj.errors import UserError
 from lifelike_mj.io import write_json
 from lifelike_mj.paths import check_output_file
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The command line (built before the rl extra is imported, so that ``--help`` and a bad option answer without
+    it)."""
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--steps", type=int, default=20_000, help="environment steps to train (each --frame-skip simulation steps)")
+    ap.add_argument("--frame-skip", type=int, default=12)
+    ap.add_argument("--wind", action="store_true", help="train on ButterflyPitchWind-v0 (winds and start altitudes drawn)")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--out", default="gym_sb3_ppo.json")
+    ap.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
+    return ap
+
+
+if __name__ == "__main__":
+    build_parser().parse_args()  # --help, or a bad option, answers here, before the optional imports below
+
+try:
+    import torch  # noqa: E402 (after the command line)
+    from stable_baselines3 import PPO  # noqa: E402 (after the command line)
+    from stable_baselines3.common.env_util import make_vec_env  # noqa: E402 (after the command line)
+    from stable_baselines3.common.vec_env import VecNormalize  # noqa: E402 (after the command line)
+except ImportError as exc:  # the rl extra is optional
+    print(f"gym_sb3_ppo.py: error: this example needs the rl extra ({exc.name} is missing): "
+          "pip install torch==2.13.0 'lifelike-mj[rl]'", file=sys.stderr)
+    raise SystemExit(2) from None
 
 
 class PaperTransfer(torch.nn.Module):
@@ -81,13 +98,7 @@ def export(model: PPO, provenance: dict | None = None):
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--steps", type=int, default=20_000, help="environment steps to train (each --frame-skip simulation steps)")
-    ap.add_argument("--frame-skip", type=int, default=12)
-    ap.add_argument("--wind", action="store_true", help="train on ButterflyPitchWind-v0 (winds and start altitudes drawn)")
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--out", default="gym_sb3_ppo.json")
-    ap.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
+    ap = build_parser()
     args = ap.parse_args()
     try:  # before any work: never replace a file unasked
         check_output_file(args.out, "--out", suffixes=(".json",), overwrite=args.overwrite)

@@ -7,6 +7,7 @@ it runs inside the compiled stepping loop. Both fly exactly the trajectory of th
     python examples/own_pitch_law.py
 """
 
+import argparse
 import math
 
 import numpy as np
@@ -26,6 +27,7 @@ simple_rule_compiled = njit(simple_rule)
 
 
 def main() -> None:
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     for backend in ("paper", "mujoco"):
         builtin = butterfly.Flight("simple_rule", backend=backend).record(duration_s=5.0)
         for name, law in (("python", simple_rule), ("numba", simple_rule_compiled)):

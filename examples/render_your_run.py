@@ -4,14 +4,16 @@ and a fish swim as a GIF. No display needed (offscreen EGL or OSMesa).
     python examples/render_your_run.py [OUT_DIR]
 """
 
-import sys
+import argparse
 from pathlib import Path
 
 from lifelike_mj import boids, butterfly, fish
 
 
 def main() -> None:
-    out = Path(sys.argv[1] if len(sys.argv) > 1 else "out/examples")
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("out_dir", nargs="?", default="out/examples", help="the folder to write into (default out/examples)")
+    out = Path(ap.parse_args().out_dir)
     out.mkdir(parents=True, exist_ok=True)
 
     trajectory = butterfly.Flight("simple_rule").record(duration_s=1.0)  # the paper backend
