@@ -34,17 +34,23 @@ def _loaders():
     from lifelike_mj.boids.presets import load_preset as boids_preset
     from lifelike_mj.butterfly.controllers import load
     from lifelike_mj.butterfly.flight3d.controllers import load_controller
+    from lifelike_mj.cli.scene import check_scene
     from lifelike_mj.fish.params import load_preset as fish_preset
 
     return {"butterfly-controller": load, "butterfly3d-controller": load_controller, "fish-preset": fish_preset,
-            "boids-preset": boids_preset, "boids-grid": load_grid}
+            "boids-preset": boids_preset, "boids-grid": load_grid, "scene": check_scene}
 
 
 #: (format, a shipped file of it): the documents the mutations start from.
 EXAMPLES = [("butterfly-controller", "butterfly/simple_rule.json"), ("butterfly-controller", "butterfly/ann_paper.json"),
             ("butterfly-controller", "butterfly/glide.json"), ("butterfly3d-controller", "butterfly3d/monarch.json"),
             ("fish-preset", "fish/B-D.json"), ("fish-preset", "fish/default.json"), ("boids-preset", "boids/5b.json"),
-            ("boids-grid", "boids/fig2_grid.json")]
+            ("boids-grid", "boids/fig2_grid.json"), ("scene", "examples/scenes/garden.json")]
+
+
+def _example(name: str) -> Path:
+    """A starting document: a shipped file, or the repository's example scene."""
+    return DOCS.parent.parent / name if name.startswith("examples/") else controllers_dir() / name
 
 
 def _schema(fmt: str) -> dict:
@@ -144,7 +150,7 @@ def _check(fmt: str, doc) -> None:
 
 @pytest.mark.parametrize("fmt, example", EXAMPLES, ids=[e[1] for e in EXAMPLES])
 def test_a_file_made_wrong_is_built_or_refused_in_one_sentence(fmt, example):
-    doc = json.loads((controllers_dir() / example).read_text())
+    doc = json.loads(_example(example).read_text())
 
     @SETTINGS
     @given(mutated(fmt, doc))
@@ -158,8 +164,8 @@ def test_a_file_made_wrong_is_built_or_refused_in_one_sentence(fmt, example):
 def test_the_shipped_files_load_and_a_beyond_bound_number_is_refused(fmt, example):
     """The starting points load; and each bounded number of each, pushed just past its bound, is refused (so the
     generated cases above include refusals, and the schema's bounds are the loader's)."""
-    doc = json.loads((controllers_dir() / example).read_text())
-    _loaders()[fmt](controllers_dir() / example)
+    doc = json.loads(_example(example).read_text())
+    _loaders()[fmt](_example(example))
     pushed = 0
     for path, sub, _v in _places(_schema(fmt), doc):
         hi = sub.get("maximum")

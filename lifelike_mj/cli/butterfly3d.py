@@ -131,7 +131,7 @@ def cmd_evolve3d(args) -> None:
 
 def cmd_assess3d(args) -> None:
     from lifelike_mj.butterfly.flight3d.controllers import load_controller
-    from lifelike_mj.butterfly.flight3d.evolution import check_time_step
+    from lifelike_mj.butterfly.flight3d.flight import check_time_step
     from lifelike_mj.butterfly.flight3d.validate import check_window, course_check, level_check, turn_check
 
     check_window("the level flight (--duration)", args.duration, LEVEL_SETTLE_S, 1.0,
@@ -157,7 +157,7 @@ def cmd_assess3d(args) -> None:
 
 def cmd_measure3d(args) -> None:
     from lifelike_mj.butterfly.flight3d.controllers import load_controller
-    from lifelike_mj.butterfly.flight3d.evolution import check_time_step
+    from lifelike_mj.butterfly.flight3d.flight import check_time_step
     from lifelike_mj.butterfly.flight3d.measures import check_window, level_measures
 
     check_window("the measures", args.settle + args.window, args.settle, 0.5, "they measure whole wing beats")
@@ -241,7 +241,7 @@ def cmd_garden(args) -> None:
 
     from lifelike_mj import checks
     from lifelike_mj.butterfly.flight3d.controllers import load_controller
-    from lifelike_mj.butterfly.flight3d.evolution import check_time_step
+    from lifelike_mj.butterfly.flight3d.flight import check_time_step
     from lifelike_mj.butterfly.flight3d.garden import Garden, film_garden
 
     checks.work(f"a garden of {args.n} butterflies for {args.duration:g} s",

@@ -163,12 +163,10 @@ def _check_follow(part: dict, model, where: str) -> None:
                             f"{', '.join(roots[:4])}{' ...' if len(roots) > 4 else ''}.")
 
 
-def scene_parts(scene: dict | str | Path, where: str = "the scene", quiet: bool = False) -> list:
-    """Run every part of ``scene`` (a scene file's path, or its content as a dict, checked as a file's) and
-    return them as :class:`~lifelike_mj.export.scene.Part`, each recorded and rigged; every part is checked
-    before any is simulated."""
-    from lifelike_mj.cli.common import creature as _module
-    from lifelike_mj.export.scene import Part
+def check_scene(scene: dict | str | Path, where: str = "the scene") -> list[tuple[dict, argparse.Namespace]]:
+    """``scene`` (a scene file's path, or its content as a dict) checked as a file is, and each part's options
+    parsed by its command's own parser: ``(part, its options)`` per part, nothing built or run; one sentence for
+    the first thing wrong."""
     from lifelike_mj.schema import check_header, validate
 
     if not isinstance(scene, dict):
@@ -177,17 +175,28 @@ def scene_parts(scene: dict | str | Path, where: str = "the scene", quiet: bool 
     else:
         check_header(scene, FORMAT, where, kind="scene")
         validate(scene, json_schema(), where)
-    looks = scene.get("looks", "rig")
     names = [p["name"] for p in scene["parts"]]
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:
         raise UserError(f"{where}: each part has its own name; {', '.join(map(repr, twice))} is used twice.")
-    from lifelike_mj import checks
+    return [(part, _parse_part(part, scene, f"{where}, part {part['name']!r}")) for part in scene["parts"]]
 
+
+def scene_parts(scene: dict | str | Path, where: str = "the scene", quiet: bool = False) -> list:
+    """Run every part of ``scene`` (a scene file's path, or its content as a dict, checked as a file's) and
+    return them as :class:`~lifelike_mj.export.scene.Part`, each recorded and rigged; every part is checked
+    before any is simulated."""
+    from lifelike_mj import checks
+    from lifelike_mj.cli.common import creature as _module
+    from lifelike_mj.export.scene import Part
+
+    if not isinstance(scene, dict):
+        where = f"scene file {scene}"
+        scene = load_scene(scene)
+    looks = scene.get("looks", "rig")
     planned, rows = [], 0
-    for part in scene["parts"]:  # every part checked and built, and its recording planned, before any runs
+    for part, args in check_scene(scene, where):  # every part checked, built and its recording planned before any runs
         at = f"{where}, part {part['name']!r}"
-        args = _parse_part(part, scene, at)
         try:
             window, parameters = _module(part["creature"]).export_window(args)
         except UserError as exc:

@@ -23,7 +23,7 @@ import numpy as np
 
 from lifelike_mj import checks
 from lifelike_mj.butterfly.flight3d import controllers as c3
-from lifelike_mj.butterfly.flight3d.flight import DT_S, MIN_STEPS_PER_BEAT
+from lifelike_mj.butterfly.flight3d.flight import DT_S, check_time_step
 from lifelike_mj.butterfly.flight3d.loop import TUMBLE_RAD, Batch
 from lifelike_mj.butterfly.flight3d.tasks import (
     DRYDEN_VERTICAL_RATIO,
@@ -121,19 +121,6 @@ def unnatural(st: dict, task: Task3D) -> float:
         if not slow:
             terms.append(over("body_angle_deg", abs(st["pitch_deg"] - body_angle_target_deg(task.rows[0][3]))))
     return sum(terms, 0.0)
-
-
-def check_time_step(dt_s: object, frequency_hz: float, what: str = "time step") -> float:
-    """``dt_s`` (s) as a float, or a :class:`~lifelike_mj.errors.UserError` unless it is positive and resolves a wing beat
-    of ``frequency_hz`` in at least :data:`~lifelike_mj.butterfly.flight3d.flight.MIN_STEPS_PER_BEAT` steps: the rule
-    (and the sentence) of :class:`~lifelike_mj.butterfly.flight3d.flight.Flight3D`, for a command or an evolution to
-    check before any flight begins. ``what`` names the time step (``"--dt"``)."""
-    dt = checks.positive(f"{what} dt_s" if what == "time step" else what, dt_s, "s")
-    period = 1.0 / float(frequency_hz)
-    if dt > period / MIN_STEPS_PER_BEAT:
-        raise UserError(f"{what} {dt:g} s does not resolve the {period:g} s wing beat: it must be at most "
-                        f"1/{MIN_STEPS_PER_BEAT} of it ({period / MIN_STEPS_PER_BEAT:g} s).")
-    return dt
 
 
 def _short(v: object) -> str:

@@ -68,6 +68,20 @@ STATE_UNITS = {
 
 #: The fewest time steps per wing beat a 3D flight accepts.
 MIN_STEPS_PER_BEAT = 8
+
+
+def check_time_step(dt_s: object, frequency_hz: float, what: str = "time step") -> float:
+    """``dt_s`` (s) as a float, or a :class:`~lifelike_mj.errors.UserError` unless it is positive and resolves a wing
+    beat of ``frequency_hz`` in at least :data:`MIN_STEPS_PER_BEAT` steps: the rule :class:`Flight3D` applies, and a
+    command or an evolution applies before any flight begins. ``what`` names the time step (``"--dt"``)."""
+    dt = checks.positive(f"{what} dt_s" if what == "time step" else what, dt_s, "s")
+    period = 1.0 / float(frequency_hz)
+    if dt > period / MIN_STEPS_PER_BEAT:
+        raise UserError(f"{what} {dt:g} s does not resolve the {period:g} s wing beat: it must be at most "
+                        f"1/{MIN_STEPS_PER_BEAT} of it ({period / MIN_STEPS_PER_BEAT:g} s).")
+    return dt
+
+
 #: A speed above this (m/s) is a runaway: the flight has diverged.
 RUNAWAY_M_S = 1e3
 
@@ -154,11 +168,7 @@ class Flight3D(StepCounter):
         if not isinstance(self.task, Task3D):
             raise UserError(f"a task is a Task3D (flight3d.level, turn, course), got {self.task!r}.")
         self.params = params or ButterflyParams()
-        self.dt = checks.positive("time step dt_s", dt_s, "s")
-        period = 1.0 / self.command.frequency_hz
-        if self.dt > period / MIN_STEPS_PER_BEAT:
-            raise UserError(f"time step {self.dt:g} s does not resolve the {period:g} s wing beat: it must be at most "
-                            f"1/{MIN_STEPS_PER_BEAT} of it ({period / MIN_STEPS_PER_BEAT:g} s).")
+        self.dt = check_time_step(dt_s, self.command.frequency_hz)
         if assist == "hold" and not callable(pitch_law):
             raise UserError("the attitude hold needs pitch_law, a function of the flight returning the pitch (rad).")
         self.controller, self.control_every = controller, checks.whole("control_every", control_every, 1)

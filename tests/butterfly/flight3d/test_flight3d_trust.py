@@ -18,6 +18,7 @@ from battery import check_refusal
 
 from lifelike_mj.butterfly.flight3d import controllers as c3
 from lifelike_mj.butterfly.flight3d import evolution as ev
+from lifelike_mj.butterfly.flight3d import flight as flight3d_flight
 from lifelike_mj.butterfly.flight3d.tasks import level
 from lifelike_mj.errors import UserError
 
@@ -203,7 +204,7 @@ def test_an_evolution_refuses_a_time_step_its_start_cannot_fly():
     fast = c3.controller_from_dict(FAST["c.json"])
     with pytest.raises(UserError, match="dt_s 0.005 s does not resolve the 0.02 s wing beat"):
         ev.FlightProblem3D((level(1.0),), fast, dt_s=0.005)
-    assert ev.check_time_step(0.0024, 50.0) == 0.0024
+    assert flight3d_flight.check_time_step(0.0024, 50.0) == 0.0024
 
 
 # ---- 4. flags are bools ---------------------------------------------------------------------------------------------
