@@ -182,9 +182,11 @@ class Sweep:
 
 
 def run_sweep(sweep: Sweep, values: list[list[float]], seeds, executor: str = "process", workers: int | None = None,
-              ray_address: str | None = None) -> dict:
+              ray_address: str | None = None, bar=None) -> dict:
     """Evaluate every combination of ``values`` (one list per axis) and ``seeds``; returns the rows
-    (one per combination and seed) and, per grid cell, the most frequent label."""
+    (one per combination and seed) and, per grid cell, the most frequent label. ``bar`` (a
+    :func:`~lifelike_mj.progress.bar`): counts the runs done, the rows being handed to the executor in about ten
+    batches (each row's run depends on the row alone, so the batches change no result)."""
     import itertools
 
     from lifelike_mj.evolve import make_evaluator
@@ -193,7 +195,14 @@ def run_sweep(sweep: Sweep, values: list[list[float]], seeds, executor: str = "p
     rows = np.array([[*g, s] for g in grid for s in seeds], dtype=float)
     sweep.check_cells(values)
     with make_evaluator(sweep, executor=executor, workers=workers, ray_address=ray_address) as ev:
-        res = ev(rows)
+        if bar is None:
+            res = ev(rows)
+        else:
+            chunk = max(1, -(-len(rows) // 10))
+            res = []
+            for k in range(0, len(rows), chunk):
+                res.extend(ev(rows[k : k + chunk]))
+                bar.update(len(rows[k : k + chunk]))
     table = []
     for row, r in zip(rows, res):
         d = {a: float(v) for a, v in zip(sweep.axes, row[:-1])}

@@ -139,9 +139,10 @@ def reproduce_boids(out: str | Path, seeds=SEEDS, executor: str = "process", wor
     # phase diagram over the cross-type weights, diagonal of 5a (W_a = 0.5, W_c = 0.01)
     xa = [float(x) for x in np.linspace(-0.3, 0.5, phase_steps)]
     yc = [float(x) for x in np.linspace(-0.01, 0.01, phase_steps)]
-    with st.next(f"phase diagram over the cross-type weights ({phase_steps} x {phase_steps} runs)"):
+    with st.next(f"phase diagram over the cross-type weights ({phase_steps} x {phase_steps} runs)",
+                 total=len(xa) * len(yc), unit="run") as b:
         ph = run_sweep(Sweep(load_preset("5a"), ("wa_cross", "wc_cross")), [xa, yc], [0], executor=executor,
-                       workers=workers)
+                       workers=workers, bar=b)
     lab = np.array([[ph["majority"][f"{a:g},{b:g}"] for a in xa] for b in yc])
     phase_diagram_figure(lab, xa, yc, "cross-type alignment w_aAB = w_aBA", "cross-type cohesion w_cAB = w_cBA",
                          out / "phase_diagram.png",

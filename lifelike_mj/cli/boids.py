@@ -156,9 +156,9 @@ def cmd_sweep(args) -> None:
                 "agent-steps", "fewer cells, seeds, agents or steps")
     sweep.check_cells(values)  # bad axes or weights: one sentence before the progress bar starts
     check_outputs(args, folders={"--out": ("sweep.json", "phase_diagram.png")})
-    with stage(f"sweep: {n_runs} runs on {args.executor}"):
+    with stage(f"sweep: {n_runs} runs on {args.executor}", total=n_runs, unit="run") as b:
         res = run_sweep(sweep, values, seed_list, executor=args.executor, workers=args.workers,
-                        ray_address=args.ray_address)
+                        ray_address=args.ray_address, bar=b)
     if args.out:
         write_sweep(res, sweep, values, args.out)
     counts: dict[str, int] = {}
