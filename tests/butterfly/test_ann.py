@@ -126,7 +126,7 @@ def test_controller_file_round_trip_and_bad_weight_count(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv, needle", [
-    (["butterfly", "evolve", "--optimizer", "nonsense", "--generations", "1"], "invalid choice: 'nonsense'"),
+    (["butterfly", "evolve", "--optimizer", "nonsense", "--generations", "1"], "--optimizer 'nonsense' is not one of"),
     (["butterfly", "evolve", "--optimizer", "rcga", "--population", "2", "--generations", "1"], "minimum"),
     (["butterfly", "evolve", "--optimizer", "rcga", "--task", "elsewhere", "--generations", "1"], "unknown task"),
     (["butterfly", "windmap", "--controller", "simple_rule"], "network"),

@@ -149,6 +149,7 @@ def test_a_usdz_package_holds_the_rigs_textures_which_its_materials_read(runs, t
     (the same pixels) at the mesh's ``st``; usd-core's validators (the package's among them) find nothing. A
     ``.usdc`` of the same run holds no image (its looks take the mean colour)."""
     import io
+    import posixpath
     import zipfile
 
     from PIL import Image
@@ -168,7 +169,7 @@ def test_a_usdz_package_holds_the_rigs_textures_which_its_materials_read(runs, t
         for prim in stage.Traverse():
             shader = UsdShade.Shader(prim)
             if prim.GetTypeName() == "Shader" and shader.GetIdAttr().Get() == "UsdUVTexture":
-                file = shader.GetInput("file").Get().path
+                file = posixpath.normpath(shader.GetInput("file").Get().path)  # relative to the stage, its root
                 look = prim.GetParent().GetName()
                 read[look] = np.asarray(Image.open(io.BytesIO(z.read(file))).convert("RGBA"))
                 surface = UsdShade.Shader(prim.GetParent().GetChild("surface"))
