@@ -59,3 +59,14 @@ def test_a_flock_too_dense_to_step_is_refused_before_any_work(tmp_path, monkeypa
     with pytest.raises(UserError, match="10,000,000 agents in a box 20 units wide"):
         boids.Flock(n=MAX_FLOCK).record(10)
     boids.Flock(n=300).step(10)  # the paper's flock is far inside the bound
+
+
+def test_a_flock_is_checked_as_the_command_line_checks_it():
+    from lifelike_mj import boids
+
+    with pytest.raises(UserError, match="seed must be a whole number from 0 to 4294967295, got 1180591620717411303424"):
+        boids.Flock(seed=2**70)
+    with pytest.raises(UserError, match="params must be BoidParams"):
+        boids.Flock(params="5a")
+    with pytest.raises(UserError, match="seed must be a whole number from 0 to 4294967295, got -1"):
+        boids.Flock(n=10).reset(seed=-1)

@@ -52,9 +52,11 @@ class Flock(StepCounter):
             from lifelike_mj.boids.presets import load_preset
 
             params = load_preset("5a")
+        if not isinstance(params, BoidParams):
+            raise UserError(f"params must be BoidParams (boids.load_preset('5a'), or BoidParams(...)), got {params!r}.")
         self.params = params
         self._n0 = checks.whole("the number of agents", n, 2, MAX_FLOCK)
-        self._seed = checks.whole("seed", seed, 0)
+        self._seed = checks.whole("seed", seed, 0, 2**32 - 1)
         self.reset()
 
     # ---- the stepper shape ---------------------------------------------------------------------
@@ -76,7 +78,7 @@ class Flock(StepCounter):
         """Back to a random start (:func:`~lifelike_mj.boids.engine.initial_state`) with ``seed`` (or the
         flock's own), ``n`` agents as built."""
         if seed is not None:
-            self._seed = checks.whole("seed", seed, 0)
+            self._seed = checks.whole("seed", seed, 0, 2**32 - 1)
         x, v, self.types = initial_state(self.params, self._n0, self._seed)
         self._x, self._v = _as3(x), _as3(v)
         self._k = 0
