@@ -36,7 +36,10 @@ def test_the_largest_flock_steps_and_is_measured():
     any work, since each agent would see about 48,000 neighbours."""
     from lifelike_mj import boids
     from lifelike_mj.boids import metrics as M
-    from lifelike_mj.cli.boids import MAX_AGENTS
+    from lifelike_mj.boids.sim import MAX_FLOCK as MAX_AGENTS
+    from lifelike_mj.cli.boids import MAX_AGENTS as CLI_MAX
+
+    assert CLI_MAX == MAX_AGENTS  # one bound for both faces
 
     wide = replace(boids.load_preset("5a"), box=300.0)
     f = boids.Flock(wide, n=MAX_AGENTS, seed=0)
@@ -56,8 +59,10 @@ def test_a_flock_too_dense_to_step_is_refused_before_any_work(tmp_path, monkeypa
 
     check_refusal(["boids", "run", "--n", "1000000", "--steps", "10"], "4.77e+11 neighbour visits over 10 steps",
                   {}, tmp_path, monkeypatch, capsys)
-    with pytest.raises(UserError, match="10,000,000 agents in a box 20 units wide"):
+    with pytest.raises(UserError, match="1,000,000 agents in a box 20 units wide"):
         boids.Flock(n=MAX_FLOCK).record(10)
+    with pytest.raises(UserError, match="the number of agents must be a whole number from 2 to 1000000"):
+        boids.Flock(n=MAX_FLOCK + 1)
     boids.Flock(n=300).step(10)  # the paper's flock is far inside the bound
 
 

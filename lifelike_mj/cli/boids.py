@@ -22,7 +22,7 @@ from lifelike_mj.errors import UserError
 NAME = "boids"
 #: Bounds of the command line: agents, steps, and values of a sweep axis (agents x steps:
 #: :data:`~lifelike_mj.checks.MAX_AGENT_STEPS` per run, :data:`~lifelike_mj.checks.MAX_SWEEP_AGENT_STEPS` per sweep).
-MAX_AGENTS = 1_000_000
+MAX_AGENTS = 1_000_000  # boids.sim.MAX_FLOCK, written out so that --help imports no engine (a test holds them equal)
 MAX_STEPS = 1_000_000
 MAX_AXIS_VALUES = 1_000
 RUN_FILES = ("trajectories.npz", "trajectories.csv", "measures.json")
