@@ -65,3 +65,25 @@ def check_refusal(argv, needle, files, tmp_path, monkeypatch, capsys) -> None:
     assert "Traceback" not in err and out == ""
     assert elapsed < 10, f"{elapsed:.1f} s to refuse {argv}"
     assert snapshot(tmp_path) == before, "something was written"
+
+
+def check_python_refusal(call, needle: str, error: type = None) -> None:
+    """Call ``call()`` (a Python surface given bad input): a :class:`~lifelike_mj.errors.UserError` (or ``error``) in one
+    sentence holding ``needle``, within 10 s (an alarm at 30 s catches a hang: a loop without a bound)."""
+    from lifelike_mj.errors import UserError
+
+    old = signal.signal(signal.SIGALRM, _alarm)
+    signal.alarm(30)
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises(error or UserError) as info:
+            call()
+    except _Hang:
+        pytest.fail(f"no answer within 30 s: {call}")
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+    text = str(info.value)
+    assert needle in text, (needle, text)
+    assert "\n" not in text and text.endswith((".", "?).")), text
+    assert time.perf_counter() - t0 < 10, f"{time.perf_counter() - t0:.1f} s to refuse {call}"

@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 import pytest
-from battery import check_refusal
+from battery import check_python_refusal, check_refusal
 
 from lifelike_mj.cli import main
 from lifelike_mj.errors import UnknownName, UserError
@@ -150,19 +150,25 @@ def test_gardens_that_fit_are_drawn_as_before():
             assert np.array_equal(place_flowers(seed, n, size), before(seed, n, size))
 
 
-def test_geometry_that_cannot_be_is_refused():
+PYTHON_CASES = [
+    # geometry that cannot be
+    (lambda f: f.Flight3D(flowers=[(0, 0, 0), (1, 0, -5)]), "flower 1's blossom at z = -5 m is not above the ground at -4 m"),
+    (lambda f: f.Flight3D(flowers=[(0, 0, 0.01)], ground_m=0.0), "not above the ground at 0 m"),
+    # a flag is a bool
+    (lambda f: f.Flight3D(contact="no"), "contact must be True or False, got 'no'"),
+    (lambda f: f.Flight3D(end_on_tumble=1), "end_on_tumble must be True or False, got 1"),
+    (lambda f: f.Garden(2, land="false"), "land must be True or False, got 'false'"),
+    # flowers that cannot fit, from Python: no hang
+    (lambda f: f.Garden(2, n_flowers=200, size_m=2.0), "n_flowers 200 cannot be met: a 2 m square (size_m) holds at most 4"),
+    (lambda f: f.place_flowers(0, 10, 2.0), "n 10 cannot be met"),
+]
+
+
+@pytest.mark.parametrize("call, needle", PYTHON_CASES, ids=[c[1][:40] for c in PYTHON_CASES])
+def test_geometry_that_cannot_be_is_refused(call, needle):
     from lifelike_mj.butterfly import flight3d
 
-    with pytest.raises(UserError, match="flower 1's blossom at z = -5 m is not above the ground at -4 m"):
-        flight3d.Flight3D(flowers=[(0, 0, 0), (1, 0, -5)])
-    with pytest.raises(UserError, match="not above the ground at 0 m"):
-        flight3d.Flight3D(flowers=[(0, 0, 0.01)], ground_m=0.0)
-    with pytest.raises(UserError, match="contact must be True or False, got 'no'"):
-        flight3d.Flight3D(contact="no")
-    with pytest.raises(UserError, match="end_on_tumble must be True or False, got 1"):
-        flight3d.Flight3D(end_on_tumble=1)
-    with pytest.raises(UserError, match="land must be True or False, got 'false'"):
-        flight3d.Garden(2, land="false")
+    check_python_refusal(lambda: call(flight3d), needle)
 
 
 def test_a_usdz_package_is_written_without_warnings(tmp_path, monkeypatch, capfd):
