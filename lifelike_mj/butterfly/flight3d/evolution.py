@@ -362,8 +362,9 @@ class FlightProblem3D:
         return [start_blossom(self.template.animal)] + [tuple(float(v) for v in blossom_under(t.rows[0][:3]))
                                                         for t in self.tasks if t.kind == "land"]
 
-    def fly(self, W: np.ndarray) -> np.ndarray:
-        """Run records ``(n, len(tasks), ...)`` of the weights ``W`` (rows) on every task."""
+    def fly(self, W: np.ndarray, steps: int | None = None) -> np.ndarray:
+        """Run records ``(n, len(tasks), ...)`` of the weights ``W`` (rows) on every task (``steps``: that many
+        steps of each flight instead of its whole duration)."""
         from lifelike_mj.butterfly.flight3d import model as mj3d
         from lifelike_mj.butterfly.flight3d.kinematics import Kinematics
 
@@ -381,8 +382,14 @@ class FlightProblem3D:
             start_take_off(records, 0.0)
         batch = Batch(m, datas, tasks, ctl, weights=np.repeat(self.all_weights(W), k, axis=0), dt_s=self.dt_s,
                       records=records, tumble_rad=TUMBLE_RAD)
-        batch.advance(int(round(self.duration_s / self.dt_s)))
+        batch.advance(int(round(self.duration_s / self.dt_s)) if steps is None else int(steps))
         return batch.records.reshape(len(W), k, -1)
+
+    def compile_here(self) -> None:
+        """Compile the flights' kernels in this process, saying so on a first run (a cold cache): two candidates flown
+        one step. A pool's workers started after it load them from the cache instead of each compiling its own in
+        silence (about 20-40 s each on two cores)."""
+        self.fly(np.zeros((2, len(self.prior))), steps=1)
 
     def evaluate(self, X: np.ndarray) -> np.ndarray:
         X = np.atleast_2d(np.asarray(X, dtype=np.float64))
@@ -615,6 +622,8 @@ def evolve(tasks=None, out: str | Path = "butterfly3d.json", *, optimizer: str =
     out = Path(out)
     with guarded_run_files(out, checkpoint, resume=resume, overwrite=overwrite) as ckpt:
         started_here = not (resume and ckpt.exists())
+        if executor != "serial":
+            problem.compile_here()
         with make_evaluator(problem, executor=executor, workers=workers, ray_address=ray_address) as ev:
             spread = _Spread(ev)
             res = optimize(problem, optimizer, seed=seed, population=population, generations=generations,
