@@ -75,9 +75,12 @@ def test_sweep_same_table_on_ray():
     ray = pytest.importorskip("ray")
     sweep = Sweep(load_preset("4c"), ("wc_cross",), n=80, n_steps=200)
     a = run_sweep(sweep, [[0.002, 0.006]], [3], executor="serial")
-    ray.init(num_cpus=2, include_dashboard=False)
+    started = not ray.is_initialized()  # another test of this process may have left its cluster running
+    if started:
+        ray.init(num_cpus=2, include_dashboard=False)
     try:
         b = run_sweep(sweep, [[0.002, 0.006]], [3], executor="ray", workers=2)
     finally:
-        ray.shutdown()
+        if started:
+            ray.shutdown()
     assert a["rows"] == b["rows"] and len(a["rows"]) == 2
