@@ -228,7 +228,7 @@ def read_json(path: str | Path, what: str, max_bytes: int | None = None) -> obje
     try:
         size = p.stat().st_size
         if size <= limit:
-            return json.loads(p.read_text(encoding="utf-8"), parse_constant=_no_constant)
+            return json.loads(p.read_text(encoding="utf-8"), parse_constant=_no_constant, object_pairs_hook=_no_twins)
     except FileNotFoundError:
         raise UserError(f"{what} file {p} does not exist.") from None
     except UnicodeDecodeError:
@@ -252,6 +252,17 @@ def load_named_json(creature: str, name_or_path: str | Path, what: str) -> tuple
     """:func:`resolve` then :func:`read_json`: ``(data, path)``."""
     path = resolve(creature, name_or_path, what)
     return read_json(path, what), path
+
+
+def _no_twins(pairs: list) -> dict:
+    """An object whose keys are each given once (JSON allows a repeated key, and Python's reader keeps the last,
+    silently: a file that says a thing twice says nothing clear)."""
+    seen = {}
+    for k, v in pairs:
+        if k in seen:
+            raise _NotStrict(f"the key {k!r} is given twice in one object")
+        seen[k] = v
+    return seen
 
 
 class _NotStrict(ValueError):

@@ -384,7 +384,8 @@ def add_commands(bf) -> None:
                         "many s after a take-off (unless given: the start's, else 0.6 m and 1 s)")
     p.add_argument("--gene-bound", type=num(0, 10, lo_open=True), default=0.4,
                    help="bound of each gene (a weight's change from the start)")
-    p.add_argument("--hidden", type=_hidden, default=[], help="hidden layer sizes, e.g. 16 (default: none, a linear network)")
+    p.add_argument("--hidden", type=_hidden, default=[],
+                   help="hidden layer sizes, e.g. 16 or 16,8 (default, 0 or none: no hidden layer, a linear network)")
     p.add_argument("--population", type=count(2, 100_000), default=16, help="population size")
     p.add_argument("--generations", type=count(1, 1_000_000), default=300, help="generations")
     p.add_argument("--duration", type=num(0, 60, lo_open=True, unit="s"), default=4.0,

@@ -62,8 +62,11 @@ def add_window(p: argparse.ArgumentParser, max_s: float, default_s: float) -> No
 
     p.add_argument("--start", type=num(0, max_s, unit="s"), default=0.0,
                    help="seconds simulated before the exported window starts")
+    from lifelike_mj.checks import MAX_FRAMES
+
     p.add_argument("--duration", type=num(0, max_s, lo_open=True, unit="s"), default=default_s,
-                   help=f"seconds exported, at most {max_s:g}")
+                   help=f"seconds exported, at most {max_s:g}, and at most {MAX_FRAMES:,} frames of --fps "
+                        f"({MAX_FRAMES / 30:g} s at 30 frames/s)")
     p.add_argument("--fps", type=count(1, 240), default=30,
                    help="playback frames per second, 1 to 240: the scene's frame rate (keys fall where the motion "
                         "needs them, --key-tolerance)")

@@ -65,8 +65,8 @@ def json_schema() -> dict:
         "still": {"type": "boolean", "description": "draw the part's still geoms (tank, flowers; default true)"},
         "follow": {"type": "array", "items": {"type": "string", "maxLength": 100}, "maxItems": 16, "uniqueItems": True,
                    "description": "the creatures (rig names) that get a follow camera"}}}
-    props = {"duration_s": number("seconds of playback every part is recorded for", exclusive_minimum=0,
-                                  maximum=MAX_DURATION_S),
+    props = {"duration_s": number("seconds of playback every part is recorded for (and at most 36,000 frames of fps)",
+                                  exclusive_minimum=0, maximum=MAX_DURATION_S),
              "fps": {"type": "integer", "minimum": 1, "maximum": 240, "description": "playback frames per second"},
              "ground_half_m": {"anyOf": [number("", exclusive_minimum=0, maximum=10_000), {"type": "null"}],
                                "description": "the ground's half size, m (null: no scene ground)"},

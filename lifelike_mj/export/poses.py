@@ -122,7 +122,8 @@ def frames_of(duration_s: float, fps: float, unit: str = "s") -> int:
     if n < 2:
         raise UserError(f"a window of {duration_s:g} {unit} at {fps:g} frames per {unit} holds a single frame; give "
                         "more time or frames.")
-    return checks.work(f"a window of {duration_s:g} {unit} at {fps:g} frames per {unit}", n, checks.MAX_FRAMES,
+    # MAX_FRAMES frames of playback: ten minutes at 60 per second, whose first and last frames both count
+    return checks.work(f"a window of {duration_s:g} {unit} at {fps:g} frames per {unit}", n, checks.MAX_FRAMES + 1,
                        "frames", "a shorter window or fewer frames per second")
 
 

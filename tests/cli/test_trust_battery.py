@@ -98,7 +98,7 @@ CASES = [
     # --- export: windows and sizes before any simulation
     (["export", "fish", "--out", "a.glb", "--start", "3000", "--duration", "0.01"], "holds a single frame", {}),
     (["export", "fish", "--out", "a.glb", "--duration", "1201", "--fps", "30"], "asks for 36,031 frames; at most "
-     "36,000", {}),
+     "36,001", {}),
     (["export", "butterfly3d", "--out", "a.glb", "--garden", "500", "--start", "1662", "--duration", "5"],
      "asks for 1,000,200,000 body-steps; at most 1,000,000,000", {}),
     (["export", "boids", "--out", "a.glb", "--n", "2000", "--start", "997001", "--steps", "3000"],

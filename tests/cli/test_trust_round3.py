@@ -50,6 +50,8 @@ CASES = [
     # --- every part checked, its recording planned, before the first part runs
     (SCENE, "part 'two': recording", {"s.json": scene(FISH, dict(FISH, name="two", options={"fish": 3000}),
                                                       duration_s=300, fps=60)}),
+    (SCENE, "is not strict JSON (the key 'duration_s' is given twice in one object)",
+     {"s.json": '{"format": "lifelike-mj/scene", "version": 1, "duration_s": 1, "duration_s": 2, "parts": []}'}),
     # --- messages that say what is wrong
     (SCENE, "scene file s.json does not exist", {}),
     (SCENE, "scene file s.json is a folder, not a file", {"s.json/": None}),
@@ -161,6 +163,7 @@ PYTHON_CASES = [
     # flowers that cannot fit, from Python: no hang
     (lambda f: f.Garden(2, n_flowers=200, size_m=2.0), "n_flowers 200 cannot be met: a 2 m square (size_m) holds at most 4"),
     (lambda f: f.place_flowers(0, 10, 2.0), "n 10 cannot be met"),
+    (lambda f: f.Flight3D(params=5), "params must be ButterflyParams, got 5"),
 ]
 
 
@@ -183,3 +186,13 @@ def test_a_usdz_package_is_written_without_warnings(tmp_path, monkeypatch, capfd
     assert "Warning" not in err and "Failed to resolve" not in err, err
     names = zipfile.ZipFile(tmp_path / "f.usdz").namelist()
     assert names[0] == "stage.usdc" and any(n.startswith("textures/") and n.endswith(".png") for n in names), names
+
+
+def test_the_documented_longest_window_is_allowed():
+    """``--duration`` and ``--fps`` at their joint maximum: ten minutes at 60 frames per second is 36,001 frames with
+    the first and the last, and is allowed; one frame more is not."""
+    from lifelike_mj.export.poses import frames_of
+
+    assert frames_of(600.0, 60.0) == 36_001 and frames_of(1200.0, 30.0) == 36_001
+    with pytest.raises(UserError, match="asks for 36,002 frames; at most 36,001"):
+        frames_of(600.0 + 1 / 60, 60.0)

@@ -167,7 +167,9 @@ class Flight3D(StepCounter):
         self.task = task if task is not None else level(1.5)
         if not isinstance(self.task, Task3D):
             raise UserError(f"a task is a Task3D (flight3d.level, turn, course), got {self.task!r}.")
-        self.params = params or ButterflyParams()
+        self.params = params if params is not None else ButterflyParams()
+        if not isinstance(self.params, ButterflyParams):
+            raise UserError(f"params must be ButterflyParams, got {self.params!r}.")
         self.dt = check_time_step(dt_s, self.command.frequency_hz)
         if assist == "hold" and not callable(pitch_law):
             raise UserError("the attitude hold needs pitch_law, a function of the flight returning the pitch (rad).")
