@@ -118,7 +118,7 @@ BAD = [
     (lambda **kw: __import__("lifelike_mj.fish", fromlist=["Tank"]).Tank(n_fish=10**7), {}, UserError,
      "the number of fish must be a whole number from 1 to 5,000"),
     (lambda **kw: __import__("lifelike_mj.boids", fromlist=["Flock"]).Flock(n=10**8), {}, UserError,
-     "the number of agents must be a whole number from 2 to 10000000"),
+     "the number of agents must be a whole number from 2 to 1000000, got 100000000"),
     (_flock, {"seed": 1.5}, UserError, "seed"),
     (_flight, {"dt_s": 1e-12}, UserError, "at most 1,000,000,000"),
     (lambda **kw: _task(speed_m_s=1e300), {}, UserError, "speed_m_s must be a number in (0, 100]"),
