@@ -16,6 +16,7 @@ Every failure is one sentence (:class:`~lifelike_mj.errors.UserError`) naming th
 from __future__ import annotations
 
 import functools
+import json
 import math
 from collections.abc import Callable, Iterable, Sequence
 
@@ -28,8 +29,10 @@ def check_header(data: object, fmt: str, where: str, versions: Iterable[int] = (
     ``versions``; else one sentence."""
     if not isinstance(data, dict):
         raise UserError(f"{where} is not a {kind}: it holds a JSON {type(data).__name__}, not an object.")
+    if "format" not in data:
+        raise UserError(f"{where} is not a {kind}: it has no \"format\" key (a {kind} says \"format\": \"{fmt}\").")
     if data.get("format") != fmt:
-        raise UserError(f"{where} is not a {kind} (its format is {data.get('format')!r}, expected {fmt!r}).")
+        raise UserError(f"{where} is not a {kind} (its format is {_json(data.get('format'))}, expected {fmt!r}).")
     versions = tuple(versions)
     v = data.get("version", 1)
     if not checks.is_whole(v) or v not in versions:
@@ -196,6 +199,25 @@ def _show(value: object) -> str:
     return text if len(text) <= 60 else text[:45] + " ... " + text[-10:]
 
 
+def _json(value: object) -> str:
+    """``value`` as the file spells it (``null``, ``true``), shortened for a sentence."""
+    try:
+        text = json.dumps(value, allow_nan=False)
+    except (TypeError, ValueError):
+        text = repr(value)
+    return text if len(text) <= 60 else text[:45] + " ... " + text[-10:]
+
+
+def _branch(schema: dict) -> str:
+    """One alternative of an ``anyOf`` in words: a number's range, ``a text``, ``true or false``, ``a list``,
+    ``null``."""
+    t = schema.get("type")
+    if t in ("number", "integer") or (isinstance(t, list) and ("number" in t or "integer" in t)):
+        return _kind(schema)
+    return {"string": "a text", "boolean": "true or false", "array": "a list of numbers", "object": "an object",
+            "null": "null"}.get(t if isinstance(t, str) else "", "another value")
+
+
 def _kind(schema: dict) -> str:
     """What ``schema`` asks for, in words: ``a number in [0, 3.14159]``, ``a whole number of at least 1``."""
     t = schema.get("type")
@@ -248,6 +270,11 @@ def sentence(err, where: str) -> str:
         return f"{at} must be {' or '.join(_show(a) for a in allowed)}, got {_show(inst)}."
     if v in ("minLength", "maxLength"):
         return f"{at} must be a text of {v.removesuffix('Length')}imum {err.validator_value} characters."
+    if v in ("anyOf", "oneOf") and isinstance(err.validator_value, list):
+        words = [_branch(b) for b in err.validator_value if isinstance(b, dict)]
+        return f"{at} must be {' or '.join(w for i, w in enumerate(words) if w not in words[:i])}, got {_json(inst)}."
+    if v == "uniqueItems":
+        return f"{at} must not list an item twice, got {_json(inst)}."
     if v == X_ARRAY:
         return f"{at}: {err.message}."
     if v is None:  # a false schema: the key may not appear here

@@ -120,7 +120,7 @@ def _matrix(name: str, m) -> np.ndarray:
         raise UserError(f"{name} must be a square k x k matrix (one row and column per type, at most {MAX_TYPES} "
                         f"types), got shape {a.shape}.")
     if not np.all(np.isfinite(a)) or np.any(np.abs(a) > MAX_WEIGHT):
-        raise UserError(f"{name} must contain finite numbers within +-{MAX_WEIGHT:g}.")
+        raise UserError(f"{name} must contain finite numbers within +-{MAX_WEIGHT:g}, got {a.tolist()!r}.")
     return a
 
 

@@ -196,3 +196,16 @@ def test_the_documented_longest_window_is_allowed():
     assert frames_of(600.0, 60.0) == 36_001 and frames_of(1200.0, 30.0) == 36_001
     with pytest.raises(UserError, match="asks for 36,002 frames; at most 36,001"):
         frames_of(600.0 + 1 / 60, 60.0)
+
+
+@pytest.mark.parametrize("scene_text, needle", [
+    ('{"format": "lifelike-mj/scene", "version": 1, "duration_s": 1, "parts": [{"name": "a", "creature": "fish", '
+     '"options": {"n": null}}]}', "parts[0].options.n must be a text or a finite number or true or false or a list of "
+                                  "numbers, got null"),
+    ('{"format": "lifelike-mj/scene", "version": 1, "duration_s": 1, "parts": [{"name": "a", "creature": "fish", '
+     '"follow": ["x", "x"]}]}', 'parts[0].follow must not list an item twice, got ["x", "x"]'),
+    ('{"version": 1, "duration_s": 1, "parts": []}', 'it has no "format" key'),
+])
+def test_a_malformed_scene_is_named_in_the_files_own_words(scene_text, needle, tmp_path, monkeypatch, capsys):
+    """The sentence speaks JSON (null, true, double quotes), not Python (None, True)."""
+    check_refusal(SCENE, needle, {"s.json": scene_text}, tmp_path, monkeypatch, capsys)

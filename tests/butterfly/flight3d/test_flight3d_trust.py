@@ -250,7 +250,7 @@ PLANAR = {"format": "lifelike-mj/butterfly-controller", "type": "constant", "par
     ("3D controller file c.json is not a JSON file", "x,y\n1,2\n"),
     ("not strict JSON (NaN", json.dumps(ctrl()).replace('"weights": [', '"weights": [NaN, ', 1)),
     ("must be a number in [-1e+06, 1e+06], got inf", json.dumps(ctrl()).replace('"weights": [', '"weights": [1e999, ', 1)),
-    ("file c is not a 3D controller file (its format is 'lifelike-mj/butterfly-controller'", PLANAR),
+    ("file c is not a 3D controller file (its format is \"lifelike-mj/butterfly-controller\"", PLANAR),
     ("file c is not a 3D controller file: it holds a JSON list", [1, 2]),
     ("modes.take_off has an unknown key 'from_m'",
      ctrl(modes={"take_off": {"weights": [0.0] * N, "from_m": 1.0}})),
