@@ -88,11 +88,10 @@ def nearest_neighbour_m(positions) -> np.ndarray:
         return np.full((T, F), np.nan)
     out = np.empty((T, F))
     if F <= TREE_MIN_FISH:
-        step = max(1, PAIR_CHUNK_BYTES // (24 * F * F))
-        for a in range(0, T, step):
-            d = np.linalg.norm(p[a : a + step, :, None, :] - p[a : a + step, None, :, :], axis=-1)
+        for a, b in _chunks(T, 24 * F * F):
+            d = np.linalg.norm(p[a:b, :, None, :] - p[a:b, None, :, :], axis=-1)
             d[:, np.arange(F), np.arange(F)] = np.inf
-            out[a : a + step] = d.min(axis=2)
+            out[a:b] = d.min(axis=2)
         return out
     from scipy.spatial import cKDTree
 
@@ -108,17 +107,18 @@ def nearest_neighbour_m(positions) -> np.ndarray:
     return out
 
 
-def _row_blocks(F: int):
-    """Blocks of rows ``(start, stop)`` of an ``F x F`` table of 3-vectors within :data:`PAIR_CHUNK_BYTES`."""
-    step = max(1, PAIR_CHUNK_BYTES // (24 * F))
-    return ((a, min(a + step, F)) for a in range(0, F, step))
+def _chunks(n: int, bytes_each: int):
+    """``(start, stop)`` of chunks of ``n`` items (frames, or rows of fish) of ``bytes_each`` bytes each, every chunk
+    within :data:`PAIR_CHUNK_BYTES`."""
+    step = max(1, PAIR_CHUNK_BYTES // max(1, bytes_each))
+    return ((a, min(a + step, n)) for a in range(0, n, step))
 
 
 def _nearest_all_pairs(q: np.ndarray) -> np.ndarray:
     """:func:`nearest_neighbour_m` of one frame ``q`` (F, 3) over all pairs, a block of fish at a time."""
     F = q.shape[0]
     out = np.empty(F)
-    for a, b in _row_blocks(F):
+    for a, b in _chunks(F, 24 * F):
         d = np.linalg.norm(q[a:b, None, :] - q[None, :, :], axis=-1)
         d[np.arange(b - a), np.arange(a, b)] = np.inf
         out[a:b] = d.min(axis=1)
@@ -220,7 +220,7 @@ def neighbour_frame(positions, head) -> tuple[np.ndarray, np.ndarray]:
         return np.zeros((0, 2)), np.zeros(0)
     i, j = np.nonzero(~np.eye(F, dtype=bool))
     rels, dphis = [np.zeros((0, 2))], [np.zeros(0)]
-    for a, b in _frame_chunks(T, 128 * i.size):
+    for a, b in _chunks(T, 128 * i.size):
         d = p[a:b, j] - p[a:b, i]  # (frames, P, 2)
         hi, hj = h[a:b, i], h[a:b, j]
         ahead = d[..., 0] * hi[..., 0] + d[..., 1] * hi[..., 1]
@@ -233,19 +233,13 @@ def neighbour_frame(positions, head) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(rels), np.concatenate(dphis)
 
 
-def _frame_chunks(T: int, bytes_per_frame: int):
-    """Chunks of frames ``(start, stop)`` of ``T`` frames, each within :data:`PAIR_CHUNK_BYTES`."""
-    step = max(1, PAIR_CHUNK_BYTES // max(1, bytes_per_frame))
-    return ((a, min(a + step, T)) for a in range(0, T, step))
-
-
 def _pair_distances_m(positions: np.ndarray, head: np.ndarray) -> np.ndarray:
     """The 3D distances (m) between the centres of every ordered pair of fish whose two headings exist, sample by
     sample (as :func:`neighbour_frame` orders them), in chunks of frames."""
     T, F, _ = positions.shape
     i, j = np.nonzero(~np.eye(F, dtype=bool))
     out = [np.zeros(0)]
-    for a, b in _frame_chunks(T, 64 * i.size):
+    for a, b in _chunks(T, 64 * i.size):
         d3 = np.linalg.norm(positions[a:b, j] - positions[a:b, i], axis=-1)  # (frames, P)
         ok = np.isfinite(head[a:b, i, 0]) & np.isfinite(head[a:b, j, 0])
         out.append(d3[ok])
@@ -450,7 +444,7 @@ def _pairs_within(p: np.ndarray, link_m: float) -> tuple[np.ndarray, np.ndarray]
         keep = np.linalg.norm(p[cand[:, 1]] - p[cand[:, 0]], axis=-1) <= link_m
         return cand[keep, 0], cand[keep, 1]
     A, B = [none], [none]
-    for lo, hi in _row_blocks(F):
+    for lo, hi in _chunks(F, 24 * F):
         near = np.linalg.norm(p[lo:hi, None, :] - p[None, :, :], axis=-1) <= link_m
         r, c = np.nonzero(near)
         r = r + lo
