@@ -363,10 +363,11 @@ def add_commands(bf) -> None:
     p.add_argument("--animal", default=None, choices=("swallowtail", "monarch"),
                    help="the butterfly: swallowtail (the paper's triangular wings) or monarch (measured wings, masses "
                         "and stroke plane); default: the start's, else swallowtail")
-    p.add_argument("--force-law", default=None, choices=("exact", "strip", "quasi_steady"),
+    p.add_argument("--force-law", default=None, choices=("exact", "strip", "quasi_steady", "calibrated"),
                    help="the wing-force law of the training flights, kept in the controller: exact (eq. 1 over the "
                         "outline), strip (eq. 1 on panels) or quasi_steady (blade elements with a revolving fruit-fly "
-                        "wing's coefficients); default: the start's, else exact")
+                        "wing's coefficients) or calibrated (the same, scaled to a filmed monarch's flight); "
+                        "default: the start's, else exact")
     p.add_argument("--natural", action="store_true",
                    help="also ask the flight to look like a butterfly's: level wings and even strokes in straight "
                         "flight, a dorsal gap of 35-50 deg, at most 20.2 W/kg, the body angle falling with speed")

@@ -70,7 +70,7 @@ INPUTS = ("ground", "air")
 MAX_SPEED_GAIN, MAX_BOOST_M_S = 100.0, 10.0
 #: The wing-force laws a controller can be evolved with and fly (those of the model's callback that act over the
 #: wing's area: :data:`~lifelike_mj.butterfly.flight3d.model.FORCE_LAWS` less ``none`` and the paper's ``tip``).
-FORCE_LAWS_FLOWN = ("exact", "strip", "quasi_steady")
+FORCE_LAWS_FLOWN = ("exact", "strip", "quasi_steady", "calibrated")
 #: The behaviour networks a controller may carry (module docstring), each with the name of its reach: ``land`` from
 #: ``from_m`` (m) out, ``take_off`` for ``for_s`` (s); and the reach a new one gets.
 MODES = {"land": "from_m", "take_off": "for_s"}
@@ -122,7 +122,8 @@ class Controller3D:
     (``omega_c_rad_s``) and what its speeds are measured against (``inputs``: ``"ground"`` or ``"air"``), with
     its provenance, the butterfly it flies (``animal``, one of
     :data:`~lifelike_mj.butterfly.flight3d.animals.ANIMALS`) and the wing-force law it was evolved with
-    (``force_law``: ``"exact"``, ``"strip"`` or ``"quasi_steady"``; flights take it unless told otherwise). Plain
+    (``force_law``: ``"exact"``, ``"strip"``, ``"quasi_steady"`` or ``"calibrated"``; flights take it unless told
+    otherwise). Plain
     data: :meth:`to_dict` / :func:`controller_from_dict`."""
 
     def __init__(self, layers, weights, base=None, scale: dict | None = None, every: int = 1,

@@ -117,7 +117,8 @@ class Flight3D(StepCounter):
     position.
     Model options: ``force_law`` (default the 3D controller's, else ``exact``; ``exact``: eq. 1 integrated exactly
     over each wing; ``strip``: eq. 1 on wing
-    panels; ``quasi_steady``: blade elements on the panels; ``tip``: the paper's tip-speed formula; ``none``),
+    panels; ``quasi_steady``: blade elements on the panels; ``calibrated``: the same scaled to a filmed monarch's flight,
+    :mod:`~lifelike_mj.butterfly.flight3d.calibrate`; ``tip``: the paper's tip-speed formula; ``none``),
     ``drag_frame`` (``body`` or ``world``), ``body_areas_m2`` (the body's drag areas along x, y, z; default the
     paper's ``A_b`` on every axis), ``masses`` (``animal`` or ``paper``), ``n_strips`` and ``n_chord`` (panels
     per wing, for the panel laws), ``drive_hz`` (the joints' tracking bandwidth), ``omega_c`` (rad/s, how

@@ -55,7 +55,8 @@ def _angle(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 def sample(flight, duration_s: float) -> dict:
     """Fly ``flight`` on for ``duration_s`` and return, at every time step: ``t_s``, the thorax's position (m),
     attitude (rad) and air velocity (m/s), the driven joints' angles (rad), rates (rad/s) and drive torques
-    (N m), and both wing tips' positions relative to the point between the hinges (m)."""
+    (N m), both wing tips' positions relative to the point between the hinges (m), and the air's whole force on the
+    wings and the body (N, world frame)."""
     from lifelike_mj.butterfly.flight3d import model as mj3d
     from lifelike_mj.butterfly.flight3d.flight import euler_from_quat
 
@@ -64,7 +65,7 @@ def sample(flight, duration_s: float) -> dict:
     tips = [m.site("wing_left_tip").id, m.site("wing_right_tip").id]
     wings = [m.body("wing_left").id, m.body("wing_right").id]
     out = {k: [] for k in ("t_s", "position_m", "attitude_rad", "air_velocity_m_s", "joints_rad", "rates_rad_s",
-                           "torques_N_m", "tips_m")}
+                           "torques_N_m", "tips_m", "air_force_N")}
     for k in range(n + 1):
         if k:
             flight.step(1)
@@ -80,6 +81,7 @@ def sample(flight, duration_s: float) -> dict:
         out["rates_rad_s"].append(d.qvel[v].copy())
         out["torques_N_m"].append(f["drive_torque_N_m"])
         out["tips_m"].append(np.stack([d.site_xpos[tips[0]] - hinge, d.site_xpos[tips[1]] - hinge]))
+        out["air_force_N"].append(f["wing_force_N"].sum(axis=0) + f["body_drag_N"])
     return {k: np.array(v) for k, v in out.items()}
 
 

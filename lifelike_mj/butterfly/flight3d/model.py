@@ -17,7 +17,10 @@ passive callback, which MuJoCo calls at every Runge-Kutta stage:
     at that point (the body's translation and rotation, flapping, feathering) less the wind; its
     component ``v_n`` along the wing's normal gives ``dF = -1/2 rho C_d dA v_n |v_n|`` along the normal.
     The force and its moment about the wing's hinge are summed over the panels.
-  - ``"quasi_steady"``: quasi-steady blade elements on the same panels (:func:`wing_panels`).
+  - ``"quasi_steady"``: quasi-steady blade elements on the same panels (:func:`wing_panels`), with a revolving
+    fruit-fly wing's coefficients.
+  - ``"calibrated"``: the same blade elements with the lift and drag scaled to the filmed monarch's flight
+    (:data:`CALIBRATED_QS`, :mod:`~lifelike_mj.butterfly.flight3d.calibrate`).
   - ``"tip"``: the paper's tip-speed formula (eq. 7-9), for the reduction to the planar flight:
     ``v' = L omega_flap - v_f sin(phi)`` with ``v_f`` the body's air-relative speed along its heading and
     ``phi`` its pitch; ``K/2 v'|v'|`` along the wing normal at the centre of pressure ``0.8 L``.
@@ -64,7 +67,7 @@ from lifelike_mj.physics.fluid import normal_drag_scalar, triangle_sq_abs
 #: Wing-force laws of the 3D callback: none (gravity and the drive only), the paper's tip-speed
 #: formula, eq. 1 on panels, the quasi-steady blade elements on panels, eq. 1 integrated exactly over the
 #: wing's triangle.
-FORCE_LAWS = {"none": 0, "tip": 1, "strip": 2, "quasi_steady": 3, "exact": 4}
+FORCE_LAWS = {"none": 0, "tip": 1, "strip": 2, "quasi_steady": 3, "exact": 4, "calibrated": 5}
 #: Quasi-steady coefficients of a revolving fruit-fly wing (Dickinson, Lehmann & Sane 1999, Science 284: the
 #: fits C_L = 0.225 + 1.58 sin(2.13 alpha - 7.20), C_D = 1.92 - 1.55 cos(2.04 alpha - 9.82), alpha in deg).
 QS_CL = (0.225, 1.58, 2.13, -7.20)
@@ -72,6 +75,9 @@ QS_CD = (1.92, -1.55, 2.04, -9.82)
 #: Rotational-force coefficient pi (3/4 - x0) of Sane & Dickinson 2002 (J Exp Biol 205) for a wing pitching
 #: about its mid-chord (x0 = 1/2).
 QS_CROT = math.pi * (0.75 - 0.5)
+#: The ``"calibrated"`` law's scales of the quasi-steady ``C_L``, ``C_D`` and ``C_rot``: fitted so that the filmed
+#: monarch's stroke at its filmed body angle flies as the filmed monarch did (:mod:`~lifelike_mj.butterfly.flight3d.calibrate`).
+CALIBRATED_QS = (0.571, 0.586, 0.571)
 #: Frames of the body drag: the thorax's axes or the world's.
 DRAG_FRAMES = {"world": 0, "body": 1}
 #: Assists: none, or the attitude held (reduction check).
@@ -117,7 +123,8 @@ U_TRI = U_RC + 1  # per triangle: three vertices (chord, span) of the left wing 
 MAX_TRIS = 64
 U_FEET = U_TRI + 6 * MAX_TRIS  # 12: the four feet's lowest points in the thorax's frame (m), legs or not (add_legs)
 U_GRIP = U_FEET + 12  # the legs' grip actuator's index + 1 (add_legs), 0 without one
-N_USERDATA = U_GRIP + 1
+U_QS = U_GRIP + 1  # 3: the quasi-steady law's scales of C_L, C_D and C_rot (1 for "quasi_steady")
+N_USERDATA = U_QS + 3
 
 _O_TIME, _O_QPOS, _O_QVEL, _O_QFRC, _O_UD = mjabi.O_TIME, mjabi.O_QPOS, mjabi.O_QVEL, mjabi.O_QFRC, mjabi.O_UD
 _O_XPOS, _O_XMAT, _O_XIPOS = mjabi.O_XPOS, mjabi.O_XMAT, mjabi.O_XIPOS
@@ -132,7 +139,7 @@ _f64 = mjabi.f64_at
 
 
 @njit(cache=True)
-def wing_panels(mode, pan, npan, side, R, lin, omega, rho, cd, out):
+def wing_panels(mode, pan, npan, side, R, lin, omega, rho, cd, qs, out):
     """The air's force on one wing from its panels (``pan``: chord position, span position, area): ``out`` =
     force (3, N), moment about the hinge (3, N m), and the force split into translational lift (3), drag (3)
     and rotational force (3), world frame. ``R``: the wing's axes as columns (chord, span, normal); ``lin``,
@@ -142,8 +149,10 @@ def wing_panels(mode, pan, npan, side, R, lin, omega, rho, cd, out):
     blade elements: with ``U`` the panel's air speed across the span and ``alpha`` its angle to the wing
     plane, lift ``1/2 rho C_L(alpha) U^2 dA`` across the flow, drag ``1/2 rho C_D(alpha) U^2 dA`` along it
     (:data:`QS_CL`, :data:`QS_CD`), and the rotational force ``C_rot rho U omega_p c dA`` along the normal
-    (:data:`QS_CROT`; ``omega_p`` the pitching rate that raises ``alpha``, ``c`` the panel's local chord).
-    Either law's force is also split into its part along the flow (drag) and across it (lift)."""
+    (:data:`QS_CROT`; ``omega_p`` the pitching rate that raises ``alpha``, ``c`` the panel's local chord); ``mode``
+    5 is the same law with ``C_L``, ``C_D`` and ``C_rot`` multiplied by ``qs[0]``, ``qs[1]``, ``qs[2]``
+    (:data:`CALIBRATED_QS`; ``qs`` is ``1, 1, 1`` in mode 3). Either law's force is also split into its part along
+    the flow (drag) and across it (lift)."""
     for k in range(15):
         out[k] = 0.0
     cx, cy, cz = R[0, 0], R[1, 0], R[2, 0]
@@ -178,8 +187,8 @@ def wing_panels(mode, pan, npan, side, R, lin, omega, rho, cd, out):
             sgn = 1.0 if vn > 0.0 else -1.0
             alpha = math.degrees(math.asin(min(1.0, abs(vn) / u)))
             q = 0.5 * rho * u2 * area
-            c_l = QS_CL[0] + QS_CL[1] * math.sin(math.radians(QS_CL[2] * alpha + QS_CL[3]))
-            c_d = QS_CD[0] + QS_CD[1] * math.cos(math.radians(QS_CD[2] * alpha + QS_CD[3]))
+            c_l = qs[0] * (QS_CL[0] + QS_CL[1] * math.sin(math.radians(QS_CL[2] * alpha + QS_CL[3])))
+            c_d = qs[1] * (QS_CD[0] + QS_CD[1] * math.cos(math.radians(QS_CD[2] * alpha + QS_CD[3])))
             # across the flow, on the side the normal force pushes: -sgn n less its part along the flow
             pn = -sgn * (nx * ex + ny * ey + nz * ez) / u2
             lx, ly, lz = -sgn * nx - pn * ex, -sgn * ny - pn * ey, -sgn * nz - pn * ez
@@ -190,7 +199,7 @@ def wing_panels(mode, pan, npan, side, R, lin, omega, rho, cd, out):
             fy = q * (c_l * ly - c_d * ey / u)
             fz = q * (c_l * lz - c_d * ez / u)
             # rotational force: the leading edge turning towards the pushed side raises alpha
-            rot = QS_CROT * rho * u * (w_span * sgn) * pan[N_PANEL * j + 3] * area
+            rot = qs[2] * QS_CROT * rho * u * (w_span * sgn) * pan[N_PANEL * j + 3] * area
             rox, roy, roz = -sgn * rot * nx, -sgn * rot * ny, -sgn * rot * nz
             out[12] += rox
             out[13] += roy
@@ -380,7 +389,8 @@ def _passive_kernel(m, d, off):
                 if mode == 4:
                     wing_exact(side, xmat[mw : mw + 9].reshape((3, 3)), lin, omega, rho, cd, tri, ntri, ud[U_RC], wout)
                 else:
-                    wing_panels(mode, pan, npan, side, xmat[mw : mw + 9].reshape((3, 3)), lin, omega, rho, cd, wout)
+                    wing_panels(mode, pan, npan, side, xmat[mw : mw + 9].reshape((3, 3)), lin, omega, rho, cd,
+                                ud[U_QS : U_QS + 3], wout)
                 for k in range(3):
                     f[k] = wout[k]
                     tq[k] = wout[3 + k]
@@ -540,14 +550,14 @@ def _python_wing(mode: int, ud: np.ndarray, side: float, Rw: np.ndarray, lin: np
         sgn = np.where(vn > 0, 1.0, -1.0)
         alpha = np.degrees(np.arcsin(np.minimum(1.0, np.abs(vn) / u)))
         q = 0.5 * rho * u2 * panels[:, 2]
-        c_l = QS_CL[0] + QS_CL[1] * np.sin(np.radians(QS_CL[2] * alpha + QS_CL[3]))
-        c_d = QS_CD[0] + QS_CD[1] * np.cos(np.radians(QS_CD[2] * alpha + QS_CD[3]))
+        c_l = ud[U_QS] * (QS_CL[0] + QS_CL[1] * np.sin(np.radians(QS_CL[2] * alpha + QS_CL[3])))
+        c_d = ud[U_QS + 1] * (QS_CD[0] + QS_CD[1] * np.cos(np.radians(QS_CD[2] * alpha + QS_CD[3])))
         side_n = -sgn[:, None] * n[None, :]
         lift_dir = side_n - (np.sum(side_n * e, axis=1) / u2)[:, None] * e
         lift_dir /= np.linalg.norm(lift_dir, axis=1)[:, None]
         dF = (q * c_l)[:, None] * lift_dir - (q * c_d / u)[:, None] * e
         w_span = float(omega @ span)
-        mag = QS_CROT * rho * u * (w_span * sgn) * panels[:, 3] * panels[:, 2]
+        mag = ud[U_QS + 2] * QS_CROT * rho * u * (w_span * sgn) * panels[:, 3] * panels[:, 2]
         rot = mag[:, None] * side_n
     drag = (np.sum(dF * e, axis=1) / u2)[:, None] * e
     total = dF + rot
@@ -888,7 +898,7 @@ def setup_data(m: mujoco.MjModel, kinematics: Kinematics, params: ButterflyParam
         raise UserError(f"unknown wing-force law {force_law!r}; choose one of: {', '.join(FORCE_LAWS)}.")
     if force_law == "tip" and a.measured:
         raise UserError(f"the paper's tip-speed law is for its triangular wing; the {a.name}'s measured wing takes "
-                        "'exact', 'strip' or 'quasi_steady'.")
+                        "'exact', 'strip', 'quasi_steady' or 'calibrated'.")
     if drag_frame not in DRAG_FRAMES:
         raise UserError(f"unknown body-drag frame {drag_frame!r}; choose one of: {', '.join(DRAG_FRAMES)}.")
     if assist not in ASSISTS:
@@ -934,6 +944,7 @@ def setup_data(m: mujoco.MjModel, kinematics: Kinematics, params: ButterflyParam
     ud[U_TRI : U_TRI + tris.size] = tris.ravel()
     ud[U_FEET : U_FEET + 12] = feet_m(m).ravel()
     ud[U_GRIP] = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "grip") + 1
+    ud[U_QS : U_QS + 3] = CALIBRATED_QS if force_law == "calibrated" else (1.0, 1.0, 1.0)
     if a.measured:
         ud[U_L] = a.span_m
     d.qpos[m.jnt_qposadr[m.joint("root").id] + 3] = 1.0

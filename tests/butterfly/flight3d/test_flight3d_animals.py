@@ -209,7 +209,7 @@ def test_the_exact_force_over_the_outline_is_the_integral_over_it():
         np.testing.assert_allclose(exact[3:6], moment, rtol=0, atol=3e-3 * np.abs(moment).max())
         pan = mj3d.outline_panels(MONARCH, n_strips=20, n_chord=4)
         got = np.zeros(15)
-        mj3d.wing_panels(2, pan.ravel(), len(pan), side, R, lin, omega, p.rho, p.cd, got)
+        mj3d.wing_panels(2, pan.ravel(), len(pan), side, R, lin, omega, p.rho, p.cd, np.ones(3), got)
         assert np.abs(got[:6] - exact[:6]).max() < 1e-3 * np.abs(exact[:6]).max()
 
 

@@ -202,7 +202,7 @@ def test_the_quasi_steady_law_gives_dickinsons_lift_and_drag_on_a_translating_wi
     U, a = 2.0, math.radians(alpha_deg)
     v = np.array([U * math.cos(a), 0.0, -U * math.sin(a)])  # forward and down: the air pushes it up
     out = np.empty(15)
-    mj3d.wing_panels(3, pan.ravel(), len(pan), 1.0, np.eye(3), v, np.zeros(3), p.rho, p.cd, out)
+    mj3d.wing_panels(3, pan.ravel(), len(pan), 1.0, np.eye(3), v, np.zeros(3), p.rho, p.cd, np.ones(3), out)
     c_l, c_d = _fruitfly(alpha_deg)
     q = 0.5 * p.rho * U * U * 0.5 * p.width_m * p.span_m
     lift, drag, rot = out[6:9], out[9:12], out[12:15]
@@ -223,11 +223,34 @@ def test_the_rotational_force_of_a_pitching_wing_is_sane_and_dickinsons():
     v = np.array([U * math.cos(a), 0.0, -U * math.sin(a)])
     out = np.empty(15)
     # leading edge (+x) up, towards the pushed side +z: rotation about -y (the span axis is +y)
-    mj3d.wing_panels(3, pan.ravel(), len(pan), 1.0, np.eye(3), v, np.array([0.0, -w, 0.0]), p.rho, p.cd, out)
+    mj3d.wing_panels(3, pan.ravel(), len(pan), 1.0, np.eye(3), v, np.array([0.0, -w, 0.0]), p.rho, p.cd, np.ones(3),
+                     out)
     # the flow across the span is the same at every panel (no rotation about other axes moves the span)
     integral = (p.width_m / p.span_m) ** 2 * p.span_m ** 3 / 3.0
     want = math.pi * 0.25 * p.rho * U * w * integral
     np.testing.assert_allclose(out[12:15], [0.0, 0.0, want], rtol=1e-9)
+
+
+def test_the_calibrated_law_scales_lift_rotation_and_drag_by_its_own_factors():
+    """The calibrated law (mode 5) is the quasi-steady law with C_L and C_rot times k_L and C_D times k_D
+    (model.CALIBRATED_QS), for a wing translating and pitching; the quasi-steady law itself is unscaled."""
+    p = ButterflyParams()
+    pan = mj3d.panels(p)
+    U, a = 1.5, math.radians(30.0)
+    v = np.array([U * math.cos(a), 0.0, -U * math.sin(a)])
+    w = np.array([0.0, -20.0, 0.0])
+    plain, scaled = np.empty(15), np.empty(15)
+    mj3d.wing_panels(3, pan.ravel(), len(pan), 1.0, np.eye(3), v, w, p.rho, p.cd, np.ones(3), plain)
+    k = np.array(mj3d.CALIBRATED_QS)
+    mj3d.wing_panels(5, pan.ravel(), len(pan), 1.0, np.eye(3), v, w, p.rho, p.cd, k, scaled)
+    np.testing.assert_allclose(scaled[6:9], k[0] * plain[6:9], rtol=1e-12)
+    np.testing.assert_allclose(scaled[9:12], k[1] * plain[9:12], rtol=1e-12)
+    np.testing.assert_allclose(scaled[12:15], k[2] * plain[12:15], rtol=1e-12)
+    assert len(set(k)) > 1  # lift and drag are scaled apart, so a mix-up of the two would fail above
+    m = mj3d.build_model(p, animal="monarch")
+    for law, want in (("quasi_steady", (1.0, 1.0, 1.0)), ("calibrated", mj3d.CALIBRATED_QS)):
+        d = mj3d.setup_data(m, Kinematics(), p, force_law=law, animal="monarch")
+        assert tuple(d.userdata[mj3d.U_QS : mj3d.U_QS + 3]) == tuple(want)
 
 
 def _midpoint_panels(p, n):
@@ -273,7 +296,7 @@ def test_the_exact_integral_of_eq_1_is_the_limit_of_ever_more_panels(model):
         for n in (10, 40, 160):
             got = np.zeros(15)
             pan = _midpoint_panels(p, n).ravel()
-            mj3d.wing_panels(2, pan, len(pan) // 4, side, R, lin, omega, p.rho, p.cd, got)
+            mj3d.wing_panels(2, pan, len(pan) // 4, side, R, lin, omega, p.rho, p.cd, np.ones(3), got)
             err = max(np.abs(got[:3] - exact[:3]).max() / np.abs(exact[:3]).max(),
                       np.abs(got[3:6] - exact[3:6]).max() / np.abs(exact[3:6]).max())
             errors.setdefault(n, []).append(err)
