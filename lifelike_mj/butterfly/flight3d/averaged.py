@@ -1,0 +1,491 @@
+"""The butterfly averaged over its wing beat: forces and moments from the simulator itself, trim points across the
+flight envelope, and the linear model about each (issue 42, point 1).
+
+**Beat-averaged wrench** (:meth:`Averager.wrench`). The body moves at a constant velocity through the air and turns at
+a constant rate; its wings and abdomen move as a kinematics command asks. At :data:`N_PHASES` phases of one wing beat
+the simulator's own force callback (:mod:`~lifelike_mj.butterfly.flight3d.model`) is evaluated at that pose and
+motion, and its forces (both wings' and the body's drag) and their moments are averaged: the trapezoidal rule,
+spectrally accurate for a periodic integrand. The moments are taken about the whole butterfly's centre of mass
+averaged over the beat, so that gravity, which pulls at the moving centre of mass, has no mean moment about it. This is
+the averaging of Taylor & Thomas (2003) and Sun & Xiong (2005), with the forces of this package's wing law in place of
+a flow solver's.
+
+**The averaged body** (:meth:`Averager.derivative`): one rigid body with the whole butterfly's mass and its
+beat-averaged inertia about that centre of mass, moved by the averaged wrench and gravity. The wings' own inertial
+forces average to nothing over a beat and are left out, as in those papers.
+
+**State and controls.** The state is the body-axis velocity ``u, v, w`` (x forward, y left, z up; m/s), the body-axis
+rates ``p, q, r`` (rad/s) and a small rotation ``(a_x, a_y, a_z)`` of the body from the trim attitude, about its own
+axes (rad; ``a_y > 0`` lowers the nose). The controls (:data:`CONTROLS`) are the symmetric and antisymmetric changes
+of the kinematics a controller makes: the flap frequency, the stroke's offset and amplitude (both wings, and left
+less right), the feathering's mean (both, and left less right), the feathering amplitude and the abdomen's angle.
+
+**Trim** (:func:`trim`): for a forward speed and a climb rate in straight flight, the body angle and the kinematics
+that make the averaged forces and the pitch moment vanish, as close as they can be to the filmed monarch's gait
+(:data:`NATURAL`), within the natural envelope (:data:`ENVELOPE`). Lateral balance holds by symmetry.
+
+**Linear model** (:func:`linearise`): the Jacobians ``A = df/dx`` and ``B = df/du`` at a trim by central
+differences, and its modes (:func:`modes`): eigenvalues, each named as Sun (2014) names insects' modes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+
+#: Phases of a wing beat the wrench is averaged over.
+N_PHASES = 48
+#: State names (module docstring).
+STATES = ("u", "v", "w", "p", "q", "r", "a_x", "a_y", "a_z")
+#: Longitudinal and lateral states (indices into :data:`STATES`).
+LONGITUDINAL, LATERAL = (0, 2, 4, 7), (1, 3, 5, 6, 8)
+#: Controls (module docstring; Hz or rad).
+CONTROLS = ("frequency_hz", "offset", "amplitude", "offset_difference", "amplitude_difference", "feather_mean",
+            "feather_mean_difference", "feather_amplitude", "abdomen_mean")
+#: The symmetric controls trim may move, and how far from :data:`NATURAL` each is allowed (the natural envelope:
+#: 9.5-11 Hz, strokes of 110-130 deg, the top of the stroke where the wing tips stop 35-50 deg apart, feathering within
+#: 45 deg, the abdomen within its filmed swing around its filmed mean).
+ENVELOPE = {"frequency_hz": (9.5, 11.0), "offset": (math.radians(2.0), math.radians(17.0)),
+            "amplitude": (math.radians(55.0), math.radians(65.0)), "feather_mean": (math.radians(-20.0), math.radians(20.0)),
+            "feather_amplitude": (math.radians(25.0), math.radians(45.0)),
+            "abdomen_mean": (math.radians(-31.0), math.radians(-3.0))}
+#: The top of the stroke (offset plus amplitude, rad) that keeps the dorsal gap at 35-50 deg: with the stroke plane
+#: tilted, the filmed gait's top at 68 deg leaves the wing tips 48.5 deg apart, and each degree higher about 2.8 deg
+#: less (measured in the simulator, :func:`flown`).
+TOP_RANGE = (math.radians(69.0), math.radians(72.5))
+
+
+def natural_command():
+    """The filmed monarch's gait (:func:`~lifelike_mj.butterfly.flight3d.controllers.default_base`)."""
+    from lifelike_mj.butterfly.flight3d.controllers import default_base
+
+    return default_base("monarch")
+
+
+def command_from_controls(base, u) -> np.ndarray:
+    """The kinematics parameters (``KinematicsCommand.as_array`` order) of ``base`` changed by the controls ``u``
+    (:data:`CONTROLS`, additions to the base's values; differences split half to each wing)."""
+    p = base.as_array().copy() if hasattr(base, "as_array") else np.array(base, float)
+    f, off, amp, doff, damp, fm, dfm, fa, ab = (float(x) for x in u)
+    p[0] += f
+    p[1] += off + 0.5 * doff
+    p[2] += off - 0.5 * doff
+    p[3] += amp + 0.5 * damp
+    p[4] += amp - 0.5 * damp
+    p[5] += fm + 0.5 * dfm
+    p[6] += fm - 0.5 * dfm
+    p[7] += fa
+    p[8] += fa
+    p[10] += ab
+    return p
+
+
+@dataclass
+class Averager:
+    """The beat-averaged wrench of ``animal`` under ``force_law`` (module docstring), evaluated on a model of its own."""
+
+    animal: str = "monarch"
+    force_law: str = "calibrated"
+    n_phases: int = N_PHASES
+    _m: mujoco.MjModel = field(init=False, repr=False)
+    _d: mujoco.MjData = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        from lifelike_mj.butterfly.flight3d import model as mj3d
+        from lifelike_mj.butterfly.flight3d.kinematics import Kinematics
+        from lifelike_mj.butterfly.params import ButterflyParams
+
+        self.params = ButterflyParams()
+        self._m = mj3d.build_model(self.params, "animal", self.animal)
+        self._m.opt.gravity[:] = (0.0, 0.0, -self.params.gravity)
+        self._d = mj3d.setup_data(self._m, Kinematics(natural_command()), self.params, force_law=self.force_law,
+                                  animal=self.animal)
+        self._q, self._driven, _ = mj3d.driven_dofs(self._m)
+        self._root = self._m.body("butterfly").id
+        self.mass_kg = float(self._m.body_subtreemass[self._root])
+        self.weight_N = self.mass_kg * self.params.gravity
+
+    def _pose(self, p: np.ndarray, psi: float, v: np.ndarray, w: np.ndarray) -> None:
+        """Pose the butterfly at phase ``psi`` of the kinematics ``p`` (held), the body level at the origin, moving at
+        ``v`` (m/s) and turning at ``w`` (rad/s), both in its own axes, in still air; forward kinematics and the
+        force callback run."""
+        from lifelike_mj.butterfly.flight3d import model as mj3d
+        from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS, joint_refs
+        from lifelike_mj.physics.callbacks import passive_callback
+
+        d = self._d
+        d.qpos[:7] = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
+        ref = np.empty((5, 3))
+        zero = np.zeros(N_PARAMS)
+        joint_refs(p, zero, zero, psi, ref)
+        d.qpos[self._q] = ref[:, 0]
+        d.qvel[:] = 0.0
+        d.qvel[0:3] = v
+        d.qvel[3:6] = w
+        d.qvel[self._driven[:5]] = ref[:, 1]
+        ud = d.userdata
+        ud[mj3d.U_T0] = d.time
+        ud[mj3d.U_PSI0] = psi
+        ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS] = p
+        ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS] = 0.0
+        ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS] = p
+        with passive_callback(mj3d.COMPILED_PASSIVE):
+            mujoco.mj_forward(self._m, d)
+
+    def mass_properties(self, p: np.ndarray, inertia: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """The centre of mass averaged over a beat of the kinematics ``p`` (m, body axes from the thorax's origin) and
+        the inertia about it, averaged (kg m^2, body axes; ``None`` unless ``inertia``)."""
+        m, d = self._m, self._d
+        coms, inertias = [], []
+        for k in range(self.n_phases):
+            self._pose(p, 2.0 * math.pi * k / self.n_phases, np.zeros(3), np.zeros(3))
+            coms.append(d.subtree_com[self._root].copy())
+        com = np.mean(coms, axis=0)
+        if not inertia:
+            return com, None
+        for k in range(self.n_phases):
+            self._pose(p, 2.0 * math.pi * k / self.n_phases, np.zeros(3), np.zeros(3))
+            inertia = np.zeros((3, 3))
+            for b in range(1, m.nbody):
+                if m.body_rootid[b] != self._root:
+                    continue
+                R = d.ximat[b].reshape(3, 3)
+                r = d.xipos[b] - com
+                inertia += R @ np.diag(m.body_inertia[b]) @ R.T + m.body_mass[b] * (r @ r * np.eye(3) - np.outer(r, r))
+            inertias.append(inertia)
+        return com, np.mean(inertias, axis=0)
+
+    def _periodic(self, x: np.ndarray, frequency_hz: float, integrate: bool) -> np.ndarray:
+        """The zero-mean time integral (``integrate``) or derivative of the periodic samples ``x`` (rows: the beat's
+        phases), spectrally, for a beat of ``frequency_hz``."""
+        n = len(x)
+        k = np.fft.rfftfreq(n, 1.0 / n)  # harmonics of the beat
+        w = 2.0 * math.pi * frequency_hz * k
+        X = np.fft.rfft(x, axis=0)
+        X[0] = 0.0
+        if integrate:
+            X[1:] /= (1j * w[1:])[:, None]
+        else:
+            X *= (1j * w)[:, None]
+        if n % 2 == 0:
+            X[-1] = 0.0  # the Nyquist term has no derivative or integral that stays real
+        return np.fft.irfft(X, n, axis=0)
+
+    def wrench(self, p: np.ndarray, v, w, about: np.ndarray, iterations: int = 4) -> tuple[np.ndarray, np.ndarray]:
+        """The air's force (N) and its moment about the point ``about`` (N m; body axes from the thorax's origin),
+        both in the body's axes, averaged over one beat of the kinematics ``p`` with the body moving at a mean
+        ``v`` (m/s) and turning at ``w`` (rad/s) through still air (module docstring).
+
+        Within the beat the body does not move at a constant velocity: the air's force, less its mean, accelerates
+        the whole butterfly's centre of mass, and the wings and abdomen move the thorax about that centre. On a
+        butterfly this shakes the thorax by about a metre per second within a beat (the filmed monarch: 1.0-1.6 m/s),
+        and averaging the forces at the mean velocity alone gives 15 % more lift than the same flight's simulation.
+        So the thorax's velocity is the periodic solution of ``m dv_com/dt = F(t) - mean F`` plus the kinematics'
+        own motion of the thorax about the centre of mass, found by ``iterations`` fixed-point sweeps (spectral
+        integration over the beat; the attitude held within the beat)."""
+        from lifelike_mj.butterfly.flight3d import model as mj3d
+
+        d = self._d
+        v, w = np.asarray(v, float), np.asarray(w, float)
+        n = self.n_phases
+        wings = [int(d.userdata[mj3d.U_WING]), int(d.userdata[mj3d.U_WING + 1])]
+        thorax = int(d.userdata[mj3d.U_THORAX])
+        rel = np.empty((n, 3))
+        for k in range(n):
+            self._pose(p, 2.0 * math.pi * k / n, np.zeros(3), np.zeros(3))
+            rel[k] = d.subtree_com[self._root] - d.xpos[thorax]
+        own = -self._periodic(rel, p[0], integrate=False)  # the thorax's velocity from the kinematics alone
+        shake = own.copy()
+        forces, moments = np.empty((n, 3)), np.empty((n, 3))
+        vel = np.empty(6)
+        for sweep in range(iterations + 1):
+            power = 0.0
+            for k in range(n):
+                self._pose(p, 2.0 * math.pi * k / n, v + shake[k], w)
+                f = mj3d.forces(d)
+                force = f["body_drag_N"].copy()
+                moment = np.cross(d.xipos[thorax] - about, f["body_drag_N"])
+                for i, b in enumerate(wings):
+                    force += f["wing_force_N"][i]
+                    moment += f["wing_moment_N_m"][i] + np.cross(d.xpos[b] - about, f["wing_force_N"][i])
+                    if sweep == iterations:  # the work the wings do against the air, turning about their hinges
+                        mujoco.mj_objectVelocity(self._m, d, mujoco.mjtObj.mjOBJ_XBODY, b, vel, 0)
+                        power -= float(f["wing_moment_N_m"][i] @ (vel[:3] - w))
+                forces[k], moments[k] = force, moment
+            shake = own + self._periodic(forces, p[0], integrate=True) / self.mass_kg
+        #: the mean power (W) the wings' turning about their hinges spends on the air (the muscles' work with perfect
+        #: elastic storage of the wings' inertia), of the last call
+        self.power_W = power / n
+        return forces.mean(axis=0), moments.mean(axis=0)
+
+    def com(self, p: np.ndarray) -> np.ndarray:
+        """The whole butterfly's centre of mass averaged over a beat of the kinematics ``p`` (m, body axes from the
+        thorax's origin)."""
+        return self.mass_properties(p, inertia=False)[0]
+
+
+def rotation(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """The body's axes in the world (columns) for ``roll`` (right wing down > 0), ``pitch`` (nose up > 0) and ``yaw``
+    (left > 0), composed yaw, pitch, roll (:func:`~lifelike_mj.butterfly.flight3d.flight.euler_from_quat`)."""
+    cr, sr, cp, sp, cy, sy = (math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch), math.cos(yaw),
+                              math.sin(yaw))
+    rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
+    ry = np.array([[cp, 0.0, -sp], [0.0, 1.0, 0.0], [sp, 0.0, cp]])  # nose up about -y
+    rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
+    return rz @ ry @ rx
+
+
+def _exp(a: np.ndarray) -> np.ndarray:
+    """The rotation matrix of the rotation vector ``a`` (rad)."""
+    t = float(np.linalg.norm(a))
+    k = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+    if t < 1e-12:
+        return np.eye(3) + k
+    return np.eye(3) + math.sin(t) / t * k + (1.0 - math.cos(t)) / t ** 2 * (k @ k)
+
+
+@dataclass
+class Trim:
+    """A trimmed straight flight: forward (horizontal) speed and climb (m/s), the body angle (rad, nose up), the
+    kinematics (``KinematicsCommand.as_array`` order), the beat-averaged centre of mass and inertia there, and the
+    largest residual force (fraction of the weight) and moment (N m) the trim left."""
+
+    speed_m_s: float
+    climb_m_s: float
+    pitch_rad: float
+    command: np.ndarray
+    com_m: np.ndarray
+    inertia_kg_m2: np.ndarray
+    residual_force: float
+    residual_moment_N_m: float
+
+    def velocity_body(self) -> np.ndarray:
+        """The trim's velocity in the body's axes (m/s)."""
+        return rotation(0.0, self.pitch_rad, 0.0).T @ np.array([self.speed_m_s, 0.0, self.climb_m_s])
+
+
+def derivative(av: Averager, trim: Trim, x, u) -> np.ndarray:
+    """The averaged body's rates of change (module docstring) at the state ``x`` (:data:`STATES`: the centre of mass's
+    velocity in body axes, the body rates, the small rotation from the trim's attitude) under the controls ``u``
+    (:data:`CONTROLS`, changes from the trim's kinematics): ``m (dv/dt + w x v) = F + m g``, ``I dw/dt + w x I w = M``,
+    ``da/dt = w`` (the last exact at ``a = 0``, where the model is linearised)."""
+    x, u = np.asarray(x, float), np.asarray(u, float)
+    v, w, a = x[0:3], x[3:6], x[6:9]
+    p = command_from_controls(trim.command, u)
+    com = av.com(p) if np.any(u != 0.0) else trim.com_m
+    R = rotation(0.0, trim.pitch_rad, 0.0) @ _exp(a)
+    g = R.T @ np.array([0.0, 0.0, -av.params.gravity])
+    v_thorax = v - np.cross(w, trim.com_m)
+    force, moment = av.wrench(p, v_thorax, w, trim.com_m)
+    moment = moment + np.cross(com - trim.com_m, av.mass_kg * g)  # gravity at the kinematics' own centre of mass
+    I = trim.inertia_kg_m2
+    dv = force / av.mass_kg + g - np.cross(w, v)
+    dw = np.linalg.solve(I, moment - np.cross(w, I @ w))
+    return np.concatenate([dv, dw, w])
+
+
+#: Trim's unknowns besides the body angle, each with its bounds (the natural envelope: :data:`ENVELOPE`, the top of the
+#: stroke in :data:`TOP_RANGE`) and the size of a change from the filmed gait that costs as much as any other (Hz or
+#: rad): trim keeps as close to the filmed monarch's gait as the balance allows.
+TRIM_UNKNOWNS = {"frequency_hz": 0.5, "top": math.radians(3.0), "amplitude": math.radians(3.0),
+                 "feather_mean": math.radians(3.0), "feather_amplitude": math.radians(5.0),
+                 "abdomen_mean": math.radians(5.0)}
+#: How far (rad) from the body angle asked of straight flight (``evolution.body_angle_target_deg``: 20 deg at 1 m/s,
+#: falling 10 deg per m/s, at least 5) a trim's body angle costs as much as a change of the gait by its scale: a weak
+#: preference that picks one trim where the balance leaves the body angle and the feathering free to trade.
+BODY_ANGLE_SCALE = math.radians(5.0)
+#: The mechanical power (W/kg, the wings' work on the air) that costs a trim as much as a change of the gait by its
+#: scale: trims prefer the cheaper of two balances, as Dudley (1991) finds butterflies' gaits economical.
+POWER_SCALE_W_KG = 3.0
+#: The moment arm (m) that turns a pitch moment into a force for the trim's residual.
+ARM_M = 0.01
+
+
+def _gait(p: np.ndarray) -> np.ndarray:
+    """The trim's unknowns (:data:`TRIM_UNKNOWNS`) of the kinematics ``p`` (symmetric: the wings' means)."""
+    off, amp = 0.5 * (p[1] + p[2]), 0.5 * (p[3] + p[4])
+    return np.array([p[0], off + amp, amp, 0.5 * (p[5] + p[6]), 0.5 * (p[7] + p[8]), p[10]])
+
+
+def _command(g: np.ndarray) -> np.ndarray:
+    """The kinematics of the filmed gait with the trim's unknowns ``g`` in place."""
+    p = natural_command().as_array().copy()
+    f, top, amp, fm, fa, ab = (float(x) for x in g)
+    p[0] = f
+    p[1] = p[2] = top - amp
+    p[3] = p[4] = amp
+    p[5] = p[6] = fm
+    p[7] = p[8] = fa
+    p[10] = ab
+    return p
+
+
+def trim(av: Averager, speed_m_s: float, climb_m_s: float = 0.0, start: Trim | None = None) -> Trim:
+    """The trimmed straight flight at ``speed_m_s`` forward and ``climb_m_s`` up (module docstring): the body angle and
+    the symmetric kinematics (:data:`TRIM_UNKNOWNS`) that zero the averaged force and pitch moment, as close to the
+    filmed gait as they can be, inside the natural envelope; from ``start`` if given."""
+    from scipy.optimize import least_squares
+
+    from lifelike_mj.butterfly.flight3d.evolution import body_angle_target_deg
+
+    nat = _gait(natural_command().as_array())
+    bounds = {"frequency_hz": ENVELOPE["frequency_hz"], "top": TOP_RANGE, "amplitude": ENVELOPE["amplitude"],
+              "feather_mean": ENVELOPE["feather_mean"], "feather_amplitude": ENVELOPE["feather_amplitude"],
+              "abdomen_mean": ENVELOPE["abdomen_mean"]}
+    lo = [math.radians(-30.0)] + [bounds[k][0] for k in TRIM_UNKNOWNS]
+    hi = [math.radians(60.0)] + [bounds[k][1] for k in TRIM_UNKNOWNS]
+    scales = np.array(list(TRIM_UNKNOWNS.values()))
+    v_world = np.array([speed_m_s, 0.0, climb_m_s])
+
+    def balance(z):
+        p = _command(z[1:])
+        R = rotation(0.0, z[0], 0.0)
+        g = R.T @ np.array([0.0, 0.0, -av.params.gravity])
+        force, moment = av.wrench(p, R.T @ v_world, np.zeros(3), av.com(p))
+        return (force + av.mass_kg * g) / av.weight_N, moment / (av.weight_N * ARM_M)
+
+    body = math.radians(body_angle_target_deg(speed_m_s))
+
+    def residual(z):
+        f, m = balance(z)
+        return np.concatenate([1e4 * np.array([f[0], f[2], m[1]]), (z[1:] - nat) / scales,
+                               [(z[0] - body) / BODY_ANGLE_SCALE, av.power_W / av.mass_kg / POWER_SCALE_W_KG]])
+
+    starts = ([np.concatenate([[body], nat])] if start is None
+              else [np.concatenate([[start.pitch_rad], _gait(start.command)])])
+    sol = None
+    for z0 in starts:  # the filmed gait, or the neighbouring trim (continuation along the envelope)
+        s = least_squares(residual, np.clip(z0, lo, hi), bounds=(lo, hi), diff_step=1e-3, xtol=1e-10, ftol=1e-10,
+                          gtol=1e-10)
+        if sol is None or s.cost < sol.cost:
+            sol = s
+    f, m = balance(sol.x)
+    p = _command(sol.x[1:])
+    com, inertia = av.mass_properties(p)
+    return Trim(float(speed_m_s), float(climb_m_s), float(sol.x[0]), p, com, inertia,
+                float(np.abs(f).max()), float(np.abs(m).max() * av.weight_N * ARM_M))
+
+
+#: Central-difference steps of the states (m/s, rad/s, rad) and of the controls (Hz, rad).
+STATE_STEPS = np.array([0.02, 0.02, 0.02, 0.2, 0.2, 0.2, 0.01, 0.01, 0.01])
+CONTROL_STEPS = np.array([0.1] + [0.01] * (len(CONTROLS) - 1))
+
+
+def linearise(av: Averager, trim: Trim) -> tuple[np.ndarray, np.ndarray]:
+    """``A = df/dx`` (9 x 9) and ``B = df/du`` (9 x 9) of :func:`derivative` at ``trim`` (module docstring), by central
+    differences of whole-beat averages (:data:`STATE_STEPS`, :data:`CONTROL_STEPS`)."""
+    x0 = np.concatenate([trim.velocity_body() + np.cross(np.zeros(3), trim.com_m), np.zeros(6)])
+    u0 = np.zeros(len(CONTROLS))
+    A = np.empty((9, 9))
+    B = np.empty((9, len(CONTROLS)))
+    for j, h in enumerate(STATE_STEPS):
+        e = np.zeros(9)
+        e[j] = h
+        A[:, j] = (derivative(av, trim, x0 + e, u0) - derivative(av, trim, x0 - e, u0)) / (2.0 * h)
+    for j, h in enumerate(CONTROL_STEPS):
+        e = np.zeros(len(CONTROLS))
+        e[j] = h
+        B[:, j] = (derivative(av, trim, x0, u0 + e) - derivative(av, trim, x0, u0 - e)) / (2.0 * h)
+    return A, B
+
+
+def name_modes(eigenvalues: np.ndarray, tol: float = 1e-6) -> list[str]:
+    """A name for each eigenvalue (1/s) as Sun (2014) names insects' modes: an oscillatory mode (a complex pair),
+    stable or unstable; a subsidence (real, negative), the fastest and the slowest so named; a divergence
+    (real, positive); neutral (zero: the heading, which nothing in the averaged forces fixes)."""
+    reals = [abs(e.real) for e in eigenvalues if abs(e.imag) <= tol and e.real < -tol]
+    names = []
+    for e in eigenvalues:
+        if abs(e.imag) > tol:
+            names.append(("unstable" if e.real > tol else "stable") + " oscillatory")
+        elif e.real > tol:
+            names.append("divergence")
+        elif e.real < -tol:
+            rank = "fast " if abs(e.real) == max(reals) else "slow " if abs(e.real) == min(reals) else ""
+            names.append(rank + "subsidence")
+        else:
+            names.append("neutral")
+    return names
+
+
+def modes(A: np.ndarray) -> dict:
+    """The longitudinal and lateral modes of ``A`` (:data:`LONGITUDINAL`, :data:`LATERAL`): eigenvalues (1/s), their
+    names (:func:`name_modes`), and for the unstable ones the time to double (s); also how far the two blocks are
+    coupled (the largest cross term against the largest term: zero by symmetry in straight flight)."""
+    out = {}
+    for name, idx in (("longitudinal", LONGITUDINAL), ("lateral", LATERAL)):
+        ev = np.linalg.eigvals(A[np.ix_(idx, idx)])
+        ev = ev[np.argsort(-ev.real)]
+        out[name] = [{"real_per_s": float(e.real), "imag_rad_s": float(e.imag), "name": n,
+                      "time_to_double_s": (math.log(2.0) / e.real) if e.real > 1e-6 else None}
+                     for e, n in zip(ev, name_modes(ev))]
+    cross = np.abs(A[np.ix_(LONGITUDINAL, LATERAL)]).max() + np.abs(A[np.ix_(LATERAL, LONGITUDINAL)]).max()
+    out["coupling"] = float(cross / np.abs(A).max())
+    return out
+
+
+#: The envelope of trims :func:`build` computes: forward speeds and climb rates (m/s).
+SPEEDS_M_S = (0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5)
+CLIMBS_M_S = (-0.5, 0.0, 0.5)
+
+
+def flown(trim: Trim, force_law: str = "calibrated", settle_s: float = 1.5, window_s: float = 1.0) -> dict:
+    """The trim checked in the simulator: its kinematics with the body held at its body angle (an outside torque, as in
+    :mod:`~lifelike_mj.butterfly.flight3d.calibrate`), from its velocity; after ``settle_s`` the mean speeds over
+    ``window_s`` (m/s, which a trim predicts), the mean of the torque that holds the pitch (N m; zero at a trim) and the
+    drive's power (W/kg, without and with perfect elastic storage)."""
+    from lifelike_mj.butterfly.flight3d import measures as M
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
+    from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+
+    fl = Flight3D(KinematicsCommand(*trim.command), animal="monarch", force_law=force_law, assist="hold",
+                  pitch_law=lambda _f: trim.pitch_rad)
+    fl.data.qvel[0:3] = (trim.speed_m_s, 0.0, trim.climb_m_s)
+    fl.step(int(round(settle_s / fl.dt)))
+    s = M.sample(fl, window_s)
+    m = M.measures(s, **M.body_numbers(fl))
+    span = s["t_s"][-1] - s["t_s"][0]
+    d = s["position_m"][-1] - s["position_m"][0]
+    return {"speed_m_s": float(d[0] / span), "climb_m_s": float(d[2] / span), "power_W_kg": m["power_W_kg"],
+            "power_net_W_kg": m["power_net_W_kg"], "dorsal_gap_deg": m["dorsal_gap_deg"],
+            "stroke_deg": 0.5 * (m["stroke_left_deg"] + m["stroke_right_deg"]), "frequency_hz": m["flap_frequency_hz"]}
+
+
+def build(speeds=SPEEDS_M_S, climbs=CLIMBS_M_S, force_law: str = "calibrated", progress=None) -> dict:
+    """The averaged model over the envelope (module docstring): at each forward speed and climb rate the trim, its
+    check in the simulator with its power (:func:`flown`), the linear model ``A, B`` and its modes. Level trims are
+    found from the fastest down, each from the one before (one branch of trims, continuous in speed); climbing and
+    sinking trims from the level trim at their speed. ``progress(done, total)`` is told after each trim."""
+    av = Averager(force_law=force_law)
+    total, done = len(speeds) * len(climbs), 0
+    level = {}
+    prev = None
+    for v in sorted(speeds, reverse=True):
+        prev = level[v] = trim(av, v, 0.0, start=prev)
+    points = []
+    for v in sorted(speeds):
+        for c in climbs:
+            t = level[v] if c == 0.0 else trim(av, v, c, start=level[v])
+            A, B = linearise(av, t)
+            points.append({"speed_m_s": v, "climb_m_s": c, "body_angle_deg": math.degrees(t.pitch_rad),
+                           "command": dict(zip(_COMMAND_NAMES, (float(x) for x in t.command))),
+                           "com_m": t.com_m.tolist(), "inertia_kg_m2": t.inertia_kg_m2.tolist(),
+                           "residual_force_per_weight": t.residual_force, "residual_moment_N_m": t.residual_moment_N_m,
+                           "flown": flown(t, force_law), "A": A.tolist(), "B": B.tolist(), "modes": modes(A)})
+            done += 1
+            if progress is not None:
+                progress(done, total)
+    return {"animal": av.animal, "force_law": force_law, "mass_kg": av.mass_kg, "states": list(STATES),
+            "controls": list(CONTROLS), "n_phases": av.n_phases, "points": points}
+
+
+def _names():
+    from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+
+    return KinematicsCommand.names()
+
+
+_COMMAND_NAMES = _names()

@@ -1,0 +1,61 @@
+"""The beat-averaged model (issue 42, point 1): its forces are the simulator's, its trims fly in the simulator, its
+linearisation has the rigid body's own terms, and its modes are named as Sun's."""
+
+import math
+
+import numpy as np
+import pytest
+
+from lifelike_mj.butterfly.flight3d import averaged as A
+from lifelike_mj.butterfly.flight3d.flight import Flight3D
+
+
+@pytest.fixture(scope="module")
+def av():
+    return A.Averager()
+
+
+def test_the_averaged_force_is_the_simulators_at_its_own_mean_velocity(av):
+    """Held at 18.6 deg, the filmed gait settles in the simulator at a mean velocity; the averaged force there carries
+    the weight and no more (within 2 %), and averaging at the mean velocity alone (no shake within the beat) does not."""
+    cmd = A.natural_command()
+    pitch = math.radians(18.6)
+    fl = Flight3D(cmd, animal="monarch", force_law="calibrated", assist="hold", pitch_law=lambda _f: pitch)
+    fl.step(1600)
+    x0, t0 = fl.data.qpos[:3].copy(), fl.time
+    fl.step(1632)  # whole beats of 10.2 Hz at 1/800 s: 1632 steps = 20.4 beats
+    v = (fl.data.qpos[:3] - x0) / (fl.time - t0)
+    p = cmd.as_array()
+    com, _ = av.mass_properties(p, inertia=False)
+    R = A.rotation(0.0, pitch, 0.0)
+    force, _ = av.wrench(p, R.T @ v, np.zeros(3), com)
+    world = R @ force / av.weight_N
+    assert abs(world[2] - 1.0) < 0.02 and abs(world[0]) < 0.02
+    still, _ = av.wrench(p, R.T @ v, np.zeros(3), com, iterations=0)
+    assert abs((R @ still)[2] / av.weight_N - 1.0) > 0.02
+
+
+def test_a_trim_flies_at_its_speed_in_the_simulator_and_its_linear_model_has_the_rigid_bodys_terms(av):
+    t = A.trim(av, 1.5, 0.0)
+    assert t.residual_force < 1e-3
+    lo, hi = A.ENVELOPE["frequency_hz"]
+    assert lo <= t.command[0] <= hi
+    flown = A.flown(t)
+    assert abs(flown["speed_m_s"] - 1.5) < 0.03 and abs(flown["climb_m_s"]) < 0.03
+    Amat, B = A.linearise(av, t)
+    g = av.params.gravity
+    # gravity: a nose-down rotation a_y speeds the body along x by g cos(pitch); a roll a_x pushes it along -y
+    assert Amat[0, 7] == pytest.approx(g * math.cos(t.pitch_rad), rel=1e-3)
+    assert Amat[1, 6] == pytest.approx(-g * math.cos(t.pitch_rad), rel=1e-3)
+    np.testing.assert_allclose(Amat[6:9, 3:6], np.eye(3), atol=1e-9)
+    m = A.modes(Amat)
+    assert m["coupling"] < 1e-6  # straight flight: longitudinal and lateral apart, by symmetry
+    # the frequency lifts, the stroke's offset pitches: each control acts where it should
+    assert B[2, A.CONTROLS.index("frequency_hz")] > 0.0
+    assert abs(B[4, A.CONTROLS.index("offset")]) > 10.0 * abs(B[3, A.CONTROLS.index("offset")])
+
+
+def test_modes_are_named_as_suns():
+    ev = np.array([0.5 + 2j, 0.5 - 2j, -10.0, -1.0, 0.0, 3.0, -3 + 1j, -3 - 1j])
+    assert A.name_modes(ev) == ["unstable oscillatory"] * 2 + ["fast subsidence", "slow subsidence", "neutral",
+                                                               "divergence"] + ["stable oscillatory"] * 2
