@@ -176,6 +176,54 @@ def cmd_measure3d(args) -> None:
     emit(args, d, human)
 
 
+def cmd_model3d(args) -> None:
+    from lifelike_mj.butterfly.flight3d import averaged, calibrate
+    from lifelike_mj.butterfly.flight3d.figures import fig_averaged
+    from lifelike_mj.io import write_json
+    from lifelike_mj.provenance import provenance
+
+    check_outputs(args, files={"--out": (".json",), "--figure": (".png",)})
+    total = len(args.speeds) * len(args.climbs)
+    with stage("the filmed flight with the calibrated law"):
+        filmed = calibrate.filmed_flight()
+    with stage(f"{total} trims, their linear models and their flights", total=total, unit="trim") as bar:
+        model = averaged.build(args.speeds, args.climbs, progress=lambda done, _n: bar.update(1))
+    model["filmed_flight"] = {"filmed": calibrate.FILMED, "calibrated": filmed}
+    out = {"provenance": provenance(speeds_m_s=args.speeds, climbs_m_s=args.climbs, force_law=model["force_law"],
+                                    animal=model["animal"], n_phases=model["n_phases"]), **model}
+    write_json(args.out, out)
+    if args.figure:
+        fig_averaged(model, args.figure)
+    level = sorted((p for p in model["points"] if p["climb_m_s"] == 0.0), key=lambda p: p["speed_m_s"])
+    human = (f"wrote {args.out}: {total} trims of the {model['animal']}, the filmed stroke at the filmed body angle "
+             f"flying {filmed['speed_m_s']:.2f} m/s forward and {filmed['climb_m_s']:+.2f} m/s up; level: "
+             + "; ".join(f"{p['speed_m_s']:g} m/s at {p['body_angle_deg']:.0f} deg, {p['command']['frequency_hz']:.1f} Hz, "
+                         f"{p['flown']['power_net_W_kg']:.0f} W/kg, "
+                         + ", ".join(m["name"] for m in p["modes"]["longitudinal"] + p["modes"]["lateral"]
+                                     if m["real_per_s"] > 1e-6 or m["name"] == "neutral") for p in level))
+    emit(args, {"out": args.out, "figure": args.figure, "levels": level and [
+        {"speed_m_s": p["speed_m_s"], "body_angle_deg": p["body_angle_deg"], "modes": p["modes"]} for p in level]}, human)
+
+
+def _values(text: str, lo: float, hi: float) -> list[float]:
+    """A comma-separated list of 1 to 50 different speeds (m/s) within ``[lo, hi]``, sorted."""
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected numbers separated by commas (m/s), got {text!r}") from None
+    if not values or len(values) > 50 or any(not (lo <= v <= hi) for v in values) or len(set(values)) < len(values):
+        raise argparse.ArgumentTypeError(f"expected 1 to 50 different speeds within {lo:g} to {hi:g} m/s, got {text!r}")
+    return sorted(values)
+
+
+def _speeds(text: str) -> list[float]:
+    return _values(text, 0.25, 3.0)
+
+
+def _climbs(text: str) -> list[float]:
+    return sorted(set(_values(text, -1.0, 1.0)) | {0.0})
+
+
 def cmd_strobe3d(args) -> None:
     from lifelike_mj.butterfly import flight3d
     from lifelike_mj.butterfly.flight3d.controllers import load_controller
@@ -432,6 +480,17 @@ def add_commands(bf) -> None:
     _add_dt(p)
     add_json(p)
     p.set_defaults(func=cmd_measure3d)
+    p = bf.add_parser("model3d", help="the monarch averaged over its wing beat: trims over the flight envelope, each "
+                                      "flown, its linear model and modes (minutes)")
+    p.add_argument("--out", required=True, help="the model file to write (.json)")
+    p.add_argument("--figure", default=None, help="also draw the trims and modes (.png)")
+    p.add_argument("--speeds", type=_speeds, default=[0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5],
+                   help="forward speeds of the trims, m/s, comma-separated (default 0.5 to 2.5 by 0.25)")
+    p.add_argument("--climbs", type=_climbs, default=[-0.5, 0.0, 0.5],
+                   help="climb rates of the trims, m/s, comma-separated; 0 is always among them (default -0.5,0,0.5)")
+    add_overwrite(p)
+    add_json(p)
+    p.set_defaults(func=cmd_model3d)
     p = bf.add_parser("strobe3d", help="a stroboscopic picture of one wing beat in level flight, from the side and "
                                        "from ahead")
     _add_level_flight(p, 3.0, "seconds of flight before the beat")

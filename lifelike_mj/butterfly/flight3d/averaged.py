@@ -36,6 +36,8 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
+#: The rate step (rad/s) of the body's damping of its own turning within the beat (:meth:`Averager.wrench`).
+DAMPING_STEP_RAD_S = 0.5
 #: Phases of a wing beat the wrench is averaged over.
 N_PHASES = 48
 #: State names (module docstring).
@@ -90,6 +92,8 @@ class Averager:
     animal: str = "monarch"
     force_law: str = "calibrated"
     n_phases: int = N_PHASES
+    #: whether the body turns within the beat (its own rocking), as well as moving
+    rotation: bool = True
     _m: mujoco.MjModel = field(init=False, repr=False)
     _d: mujoco.MjData = field(init=False, repr=False)
 
@@ -108,16 +112,22 @@ class Averager:
         self.mass_kg = float(self._m.body_subtreemass[self._root])
         self.weight_N = self.mass_kg * self.params.gravity
 
-    def _pose(self, p: np.ndarray, psi: float, v: np.ndarray, w: np.ndarray) -> None:
+    def _pose(self, p: np.ndarray, psi: float, v: np.ndarray, w: np.ndarray, tilt: np.ndarray | None = None) -> None:
         """Pose the butterfly at phase ``psi`` of the kinematics ``p`` (held), the body level at the origin, moving at
         ``v`` (m/s) and turning at ``w`` (rad/s), both in its own axes, in still air; forward kinematics and the
-        force callback run."""
+        force callback run; ``tilt``: a small rotation of the body (rad, a rotation vector), ``v`` and ``w`` then in the
+        untilted axes."""
         from lifelike_mj.butterfly.flight3d import model as mj3d
         from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS, joint_refs
         from lifelike_mj.physics.callbacks import passive_callback
 
         d = self._d
         d.qpos[:7] = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
+        if tilt is not None:
+            angle = float(np.linalg.norm(tilt))
+            if angle > 0.0:
+                mujoco.mju_axisAngle2Quat(d.qpos[3:7], tilt / angle, angle)
+            w = _exp(tilt).T @ w  # a free joint's angular velocity is in the body's own axes
         ref = np.empty((5, 3))
         zero = np.zeros(N_PARAMS)
         joint_refs(p, zero, zero, psi, ref)
@@ -135,10 +145,22 @@ class Averager:
         with passive_callback(mj3d.COMPILED_PASSIVE):
             mujoco.mj_forward(self._m, d)
 
+    def _inertia_about(self, point: np.ndarray) -> np.ndarray:
+        """The whole butterfly's inertia (kg m^2, world axes) about ``point`` in the pose now."""
+        m, d = self._m, self._d
+        inertia = np.zeros((3, 3))
+        for b in range(1, m.nbody):
+            if m.body_rootid[b] != self._root:
+                continue
+            R = d.ximat[b].reshape(3, 3)
+            r = d.xipos[b] - point
+            inertia += R @ np.diag(m.body_inertia[b]) @ R.T + m.body_mass[b] * (r @ r * np.eye(3) - np.outer(r, r))
+        return inertia
+
     def mass_properties(self, p: np.ndarray, inertia: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """The centre of mass averaged over a beat of the kinematics ``p`` (m, body axes from the thorax's origin) and
         the inertia about it, averaged (kg m^2, body axes; ``None`` unless ``inertia``)."""
-        m, d = self._m, self._d
+        d = self._d
         coms, inertias = [], []
         for k in range(self.n_phases):
             self._pose(p, 2.0 * math.pi * k / self.n_phases, np.zeros(3), np.zeros(3))
@@ -148,14 +170,7 @@ class Averager:
             return com, None
         for k in range(self.n_phases):
             self._pose(p, 2.0 * math.pi * k / self.n_phases, np.zeros(3), np.zeros(3))
-            inertia = np.zeros((3, 3))
-            for b in range(1, m.nbody):
-                if m.body_rootid[b] != self._root:
-                    continue
-                R = d.ximat[b].reshape(3, 3)
-                r = d.xipos[b] - com
-                inertia += R @ np.diag(m.body_inertia[b]) @ R.T + m.body_mass[b] * (r @ r * np.eye(3) - np.outer(r, r))
-            inertias.append(inertia)
+            inertias.append(self._inertia_about(com))
         return com, np.mean(inertias, axis=0)
 
     def _periodic(self, x: np.ndarray, frequency_hz: float, integrate: bool) -> np.ndarray:
@@ -174,7 +189,22 @@ class Averager:
             X[-1] = 0.0  # the Nyquist term has no derivative or integral that stays real
         return np.fft.irfft(X, n, axis=0)
 
-    def wrench(self, p: np.ndarray, v, w, about: np.ndarray, iterations: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    @staticmethod
+    def _turning(moments: np.ndarray, spin: np.ndarray, inertia: np.ndarray, damping: np.ndarray,
+                 frequency_hz: float) -> np.ndarray:
+        """One preconditioned sweep toward the periodic rate of turn ``s`` with ``I ds/dt = M(t) - mean M``: per harmonic
+        ``k`` of the beat, ``s_k <- (i k w I - D)^-1 (M_k - D s_k)`` with ``D`` the damping ``dM/dw`` (a fixed point of
+        it solves the equation; where ``D`` is the true damping it converges at once)."""
+        n = len(moments)
+        w = 2.0 * math.pi * frequency_hz * np.fft.rfftfreq(n, 1.0 / n)
+        Mk, Sk = np.fft.rfft(moments, axis=0), np.fft.rfft(spin, axis=0)
+        out = np.zeros_like(Sk)
+        top = len(w) - 1 if n % 2 == 0 else len(w)
+        for i in range(1, top):
+            out[i] = np.linalg.solve(1j * w[i] * inertia - damping, Mk[i] - damping @ Sk[i])
+        return np.fft.irfft(out, n, axis=0)
+
+    def wrench(self, p: np.ndarray, v, w, about: np.ndarray, iterations: int = 8) -> tuple[np.ndarray, np.ndarray]:
         """The air's force (N) and its moment about the point ``about`` (N m; body axes from the thorax's origin),
         both in the body's axes, averaged over one beat of the kinematics ``p`` with the body moving at a mean
         ``v`` (m/s) and turning at ``w`` (rad/s) through still air (module docstring).
@@ -188,37 +218,70 @@ class Averager:
         integration over the beat; the attitude held within the beat)."""
         from lifelike_mj.butterfly.flight3d import model as mj3d
 
-        d = self._d
+        d, m = self._d, self._m
         v, w = np.asarray(v, float), np.asarray(w, float)
         n = self.n_phases
         wings = [int(d.userdata[mj3d.U_WING]), int(d.userdata[mj3d.U_WING + 1])]
         thorax = int(d.userdata[mj3d.U_THORAX])
-        rel = np.empty((n, 3))
+        rel, spin_momentum = np.empty((n, 3)), np.empty((n, 3))
+        inertia = np.zeros((3, 3))
         for k in range(n):
             self._pose(p, 2.0 * math.pi * k / n, np.zeros(3), np.zeros(3))
             rel[k] = d.subtree_com[self._root] - d.xpos[thorax]
+            if self.rotation:
+                mujoco.mj_subtreeVel(m, d)
+                spin_momentum[k] = d.subtree_angmom[self._root]
+                inertia += self._inertia_about(d.subtree_com[self._root]) / n
         own = -self._periodic(rel, p[0], integrate=False)  # the thorax's velocity from the kinematics alone
         shake = own.copy()
-        forces, moments = np.empty((n, 3)), np.empty((n, 3))
+        tilt, spin = np.zeros((n, 3)), np.zeros((n, 3))
+        if self.rotation:  # the body's turn from the kinematics alone: the whole butterfly keeps its angular momentum
+            own_spin = -np.linalg.solve(inertia, (spin_momentum - spin_momentum.mean(axis=0)).T).T
+            spin = own_spin.copy()
+            tilt = self._periodic(spin, p[0], integrate=True)
         vel = np.empty(6)
-        for sweep in range(iterations + 1):
-            power = 0.0
+
+        def sweep(dw=None) -> tuple[np.ndarray, np.ndarray, float]:
+            """The forces and moments at each phase with the body on its motion now (and ``dw`` more rate), and the
+            power the wings spend on the air."""
+            forces, moments, power = np.empty((n, 3)), np.empty((n, 3)), 0.0
             for k in range(n):
-                self._pose(p, 2.0 * math.pi * k / n, v + shake[k], w)
+                turn = w + spin[k] + (0.0 if dw is None else dw)
+                self._pose(p, 2.0 * math.pi * k / n, v + shake[k] - np.cross(spin[k], rel[k]), turn,
+                           tilt[k] if self.rotation else None)
                 f = mj3d.forces(d)
+                centre = _exp(tilt[k]) @ about if self.rotation else about
                 force = f["body_drag_N"].copy()
-                moment = np.cross(d.xipos[thorax] - about, f["body_drag_N"])
+                moment = np.cross(d.xipos[thorax] - centre, f["body_drag_N"])
                 for i, b in enumerate(wings):
                     force += f["wing_force_N"][i]
-                    moment += f["wing_moment_N_m"][i] + np.cross(d.xpos[b] - about, f["wing_force_N"][i])
-                    if sweep == iterations:  # the work the wings do against the air, turning about their hinges
-                        mujoco.mj_objectVelocity(self._m, d, mujoco.mjtObj.mjOBJ_XBODY, b, vel, 0)
-                        power -= float(f["wing_moment_N_m"][i] @ (vel[:3] - w))
+                    moment += f["wing_moment_N_m"][i] + np.cross(d.xpos[b] - centre, f["wing_force_N"][i])
+                    mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_XBODY, b, vel, 0)
+                    power -= float(f["wing_moment_N_m"][i] @ (vel[:3] - turn))
                 forces[k], moments[k] = force, moment
+            return forces, moments, power / n
+
+        forces, moments, power = sweep()
+        if self.rotation:
+            # the body's damping of its own turning, dM/dw (N m s), averaged over the beat: it preconditions the
+            # periodic solution, whose plain fixed-point sweeps diverge for the roll (its damping outruns the beat)
+            damping = np.empty((3, 3))
+            for j in range(3):
+                e = np.zeros(3)
+                e[j] = DAMPING_STEP_RAD_S
+                damping[:, j] = (sweep(e)[1] - moments).mean(axis=0) / DAMPING_STEP_RAD_S
+        for _ in range(iterations):
             shake = own + self._periodic(forces, p[0], integrate=True) / self.mass_kg
+            if self.rotation:
+                spin = own_spin + self._turning(moments, spin - own_spin, inertia, damping, p[0])
+                tilt = self._periodic(spin, p[0], integrate=True)
+            forces, moments, power = sweep()
         #: the mean power (W) the wings' turning about their hinges spends on the air (the muscles' work with perfect
         #: elastic storage of the wings' inertia), of the last call
-        self.power_W = power / n
+        self.power_W = power
+        #: the body's rotation (rad, rotation vectors), its rate of turn (rad/s) and the thorax's velocity shake (m/s)
+        #: over the beat, of the last call (untilted axes)
+        self.tilt, self.spin, self.shake = tilt, spin, shake
         return forces.mean(axis=0), moments.mean(axis=0)
 
     def com(self, p: np.ndarray) -> np.ndarray:
@@ -432,39 +495,57 @@ SPEEDS_M_S = (0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5)
 CLIMBS_M_S = (-0.5, 0.0, 0.5)
 
 
-def flown(trim: Trim, force_law: str = "calibrated", settle_s: float = 1.5, window_s: float = 1.0) -> dict:
-    """The trim checked in the simulator: its kinematics with the body held at its body angle (an outside torque, as in
-    :mod:`~lifelike_mj.butterfly.flight3d.calibrate`), from its velocity; after ``settle_s`` the mean speeds over
-    ``window_s`` (m/s, which a trim predicts), the mean of the torque that holds the pitch (N m; zero at a trim) and the
-    drive's power (W/kg, without and with perfect elastic storage)."""
+def flown(av: Averager, trim: Trim, beats: int = 6) -> dict:
+    """The trim checked in free flight: the simulator started on the periodic motion the averaging predicts at the
+    trim's phase 0 (the body's attitude and rates, the thorax's velocity, within the beat) and flown open loop with the
+    trim's kinematics for ``beats`` whole beats. It reports the mean speeds (m/s: a trim keeps its own), the change of
+    the body angle and roll over the last beat against the first (deg: a trim keeps them), and the drive's power
+    (W/kg, without and with perfect elastic storage), the stroke, dorsal gap and frequency flown."""
     from lifelike_mj.butterfly.flight3d import measures as M
     from lifelike_mj.butterfly.flight3d.flight import Flight3D
     from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
 
-    fl = Flight3D(KinematicsCommand(*trim.command), animal="monarch", force_law=force_law, assist="hold",
-                  pitch_law=lambda _f: trim.pitch_rad)
-    fl.data.qvel[0:3] = (trim.speed_m_s, 0.0, trim.climb_m_s)
-    fl.step(int(round(settle_s / fl.dt)))
-    s = M.sample(fl, window_s)
+    R0 = rotation(0.0, trim.pitch_rad, 0.0)
+    v_body = trim.velocity_body()
+    av.wrench(trim.command, v_body, np.zeros(3), trim.com_m)
+    fl = Flight3D(KinematicsCommand(*trim.command), animal=av.animal, force_law=av.force_law)
+    R = R0 @ _exp(av.tilt[0])
+    q = np.empty(4)
+    mujoco.mju_mat2Quat(q, R.ravel())
+    fl.data.qpos[3:7] = q
+    fl.data.qvel[0:3] = R0 @ (v_body + av.shake[0])
+    fl.data.qvel[3:6] = _exp(av.tilt[0]).T @ av.spin[0]
+    n = int(round(beats / (trim.command[0] * fl.dt)))
+    s = M.sample(fl, n * fl.dt)
     m = M.measures(s, **M.body_numbers(fl))
-    span = s["t_s"][-1] - s["t_s"][0]
-    d = s["position_m"][-1] - s["position_m"][0]
-    return {"speed_m_s": float(d[0] / span), "climb_m_s": float(d[2] / span), "power_W_kg": m["power_W_kg"],
-            "power_net_W_kg": m["power_net_W_kg"], "dorsal_gap_deg": m["dorsal_gap_deg"],
-            "stroke_deg": 0.5 * (m["stroke_left_deg"] + m["stroke_right_deg"]), "frequency_hz": m["flap_frequency_hz"]}
+    bb = M.beats(0.5 * (s["joints_rad"][:, 0] + s["joints_rad"][:, 1]))
+    (a0, b0), (a1, b1) = bb[0], bb[-1]
+    span = s["t_s"][b1] - s["t_s"][a0]
+    d = s["position_m"][b1] - s["position_m"][a0]
+    att = np.degrees(s["attitude_rad"])
+    return {"speed_m_s": float(d[0] / span), "climb_m_s": float(d[2] / span), "side_m_s": float(d[1] / span),
+            "body_angle_change_deg": float(att[a1:b1, 1].mean() - att[a0:b0, 1].mean()),
+            "roll_change_deg": float(att[a1:b1, 0].mean() - att[a0:b0, 0].mean()),
+            "power_W_kg": m["power_W_kg"], "power_net_W_kg": m["power_net_W_kg"], "dorsal_gap_deg": m["dorsal_gap_deg"],
+            "stroke_deg": 0.5 * (m["stroke_left_deg"] + m["stroke_right_deg"]), "frequency_hz": m["flap_frequency_hz"],
+            "body_pitch_swing_deg": m["body_pitch_swing_deg"], "beats": len(bb)}
 
 
 def build(speeds=SPEEDS_M_S, climbs=CLIMBS_M_S, force_law: str = "calibrated", progress=None) -> dict:
     """The averaged model over the envelope (module docstring): at each forward speed and climb rate the trim, its
     check in the simulator with its power (:func:`flown`), the linear model ``A, B`` and its modes. Level trims are
     found from the fastest down, each from the one before (one branch of trims, continuous in speed); climbing and
-    sinking trims from the level trim at their speed. ``progress(done, total)`` is told after each trim."""
+    sinking trims from the level trim at their speed. ``progress(done, total)`` is told after each trim is found."""
     av = Averager(force_law=force_law)
+    climbs = sorted(set(float(c) for c in climbs) | {0.0})  # the level trims are where the others start
     total, done = len(speeds) * len(climbs), 0
     level = {}
     prev = None
     for v in sorted(speeds, reverse=True):
         prev = level[v] = trim(av, v, 0.0, start=prev)
+        done += 1
+        if progress is not None:
+            progress(done, total)
     points = []
     for v in sorted(speeds):
         for c in climbs:
@@ -474,10 +555,11 @@ def build(speeds=SPEEDS_M_S, climbs=CLIMBS_M_S, force_law: str = "calibrated", p
                            "command": dict(zip(_COMMAND_NAMES, (float(x) for x in t.command))),
                            "com_m": t.com_m.tolist(), "inertia_kg_m2": t.inertia_kg_m2.tolist(),
                            "residual_force_per_weight": t.residual_force, "residual_moment_N_m": t.residual_moment_N_m,
-                           "flown": flown(t, force_law), "A": A.tolist(), "B": B.tolist(), "modes": modes(A)})
-            done += 1
-            if progress is not None:
-                progress(done, total)
+                           "flown": flown(av, t), "A": A.tolist(), "B": B.tolist(), "modes": modes(A)})
+            if c != 0.0:
+                done += 1
+                if progress is not None:
+                    progress(done, total)
     return {"animal": av.animal, "force_law": force_law, "mass_kg": av.mass_kg, "states": list(STATES),
             "controls": list(CONTROLS), "n_phases": av.n_phases, "points": points}
 

@@ -110,3 +110,47 @@ def fig_force_breakdown(breakdowns: dict, weight_N: float, path: str | os.PathLi
             ax.legend(fontsize=7, loc="upper right")
         axes[1, col].set_xlabel("time [s]")
     return finish(fig, path)
+
+
+def fig_averaged(model: dict, path: str | os.PathLike | None = None) -> Figure:
+    """The averaged model over its envelope (:func:`~lifelike_mj.butterfly.flight3d.averaged.build`): the trims' body
+    angle, flap frequency and power against the forward speed (one line per climb rate), and the eigenvalues of the
+    longitudinal and lateral linear models in the complex plane (1/s), coloured by the forward speed."""
+    from matplotlib import colormaps
+
+    fig = new_figure(12.0, 8.0)
+    (body, power), (lon, lat) = fig.subplots(2, 2)
+    climbs = sorted({p["climb_m_s"] for p in model["points"]})
+    for c in climbs:
+        pts = sorted((p for p in model["points"] if p["climb_m_s"] == c), key=lambda p: p["speed_m_s"])
+        v = [p["speed_m_s"] for p in pts]
+        body.plot(v, [p["body_angle_deg"] for p in pts], "o-", ms=3, label=f"climb {c:+g} m/s")
+        power.plot(v, [p["flown"]["power_net_W_kg"] for p in pts], "o-", ms=3, label=f"climb {c:+g} m/s")
+    level = sorted((p for p in model["points"] if p["climb_m_s"] == 0.0), key=lambda p: p["speed_m_s"])
+    ax2 = body.twinx()
+    ax2.plot([p["speed_m_s"] for p in level], [p["command"]["frequency_hz"] for p in level], "k--", lw=0.9,
+             label="flap frequency, level")
+    ax2.set_ylabel("flap frequency [Hz] (dashed)")
+    power.axhspan(12.5, 20.2, color="0.85", label="Dudley 1991, 12.5-20.2 W/kg")
+    body.set_xlabel("forward speed [m/s]")
+    body.set_ylabel("body angle [deg]")
+    body.set_title("trims: body angle and frequency")
+    power.set_xlabel("forward speed [m/s]")
+    power.set_ylabel("power, perfect elastic storage [W/kg]")
+    power.set_title("trims flown in the simulator: power")
+    cmap = colormaps["viridis"]
+    speeds = [p["speed_m_s"] for p in level]
+    lo, hi = min(speeds), max(speeds)
+    for ax, key, title in ((lon, "longitudinal", "longitudinal modes (level)"), (lat, "lateral", "lateral modes (level)")):
+        for p in level:
+            col = cmap((p["speed_m_s"] - lo) / (hi - lo) if hi > lo else 0.5)
+            ev = p["modes"][key]
+            ax.scatter([m["real_per_s"] for m in ev], [m["imag_rad_s"] for m in ev], color=col, s=14)
+        ax.axvline(0.0, color="k", lw=0.6)
+        ax.set_xscale("symlog", linthresh=5.0)
+        ax.set_xlabel("real part [1/s] (right of 0: unstable)")
+        ax.set_ylabel("imaginary part [rad/s]")
+        ax.set_title(title + f", {lo:g} (purple) to {hi:g} m/s (yellow)")
+    for ax in (body, power):
+        ax.legend(fontsize=7)
+    return finish(fig, path)

@@ -15,9 +15,11 @@ def av():
     return A.Averager()
 
 
-def test_the_averaged_force_is_the_simulators_at_its_own_mean_velocity(av):
-    """Held at 18.6 deg, the filmed gait settles in the simulator at a mean velocity; the averaged force there carries
-    the weight and no more (within 2 %), and averaging at the mean velocity alone (no shake within the beat) does not."""
+def test_the_averaged_force_is_the_simulators_at_its_own_mean_velocity():
+    """Held at 18.6 deg, the filmed gait settles in the simulator at a mean velocity; the averaged force there, the body
+    held as well (no turning within the beat), carries the weight and no more (within 2 %), and averaging at the mean
+    velocity alone (no shake within the beat) does not."""
+    av = A.Averager(rotation=False)
     cmd = A.natural_command()
     pitch = math.radians(18.6)
     fl = Flight3D(cmd, animal="monarch", force_law="calibrated", assist="hold", pitch_law=lambda _f: pitch)
@@ -35,13 +37,20 @@ def test_the_averaged_force_is_the_simulators_at_its_own_mean_velocity(av):
     assert abs((R @ still)[2] / av.weight_N - 1.0) > 0.02
 
 
-def test_a_trim_flies_at_its_speed_in_the_simulator_and_its_linear_model_has_the_rigid_bodys_terms(av):
+@pytest.mark.slow
+def test_a_trim_flies_near_its_speed_in_free_flight_and_its_linear_model_has_the_rigid_bodys_terms(av):
+    """The 1.5 m/s trim, started in the simulator on the motion within the beat that the averaging predicts and flown
+    open loop, keeps near its speed for four beats (the model's accuracy: within 0.15 m/s forward and 0.2 m/s
+    vertically) and rocks in pitch as the averaging predicts (within 20 %); its linear model has the rigid body's own
+    terms and each control acts where it should."""
     t = A.trim(av, 1.5, 0.0)
     assert t.residual_force < 1e-3
     lo, hi = A.ENVELOPE["frequency_hz"]
     assert lo <= t.command[0] <= hi
-    flown = A.flown(t)
-    assert abs(flown["speed_m_s"] - 1.5) < 0.03 and abs(flown["climb_m_s"]) < 0.03
+    flown = A.flown(av, t)
+    assert abs(flown["speed_m_s"] - 1.5) < 0.15 and abs(flown["climb_m_s"]) < 0.2
+    predicted = math.degrees(np.ptp(av.tilt[:, 1]))
+    assert abs(flown["body_pitch_swing_deg"] / predicted - 1.0) < 0.2
     Amat, B = A.linearise(av, t)
     g = av.params.gravity
     # gravity: a nose-down rotation a_y speeds the body along x by g cos(pitch); a roll a_x pushes it along -y
@@ -49,10 +58,12 @@ def test_a_trim_flies_at_its_speed_in_the_simulator_and_its_linear_model_has_the
     assert Amat[1, 6] == pytest.approx(-g * math.cos(t.pitch_rad), rel=1e-3)
     np.testing.assert_allclose(Amat[6:9, 3:6], np.eye(3), atol=1e-9)
     m = A.modes(Amat)
-    assert m["coupling"] < 1e-6  # straight flight: longitudinal and lateral apart, by symmetry
-    # the frequency lifts, the stroke's offset pitches: each control acts where it should
+    assert m["coupling"] < 1e-4  # straight flight: longitudinal and lateral apart, by symmetry (to the solution's rounding)
+    assert all(abs(e["real_per_s"]) < 1e3 for e in m["longitudinal"] + m["lateral"])
+    # the frequency lifts, the stroke's offset pitches, the feathering's difference rolls
     assert B[2, A.CONTROLS.index("frequency_hz")] > 0.0
     assert abs(B[4, A.CONTROLS.index("offset")]) > 10.0 * abs(B[3, A.CONTROLS.index("offset")])
+    assert abs(B[3, A.CONTROLS.index("feather_mean_difference")]) > abs(B[5, A.CONTROLS.index("feather_mean_difference")])
 
 
 def test_modes_are_named_as_suns():

@@ -1,0 +1,377 @@
+"""A flight controller designed from the averaged model (issue 42, point 2): gain-scheduled LQR with integral action,
+a wind estimate from the body's own motion, and guidance that crabs and speeds up into the wind.
+
+**What it sees.** Its own motion only: the thorax's position and velocity over the ground, its attitude and its
+rates of turn (what an insect has from its eyes, halteres or antennae' mechanosensors, and gravity). Never the wind.
+Every measurement is averaged over the last wing beat (a moving mean one beat long), which removes the beat's own
+periodic shake and costs half a beat of delay: insects correct upsets with about one beat of latency (Ristroph et al.
+2010; Beatus et al. 2015).
+
+**The plant.** At each forward speed of the envelope the trim and the linear model of
+:mod:`~lifelike_mj.butterfly.flight3d.averaged` (``A``, ``B``: 9 states, 9 controls), augmented with the altitude
+error and three integrals: of the altitude error, of the airspeed error and of the heading error. The heading and
+altitude errors and the airspeed error are outputs of the state (their rows are the world's vertical, forward and yaw
+components of the body's motion and rotation at the trim attitude).
+
+**The gains** (:func:`design`): at each speed the infinite-horizon LQR gain of the augmented model
+(``scipy.linalg.solve_continuous_are``) for the weights :data:`Q_SCALES` and :data:`R_SCALES` (Bryson's rule: each
+state or control divided by the size it may reach). In flight the gains and the trim are interpolated linearly in the
+airspeed asked.
+
+**The wind** (:meth:`DesignedController.wind`): an observer on the velocity over the ground. The linear model about the
+trim at the estimated airspeed predicts the beat-averaged acceleration from the estimated air velocity, the rates,
+the attitude and the controls as flown; the wind estimate moves until the prediction matches the measured velocity.
+
+**Guidance.** On a course the butterfly is asked to make good a ground velocity along the line to the next waypoint
+at the task's speed. The air velocity that does so is that ground velocity less the estimated wind: its direction is
+the heading asked (it crabs into a cross wind), its size the airspeed asked, clipped to the envelope; when a head wind
+asks for more than the envelope's top speed, the ground speed asked is lowered so that the track is still held, as
+butterflies that make ground upwind do by flying faster than the wind (Srygley et al. 1996). The altitude asked is the
+waypoint's; errors beyond :data:`MAX_ALTITUDE_ERROR_M` and :data:`MAX_HEADING_ERROR_RAD` are clipped, so that a far
+target asks a steady climb or turn, not a saturated one.
+
+**Saturation.** Every control is clipped to the natural envelope (:data:`~lifelike_mj.butterfly.flight3d.averaged.ENVELOPE`
+for the symmetric ones, :data:`DIFFERENCE_LIMITS` for left against right); the integrals are bounded
+(:data:`INTEGRAL_LIMITS`), so they do not wind up.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+
+import numpy as np
+
+from lifelike_mj.butterfly.flight3d import averaged as av
+from lifelike_mj.butterfly.flight3d import model as mj3d
+from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
+
+#: Bryson's scales of the augmented state: 9 model states (m/s, rad/s, rad), then the altitude error (m), its integral
+#: (m s), the airspeed error's integral (m) and the heading error's integral (rad s).
+Q_SCALES = np.array([0.9, 0.9, 0.9, 9.0, 9.0, 9.0, 0.45, 0.45, 0.3, 0.15, 0.15, 0.45, 0.3])
+#: Bryson's scales of the controls (Hz, rad), :data:`~lifelike_mj.butterfly.flight3d.averaged.CONTROLS` order.
+R_SCALES = np.array([0.5, 0.06, 0.06, 0.05, 0.05, 0.1, 0.1, 0.1, 0.15])
+#: Limits of the antisymmetric controls (rad): offset, amplitude and feathering differences left less right.
+DIFFERENCE_LIMITS = {"offset_difference": math.radians(15.0), "amplitude_difference": math.radians(15.0),
+                     "feather_mean_difference": math.radians(20.0)}
+#: Errors fed to the regulator are clipped to these (m, rad).
+MAX_ALTITUDE_ERROR_M, MAX_HEADING_ERROR_RAD = 0.25, math.radians(30.0)
+#: The velocity, rate and attitude errors fed to the regulator are clipped to these (m/s, rad/s, rad): far from its
+#: trim the linear model no longer holds, and a clipped error asks the largest correction it still describes.
+MAX_SPEED_ERROR_M_S, MAX_RATE_RAD_S, MAX_ATTITUDE_ERROR_RAD = 0.4, 4.0, math.radians(30.0)
+#: The integrals of the altitude, airspeed and heading errors are kept within these (m s, m, rad s): a clipped
+#: control cannot wind them up further than what their own gains turn into a full correction.
+INTEGRAL_LIMITS = np.array([0.3, 0.6, 0.3])
+#: Poles of the wind observer's error (1/s, per axis): its natural frequency and damping ratio.
+OBSERVER_HZ, OBSERVER_ZETA = 0.5, 1.0
+#: Near a waypoint the ground speed asked is at most ``APPROACH_MIN_M_S + APPROACH_PER_S * distance`` (m/s, 1/s).
+APPROACH_MIN_M_S, APPROACH_PER_S = 0.7, 1.0
+#: Airspeed limits of guidance (m/s): the envelope of the trims, less the top 0.3 m/s, whose trims fly at the top of
+#: the frequency's range and leave nothing to climb with.
+MIN_AIRSPEED_M_S, MAX_AIRSPEED_M_S = 0.5, 2.2
+#: The most the airspeed asked changes (m/s^2): a wind triangle that flips as a waypoint passes does not jerk the
+#: speed loop.
+MAX_SPEED_CHANGE_M_S2 = 1.0
+#: The regulator's state: the 9 model states, the altitude error and three integrals, then the 9 controls as flown and
+#: their 9 rates (the kinematics follow a command through a critically damped filter of one wing beat: the
+#: controller knows its own motor state, as an animal's efference copy does).
+N_PLANT, N_AUG = 13, 31
+#: The most the heading asked turns (rad/s) toward where guidance points: a turn is a steady bank, not a step.
+MAX_TURN_RATE_RAD_S = 1.5
+
+
+def _outputs(trim_pitch: float, v0_body: np.ndarray) -> np.ndarray:
+    """Rows of the world's vertical speed, forward speed and heading (yaw) as linear functions of the 9 model states at
+    a trim of body angle ``trim_pitch`` moving at ``v0_body`` (body axes): the world velocity is ``R0 (dv + a x v0)``,
+    the heading the world vertical component of ``R0 a``."""
+    R0 = av.rotation(0.0, trim_pitch, 0.0)
+    C = np.zeros((3, 9))
+    cross = np.array([[0.0, v0_body[2], -v0_body[1]], [-v0_body[2], 0.0, v0_body[0]], [v0_body[1], -v0_body[0], 0.0]])
+    # a x v0 = -v0 x a = cross @ a
+    world_v = np.hstack([R0, np.zeros((3, 3)), R0 @ cross])
+    C[0] = world_v[2]
+    C[1] = world_v[0]
+    C[2, 6:9] = R0[2]
+    return C
+
+
+def augment(A: np.ndarray, B: np.ndarray, trim_pitch: float, v0_body: np.ndarray,
+            omega_c: float) -> tuple[np.ndarray, np.ndarray]:
+    """The augmented model (module docstring): states 9 + altitude error, its integral, the airspeed error's
+    integral, the heading error's integral, then the controls as flown and their rates, which follow the command
+    ``u`` through the kinematics' critically damped filter of natural frequency ``omega_c`` (rad/s)."""
+    C = _outputs(trim_pitch, v0_body)
+    nu = B.shape[1]
+    Aa = np.zeros((N_AUG, N_AUG))
+    Aa[:9, :9] = A
+    Aa[:9, N_PLANT : N_PLANT + nu] = B  # the body feels the controls as flown
+    Aa[9, :9] = C[0]  # altitude error rate = vertical speed
+    Aa[10, 9] = 1.0
+    Aa[11, :9] = C[1]
+    Aa[12, :9] = C[2]
+    Aa[N_PLANT : N_PLANT + nu, N_PLANT + nu :] = np.eye(nu)
+    Aa[N_PLANT + nu :, N_PLANT : N_PLANT + nu] = -omega_c ** 2 * np.eye(nu)
+    Aa[N_PLANT + nu :, N_PLANT + nu :] = -2.0 * omega_c * np.eye(nu)
+    Ba = np.zeros((N_AUG, nu))
+    Ba[N_PLANT + nu :] = omega_c ** 2 * np.eye(nu)
+    return Aa, Ba
+
+
+def lqr(A: np.ndarray, B: np.ndarray, q_scales=Q_SCALES, r_scales=R_SCALES) -> np.ndarray:
+    """The infinite-horizon LQR gain ``K`` (``u = -K x``) for Bryson's weights: ``q_scales`` of the first states, the
+    controls as flown weighed as the commands (``r_scales``) and their rates not at all."""
+    from scipy.linalg import solve_continuous_are
+
+    q = np.full(A.shape[0], np.inf)
+    q[: len(q_scales)] = q_scales
+    q[N_PLANT : N_PLANT + len(r_scales)] = r_scales
+    Q = np.diag(1.0 / q ** 2)
+    R = np.diag(1.0 / np.asarray(r_scales) ** 2)
+    P = solve_continuous_are(A, B, Q, R)
+    return np.linalg.solve(R, B.T @ P)
+
+
+def design(model: dict, q_scales=Q_SCALES, r_scales=R_SCALES, beats_per_cycle: float = 1.0) -> dict:
+    """The designed controller's schedule from an averaged model (:func:`~lifelike_mj.butterfly.flight3d.averaged.build`
+    output; its level trims): per speed the trim (body angle, kinematics, body velocity), the model rows the wind
+    observer needs, the gain, and the closed loop's slowest pole (1/s)."""
+    rows = sorted((p for p in model["points"] if p["climb_m_s"] == 0.0), key=lambda p: p["speed_m_s"])
+    out = []
+    for p in rows:
+        A, B = np.array(p["A"]), np.array(p["B"])
+        pitch = math.radians(p["body_angle_deg"])
+        v0 = av.rotation(0.0, pitch, 0.0).T @ np.array([p["speed_m_s"], 0.0, 0.0])
+        omega_c = 2.0 * math.pi * p["command"]["frequency_hz"] / beats_per_cycle
+        Aa, Ba = augment(A, B, pitch, v0, omega_c)
+        K = lqr(Aa, Ba, q_scales, r_scales)
+        poles = np.linalg.eigvals(Aa - Ba @ K)
+        out.append({"speed_m_s": p["speed_m_s"], "body_angle_rad": pitch, "command": list(p["command"].values()),
+                    "v0_body_m_s": v0.tolist(), "A": A.tolist(), "B": B.tolist(), "K": K.tolist(),
+                    "slowest_pole_per_s": float(-poles.real.max())})
+    return {"kind": "designed", "schedule": out, "q_scales": list(map(float, q_scales)),
+            "r_scales": list(map(float, r_scales))}
+
+
+def _interp(schedule: list[dict], speed: float, key: str) -> np.ndarray:
+    speeds = np.array([s["speed_m_s"] for s in schedule])
+    x = float(np.clip(speed, speeds[0], speeds[-1]))
+    i = int(np.clip(np.searchsorted(speeds, x) - 1, 0, len(speeds) - 2))
+    t = (x - speeds[i]) / (speeds[i + 1] - speeds[i])
+    return (1.0 - t) * np.asarray(schedule[i][key], float) + t * np.asarray(schedule[i + 1][key], float)
+
+
+def _log(R: np.ndarray) -> np.ndarray:
+    """The rotation vector (rad) of the rotation matrix ``R``."""
+    c = max(-1.0, min(1.0, 0.5 * (np.trace(R) - 1.0)))
+    t = math.acos(c)
+    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    if t < 1e-9:
+        return 0.5 * w
+    return t / (2.0 * math.sin(t)) * w
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def limits() -> tuple[np.ndarray, np.ndarray]:
+    """The lowest and highest value of each control (:data:`~lifelike_mj.butterfly.flight3d.averaged.CONTROLS`) as
+    an absolute value: the symmetric ones' natural envelope, the differences' :data:`DIFFERENCE_LIMITS`."""
+    lo, hi = np.empty(len(av.CONTROLS)), np.empty(len(av.CONTROLS))
+    for i, name in enumerate(av.CONTROLS):
+        if name in DIFFERENCE_LIMITS:
+            lo[i], hi[i] = -DIFFERENCE_LIMITS[name], DIFFERENCE_LIMITS[name]
+        elif name == "offset":
+            lo[i], hi[i] = av.TOP_RANGE[0] - av.ENVELOPE["amplitude"][1], av.TOP_RANGE[1] - av.ENVELOPE["amplitude"][0]
+        else:
+            lo[i], hi[i] = av.ENVELOPE[name]
+    return lo, hi
+
+
+def _symmetric(p: np.ndarray) -> np.ndarray:
+    """The controls' absolute values (:data:`~lifelike_mj.butterfly.flight3d.averaged.CONTROLS`) of kinematics ``p``."""
+    return np.array([p[0], 0.5 * (p[1] + p[2]), 0.5 * (p[3] + p[4]), p[1] - p[2], p[3] - p[4], 0.5 * (p[5] + p[6]),
+                     p[5] - p[6], 0.5 * (p[7] + p[8]), p[10]])
+
+
+class DesignedController:
+    """The designed controller (module docstring) as a Python callable for :class:`Flight3D`
+    (``controller=DesignedController(design(model))``, ``control_every=1``): it measures at every step and sets a new
+    command every ``every`` steps."""
+
+    def __init__(self, spec: dict, every: int = 8, predict: bool = False) -> None:
+        self.schedule = spec["schedule"]
+        self.every = every
+        self.predict = predict
+        self.lo, self.hi = limits()
+        self.reset()
+
+    def reset(self) -> None:
+        self.buffer: deque = deque()
+        self.integral = np.zeros(3)
+        self.v_hat = None
+        self.w_hat = np.zeros(3)
+        self.k = 0
+        self.prev_u = None
+        self.heading = None
+        self.airspeed = None
+        self.log: list[dict] = []
+
+    # ---- guidance -----------------------------------------------------------------------------------------------
+
+    def references(self, flight, pos: np.ndarray, wind: np.ndarray) -> tuple[float, float, float]:
+        """Heading (rad), altitude (m) and airspeed (m/s) asked now (module docstring)."""
+        from lifelike_mj.butterfly.flight3d.tasks import R_PASSED
+
+        task = flight.task
+        if task.kind == "waypoints":
+            i = min(int(flight._rec[R_PASSED]), len(task.rows) - 1)
+            wp = np.array(task.rows[i][:3])
+            to = wp[:2] - pos[:2]
+            dist = float(np.linalg.norm(to))
+            d = to / dist if dist > 1e-9 else np.array([1.0, 0.0])
+            # slower as it closes, so that its turns are tighter than the waypoint's radius
+            speed = min(task.speed_m_s, APPROACH_MIN_M_S + APPROACH_PER_S * dist)
+            return self._ref_tuple(d, speed, wind, float(wp[2]))
+        heading, altitude, speed = flight.reference
+        d = np.array([math.cos(heading), math.sin(heading)])
+        return self._ref_tuple(d, speed, wind, altitude, ground=False)
+
+    def _ref_tuple(self, d, speed, wind, altitude, ground: bool = True):
+        if not ground:  # a schedule asks for a heading and an airspeed
+            return float(math.atan2(d[1], d[0])), float(altitude), float(np.clip(speed, MIN_AIRSPEED_M_S,
+                                                                                   MAX_AIRSPEED_M_S))
+        heading, airspeed = self.wind_triangle(d, speed, wind[:2])
+        return heading, float(altitude), airspeed
+
+    @staticmethod
+    def wind_triangle(d: np.ndarray, ground_speed: float, wind_xy: np.ndarray) -> tuple[float, float]:
+        """The heading (rad) and airspeed (m/s) that make good ``ground_speed`` along the unit vector ``d`` in the wind
+        ``wind_xy`` (m/s), the ground speed lowered where the airspeed would pass :data:`MAX_AIRSPEED_M_S`."""
+        air = ground_speed * d - wind_xy
+        if np.linalg.norm(air) > MAX_AIRSPEED_M_S:
+            along = float(d @ wind_xy)
+            disc = along * along - float(wind_xy @ wind_xy) + MAX_AIRSPEED_M_S ** 2
+            g = along + math.sqrt(disc) if disc >= 0.0 else 0.0
+            air = max(g, 0.0) * d - wind_xy
+            n = float(np.linalg.norm(air))
+            if n > MAX_AIRSPEED_M_S:
+                air *= MAX_AIRSPEED_M_S / n
+        speed = float(np.linalg.norm(air))
+        if speed < 1e-9:
+            return float(math.atan2(d[1], d[0])), MIN_AIRSPEED_M_S
+        return float(math.atan2(air[1], air[0])), float(np.clip(speed, MIN_AIRSPEED_M_S, MAX_AIRSPEED_M_S))
+
+    # ---- the loop -------------------------------------------------------------------------------------------------
+
+    def __call__(self, flight):
+        from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+
+        d = flight.data
+        dt = flight.dt
+        quat = d.qpos[3:7]
+        R = np.empty(9)
+        import mujoco
+
+        mujoco.mju_quat2Mat(R, quat)
+        R = R.reshape(3, 3)
+        freq = float(d.userdata[mj3d.U_P0])  # the flap frequency flown
+        n_beat = max(1, int(round(1.0 / (freq * dt))))
+        self.buffer.append((d.qpos[0:3].copy(), d.qvel[0:3].copy(), d.qvel[3:6].copy(), R.copy()))
+        while len(self.buffer) > n_beat:
+            self.buffer.popleft()
+        self.k += 1
+        if (self.k - 1) % self.every:
+            return None
+        pos = np.mean([b[0] for b in self.buffer], axis=0)
+        vel = np.mean([b[1] for b in self.buffer], axis=0)
+        rates = np.mean([b[2] for b in self.buffer], axis=0)
+        Rm = self.buffer[-1][3]
+        # a mean attitude: the beat's rotations averaged about the latest (small swings)
+        a_mean = np.mean([_log(Rm.T @ b[3]) for b in self.buffer], axis=0)
+        Rm = Rm @ av._exp(a_mean)
+        t_ctrl = self.every * dt
+        wind = self.wind(vel, Rm, rates, d.userdata[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS].copy(), t_ctrl)
+        target, altitude, asked = self.references(flight, pos, wind)
+        if self.airspeed is None:
+            self.airspeed = asked
+        dv = MAX_SPEED_CHANGE_M_S2 * self.every * dt
+        airspeed = self.airspeed = self.airspeed + float(np.clip(asked - self.airspeed, -dv, dv))
+        if self.heading is None:
+            self.heading = math.atan2(Rm[1, 0], Rm[0, 0])
+        step = MAX_TURN_RATE_RAD_S * t_ctrl
+        turn = float(np.clip(_wrap(target - self.heading), -step, step))
+        heading = self.heading = _wrap(self.heading + turn)
+        turn_rate = turn / t_ctrl  # the heading asked turns at this rate (rad/s, left > 0): a coordinated turn
+        sched = self.schedule
+        pitch0 = float(_interp(sched, airspeed, "body_angle_rad"))
+        v0 = _interp(sched, airspeed, "v0_body_m_s")
+        K = _interp(sched, airspeed, "K")
+        trim_cmd = _interp(sched, airspeed, "command")
+        yaw = math.atan2(Rm[1, 0], Rm[0, 0])
+        herr = float(np.clip(_wrap(yaw - heading), -MAX_HEADING_ERROR_RAD, MAX_HEADING_ERROR_RAD))
+        # the trim attitude at the heading asked (the error clipped), banked into the turn asked: tan(bank) = v r / g
+        bank = -math.atan(airspeed * turn_rate / 9.81)
+        R0 = av.rotation(bank, pitch0, yaw - herr)
+        a = _log(R0.T @ Rm)
+        v_air = Rm.T @ (vel - wind)
+        x = np.zeros(N_AUG)
+        x[0:3] = np.clip(v_air - v0, -MAX_SPEED_ERROR_M_S, MAX_SPEED_ERROR_M_S)
+        x[3:6] = np.clip(rates - R0.T @ np.array([0.0, 0.0, turn_rate]), -MAX_RATE_RAD_S, MAX_RATE_RAD_S)
+        x[6:9] = np.clip(a, -MAX_ATTITUDE_ERROR_RAD, MAX_ATTITUDE_ERROR_RAD)
+        ud = d.userdata
+        nu = len(av.CONTROLS)
+        x[N_PLANT : N_PLANT + nu] = _symmetric(ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS]) - _symmetric(np.asarray(trim_cmd))
+        x[N_PLANT + nu :] = _symmetric(ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS])  # the controls' rates as flown
+        if self.predict:  # the beat's mean lags half a beat: carry the model's state that far ahead
+            A = _interp(sched, airspeed, "A")
+            B = _interp(sched, airspeed, "B")
+            x[0:9] += 0.5 / freq * (A @ x[0:9] + B @ x[N_PLANT : N_PLANT + nu])
+        zerr = float(np.clip(pos[2] - altitude, -MAX_ALTITUDE_ERROR_M, MAX_ALTITUDE_ERROR_M))
+        x[9] = zerr
+        x[10:13] = self.integral
+        u = -K @ x
+        absolute = _symmetric(trim_cmd) + u
+        clipped = np.clip(absolute, self.lo, self.hi)
+        fwd = float(np.array([math.cos(heading), math.sin(heading), 0.0]) @ (vel - wind))
+        self.integral = np.clip(self.integral + t_ctrl * np.array([zerr, fwd - airspeed, herr]), -INTEGRAL_LIMITS,
+                                INTEGRAL_LIMITS)
+        self.prev_u = clipped - _symmetric(trim_cmd)
+        self.prev_rates, self.prev_a, self.prev_R = rates, a, Rm
+        self.log.append({"t": flight.time, "wind": wind.copy(), "heading": heading, "airspeed": airspeed,
+                         "altitude": altitude, "pos": pos.copy(), "x": x.copy(), "u": clipped - _symmetric(trim_cmd)})
+        p = av.command_from_controls(np.array(trim_cmd), clipped - _symmetric(np.array(trim_cmd)))
+        return KinematicsCommand(*p)
+
+    def wind(self, vel: np.ndarray, Rm: np.ndarray, rates: np.ndarray, flown: np.ndarray, dt: float) -> np.ndarray:
+        """The wind estimate (world, m/s): one step of the observer (module docstring). The model's acceleration is
+        taken about the trim at the airspeed the estimate implies (its body angle, kinematics and derivatives), from
+        the controls as flown (``flown``: the kinematics parameters now) and the body's attitude and rates; the wind is
+        the observer's second state, ``dw/dt = -k A_vv^-1 e`` with ``e`` the velocity's error, which with
+        ``dv/dt = A_vv (v - w - v0) + ... + l e`` makes the errors' poles those of ``s^2 + (l - A_vv) s + k``. Only the
+        horizontal wind is estimated: an error of the model's lift would look like a vertical wind, which the
+        altitude's integral takes up instead."""
+        if self.v_hat is None:
+            self.v_hat = vel.copy()
+            return self.w_hat.copy()
+        air = (self.v_hat - self.w_hat)[:2]
+        speed = float(np.linalg.norm(air))
+        sched = self.schedule
+        A = _interp(sched, speed, "A")
+        B = _interp(sched, speed, "B")
+        v0 = _interp(sched, speed, "v0_body_m_s")
+        pitch0 = float(_interp(sched, speed, "body_angle_rad"))
+        trim_cmd = _interp(sched, speed, "command")
+        yaw = math.atan2(Rm[1, 0], Rm[0, 0])
+        a = _log(av.rotation(0.0, pitch0, yaw).T @ Rm)
+        u = _symmetric(flown) - _symmetric(trim_cmd)
+        v_b = Rm.T @ (self.v_hat - self.w_hat)
+        acc = Rm @ (A[0:3, 0:3] @ (v_b - v0) + A[0:3, 3:6] @ rates + A[0:3, 6:9] @ a + B[0:3] @ u)
+        Avv = Rm @ A[0:3, 0:3] @ Rm.T
+        e = vel - self.v_hat
+        wn = 2.0 * math.pi * OBSERVER_HZ
+        self.v_hat = self.v_hat + dt * (acc + 2.0 * OBSERVER_ZETA * wn * e)
+        dw = -wn * wn * np.linalg.solve(Avv, e)
+        dw[2] = 0.0
+        self.w_hat = self.w_hat + dt * dw
+        return self.w_hat.copy()
