@@ -68,7 +68,7 @@ OBSERVER_HZ, OBSERVER_ZETA = 0.5, 1.0
 APPROACH_MIN_M_S, APPROACH_PER_S = 0.7, 1.0
 #: Airspeed limits of guidance (m/s): the envelope of the trims, less the top 0.3 m/s, whose trims fly at the top of
 #: the frequency's range and leave nothing to climb with.
-MIN_AIRSPEED_M_S, MAX_AIRSPEED_M_S = 0.5, 2.2
+MIN_AIRSPEED_M_S, MAX_AIRSPEED_M_S = 0.5, 2.0
 #: The most the airspeed asked changes (m/s^2): a wind triangle that flips as a waypoint passes does not jerk the
 #: speed loop.
 MAX_SPEED_CHANGE_M_S2 = 1.0
