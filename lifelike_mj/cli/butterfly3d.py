@@ -195,7 +195,9 @@ def cmd_model3d(args) -> None:
     if args.figure:
         fig_averaged(model, args.figure)
     level = sorted((p for p in model["points"] if p["climb_m_s"] == 0.0), key=lambda p: p["speed_m_s"])
-    human = (f"wrote {args.out}: {total} trims of the {model['animal']}, the filmed stroke at the filmed body angle "
+    balanced = sum(p["trimmed"] for p in model["points"])
+    human = (f"wrote {args.out}: {balanced} of {total} trims of the {model['animal']} balance inside the natural "
+             f"envelope; the filmed stroke at the filmed body angle "
              f"flying {filmed['speed_m_s']:.2f} m/s forward and {filmed['climb_m_s']:+.2f} m/s up; level: "
              + "; ".join(f"{p['speed_m_s']:g} m/s at {p['body_angle_deg']:.0f} deg, {p['command']['frequency_hz']:.1f} Hz, "
                          f"{p['flown']['power_net_W_kg']:.0f} W/kg, "

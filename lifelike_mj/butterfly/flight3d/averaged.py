@@ -490,6 +490,9 @@ def modes(A: np.ndarray) -> dict:
     return out
 
 
+#: A trim whose largest residual force is within this fraction of the weight balances; one beyond it has no balance
+#: inside the natural envelope (the nearest one is kept, and marked).
+TRIMMED_RESIDUAL = 1e-3
 #: The envelope of trims :func:`build` computes: forward speeds and climb rates (m/s).
 SPEEDS_M_S = (0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5)
 CLIMBS_M_S = (-0.5, 0.0, 0.5)
@@ -555,6 +558,7 @@ def build(speeds=SPEEDS_M_S, climbs=CLIMBS_M_S, force_law: str = "calibrated", p
                            "command": dict(zip(_COMMAND_NAMES, (float(x) for x in t.command))),
                            "com_m": t.com_m.tolist(), "inertia_kg_m2": t.inertia_kg_m2.tolist(),
                            "residual_force_per_weight": t.residual_force, "residual_moment_N_m": t.residual_moment_N_m,
+                           "trimmed": bool(t.residual_force <= TRIMMED_RESIDUAL),
                            "flown": flown(av, t), "A": A.tolist(), "B": B.tolist(), "modes": modes(A)})
             if c != 0.0:
                 done += 1

@@ -77,7 +77,7 @@ def filmed_flight(scales=None, force_law: str = "calibrated", settle_s: float = 
     return {"force_law": law, "scales": None if scales is None else [k_l, k_d],
             "speed_m_s": float((pos[-1, 0] - pos[0, 0]) / span), "climb_m_s": float((pos[-1, 2] - pos[0, 2]) / span),
             "bobbing_mm": m["bobbing_mm"], "power_W_kg": m["power_W_kg"], "power_net_W_kg": m["power_net_W_kg"],
-            "advance_ratio": m["advance_ratio"], "dorsal_gap_deg": m["dorsal_gap_deg"],
+            "advance_ratio": float(m["advance_ratio"]), "dorsal_gap_deg": m["dorsal_gap_deg"],
             "downstroke_weight_share": float(up_force[down].sum() / (weight * len(up_force))),
             "upstroke_weight_share": float(up_force[~down].sum() / (weight * len(up_force)))}
 

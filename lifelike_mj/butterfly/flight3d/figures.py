@@ -114,7 +114,8 @@ def fig_force_breakdown(breakdowns: dict, weight_N: float, path: str | os.PathLi
 
 def fig_averaged(model: dict, path: str | os.PathLike | None = None) -> Figure:
     """The averaged model over its envelope (:func:`~lifelike_mj.butterfly.flight3d.averaged.build`): the trims' body
-    angle, flap frequency and power against the forward speed (one line per climb rate), and the eigenvalues of the
+    angle, flap frequency and power against the forward speed (one line per climb rate; a point with no balance inside
+    the natural envelope is left out), and the eigenvalues of the
     longitudinal and lateral linear models in the complex plane (1/s), coloured by the forward speed."""
     from matplotlib import colormaps
 
@@ -123,6 +124,7 @@ def fig_averaged(model: dict, path: str | os.PathLike | None = None) -> Figure:
     climbs = sorted({p["climb_m_s"] for p in model["points"]})
     for c in climbs:
         pts = sorted((p for p in model["points"] if p["climb_m_s"] == c), key=lambda p: p["speed_m_s"])
+        pts = [p for p in pts if p["residual_force_per_weight"] <= 1e-3]  # no balance inside the envelope: not drawn
         v = [p["speed_m_s"] for p in pts]
         body.plot(v, [p["body_angle_deg"] for p in pts], "o-", ms=3, label=f"climb {c:+g} m/s")
         power.plot(v, [p["flown"]["power_net_W_kg"] for p in pts], "o-", ms=3, label=f"climb {c:+g} m/s")
