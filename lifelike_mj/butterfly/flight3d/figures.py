@@ -128,7 +128,8 @@ def fig_averaged(model: dict, path: str | os.PathLike | None = None) -> Figure:
         v = [p["speed_m_s"] for p in pts]
         body.plot(v, [p["body_angle_deg"] for p in pts], "o-", ms=3, label=f"climb {c:+g} m/s")
         power.plot(v, [p["flown"]["power_net_W_kg"] for p in pts], "o-", ms=3, label=f"climb {c:+g} m/s")
-    level = sorted((p for p in model["points"] if p["climb_m_s"] == 0.0), key=lambda p: p["speed_m_s"])
+    level = sorted((p for p in model["points"] if p["climb_m_s"] == 0.0 and p["residual_force_per_weight"] <= 1e-3),
+                   key=lambda p: p["speed_m_s"])
     ax2 = body.twinx()
     ax2.plot([p["speed_m_s"] for p in level], [p["command"]["frequency_hz"] for p in level], "k--", lw=0.9,
              label="flap frequency, level")
