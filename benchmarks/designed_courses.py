@@ -52,12 +52,48 @@ def fly(job: tuple[str, int]) -> dict:
     return out
 
 
+def picture(model_path: str, seed: int, out: str) -> None:
+    """The course of ``seed`` in the gusts of Dryden's ratio, drawn (``figures.fig_wind_course``): the path, the altitude
+    against the waypoints', and the wind estimate against the wind met."""
+    import numpy as np
+
+    from lifelike_mj.butterfly.flight3d import designed as D
+    from lifelike_mj.butterfly.flight3d import model as mj3d
+    from lifelike_mj.butterfly.flight3d.figures import fig_wind_course
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
+    from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+    from lifelike_mj.butterfly.flight3d.tasks import course
+
+    spec = D.design(json.loads(Path(model_path).read_text()))
+    ctl = D.DesignedController(spec)
+    task = course(seed).with_weather(**WEATHER["gusts_dryden"])
+    fl = Flight3D(KinematicsCommand(*D._interp(spec["schedule"], 1.5, "command")), animal="monarch",
+                  force_law="calibrated", controller=ctl, task=task)
+    t, pos, true, est, passed_at = [], [], [], [], []
+    while fl.time < 60.0 and fl.waypoints_passed < len(task.rows):
+        before = fl.waypoints_passed
+        fl.step(8)
+        if fl.waypoints_passed > before:
+            passed_at.append(fl.time)
+        t.append(fl.time)
+        pos.append(fl.data.qpos[:3].copy())
+        true.append(fl.data.userdata[mj3d.U_AIR : mj3d.U_AIR + 3].copy())
+        est.append(ctl.log[-1]["wind"])
+    fig_wind_course(np.array(t), np.array(pos), [r[:3] for r in task.rows], passed_at, np.array(true), np.array(est),
+                    out, title=f"course {seed}: 1 m/s wind to +x, gusts 0.5 m/s (vertical 0.25)")
+    print(f"{out}: {len(passed_at)} of {len(task.rows)} waypoints in {fl.time:.1f} s")
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--model", default=str(MODEL))
     ap.add_argument("--seeds", default="200-209", help="first-last")
     ap.add_argument("--out", default=str(HERE / "results" / "designed_courses.json"))
+    ap.add_argument("--picture", default=None, help="also draw one course in gusts (Dryden's ratio) here (.png)")
+    ap.add_argument("--picture-seed", type=int, default=200)
     args = ap.parse_args(argv)
+    if args.picture:
+        picture(args.model, args.picture_seed, args.picture)
     lo, hi = (int(v) for v in args.seeds.split("-"))
     start = time.perf_counter()
     with Pool(2) as pool:

@@ -157,3 +157,41 @@ def fig_averaged(model: dict, path: str | os.PathLike | None = None) -> Figure:
     for ax in (body, power):
         ax.legend(fontsize=7)
     return finish(fig, path)
+
+
+def fig_wind_course(t_s, position_m, waypoints, passed_at_s, wind_true_m_s, wind_estimate_m_s,
+                    path: str | os.PathLike | None = None, title: str = "") -> Figure:
+    """A course flown in wind: the path from above against its waypoints, the altitude against the waypoints' over
+    time (each waypoint's altitude until it is passed), and each horizontal component of the wind the butterfly
+    estimated against the wind it met (m/s, world axes; the estimate is the controller's own, made from its motion)."""
+    fig = new_figure(12.0, 7.5)
+    grid = fig.add_gridspec(2, 2, width_ratios=[1.0, 1.3])
+    top = fig.add_subplot(grid[:, 0])
+    alt = fig.add_subplot(grid[0, 1])
+    wind = fig.add_subplot(grid[1, 1], sharex=alt)
+    pos, wp = np.asarray(position_m), np.asarray(waypoints, dtype=float)
+    top.plot(pos[:, 0], pos[:, 1], lw=0.9, label="path")
+    top.scatter(wp[:, 0], wp[:, 1], marker="o", s=40, facecolors="none", edgecolors="k", label="waypoints (0.3 m)")
+    for k, (x, y) in enumerate(wp[:, :2]):
+        top.annotate(str(k + 1), (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+    top.set_aspect("equal", adjustable="datalim")
+    top.set_xlabel("x [m]")
+    top.set_ylabel("y [m]")
+    top.set_title(title or "from above")
+    top.legend(fontsize=7)
+    t = np.asarray(t_s)
+    alt.plot(t, pos[:, 2], lw=0.9, label="altitude")
+    edges = [0.0, *passed_at_s]
+    for k, (a, b) in enumerate(zip(edges, [*passed_at_s, t[-1]])):
+        if k < len(wp):
+            alt.hlines(wp[k, 2], a, b, colors="k", linestyles="--", lw=0.8, label="waypoint asked" if k == 0 else None)
+    alt.set_ylabel("altitude [m]")
+    alt.legend(fontsize=7)
+    true, est = np.asarray(wind_true_m_s), np.asarray(wind_estimate_m_s)
+    for i, (name, col) in enumerate((("x", "C0"), ("y", "C1"))):
+        wind.plot(t, true[:, i], color=col, lw=0.6, alpha=0.6, label=f"wind met, {name}")
+        wind.plot(t, est[:, i], color=col, lw=1.6, label=f"estimate, {name}")
+    wind.set_xlabel("time [s]")
+    wind.set_ylabel("wind [m/s]")
+    wind.legend(fontsize=7, ncol=2)
+    return finish(fig, path)
