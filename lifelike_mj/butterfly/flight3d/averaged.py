@@ -325,6 +325,14 @@ class Trim:
     residual_force: float
     residual_moment_N_m: float
 
+    @classmethod
+    def from_point(cls, point: dict) -> Trim:
+        """The trim of one point of a built model (:func:`build`'s ``points``, e.g. read from ``model3d``'s file)."""
+        return cls(float(point["speed_m_s"]), float(point["climb_m_s"]), math.radians(point["body_angle_deg"]),
+                   np.array(list(point["command"].values()), dtype=float), np.array(point["com_m"], dtype=float),
+                   np.array(point["inertia_kg_m2"], dtype=float), float(point["residual_force_per_weight"]),
+                   float(point["residual_moment_N_m"]))
+
     def velocity_body(self) -> np.ndarray:
         """The trim's velocity in the body's axes (m/s)."""
         return rotation(0.0, self.pitch_rad, 0.0).T @ np.array([self.speed_m_s, 0.0, self.climb_m_s])

@@ -1,13 +1,18 @@
 """The beat-averaged model (issue 42, point 1): its forces are the simulator's, its trims fly in the simulator, its
 linearisation has the rigid body's own terms, and its modes are named as Sun's."""
 
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from lifelike_mj.butterfly.flight3d import averaged as A
 from lifelike_mj.butterfly.flight3d.flight import Flight3D
+
+#: The averaged model ``lifelike-mj butterfly model3d`` built (its command in its provenance).
+MODEL = Path(__file__).resolve().parents[3] / "benchmarks" / "results" / "monarch_model.json"
 
 
 @pytest.fixture(scope="module")
@@ -43,8 +48,10 @@ def test_a_trim_flies_near_its_speed_in_free_flight_and_its_linear_model_has_the
     open loop, keeps near its speed for four beats (the model's accuracy: within 0.15 m/s forward and 0.2 m/s
     vertically) and rocks in pitch as the averaging predicts (within 20 %); its linear model has the rigid body's own
     terms and each control acts where it should."""
-    t = A.trim(av, 1.5, 0.0)
+    shipped = next(p for p in json.loads(MODEL.read_text())["points"] if p["speed_m_s"] == 1.5 and p["climb_m_s"] == 0)
+    t = A.trim(av, 1.5, 0.0, start=A.Trim.from_point(shipped))  # the shipped model's trim is one: it stays
     assert t.residual_force < 1e-3
+    assert abs(math.degrees(t.pitch_rad) - shipped["body_angle_deg"]) < 0.5
     lo, hi = A.ENVELOPE["frequency_hz"]
     assert lo <= t.command[0] <= hi
     flown = A.flown(av, t)
