@@ -199,10 +199,9 @@ class DesignedController:
     (``controller=DesignedController(design(model))``, ``control_every=1``): it measures at every step and sets a new
     command every ``every`` steps."""
 
-    def __init__(self, spec: dict, every: int = 8, predict: bool = False) -> None:
+    def __init__(self, spec: dict, every: int = 8) -> None:
         self.schedule = spec["schedule"]
         self.every = every
-        self.predict = predict
         self.lo, self.hi = limits()
         self.reset()
 
@@ -212,7 +211,6 @@ class DesignedController:
         self.v_hat = None
         self.w_hat = np.zeros(3)
         self.k = 0
-        self.prev_u = None
         self.heading = None
         self.airspeed = None
         self.log: list[dict] = []
@@ -323,10 +321,6 @@ class DesignedController:
         nu = len(av.CONTROLS)
         x[N_PLANT : N_PLANT + nu] = _symmetric(ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS]) - _symmetric(np.asarray(trim_cmd))
         x[N_PLANT + nu :] = _symmetric(ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS])  # the controls' rates as flown
-        if self.predict:  # the beat's mean lags half a beat: carry the model's state that far ahead
-            A = _interp(sched, airspeed, "A")
-            B = _interp(sched, airspeed, "B")
-            x[0:9] += 0.5 / freq * (A @ x[0:9] + B @ x[N_PLANT : N_PLANT + nu])
         zerr = float(np.clip(pos[2] - altitude, -MAX_ALTITUDE_ERROR_M, MAX_ALTITUDE_ERROR_M))
         x[9] = zerr
         x[10:13] = self.integral
@@ -336,8 +330,6 @@ class DesignedController:
         fwd = float(np.array([math.cos(heading), math.sin(heading), 0.0]) @ (vel - wind))
         self.integral = np.clip(self.integral + t_ctrl * np.array([zerr, fwd - airspeed, herr]), -INTEGRAL_LIMITS,
                                 INTEGRAL_LIMITS)
-        self.prev_u = clipped - _symmetric(trim_cmd)
-        self.prev_rates, self.prev_a, self.prev_R = rates, a, Rm
         self.log.append({"t": flight.time, "wind": wind.copy(), "heading": heading, "airspeed": airspeed,
                          "altitude": altitude, "pos": pos.copy(), "x": x.copy(), "u": clipped - _symmetric(trim_cmd)})
         p = av.command_from_controls(np.array(trim_cmd), clipped - _symmetric(np.array(trim_cmd)))
