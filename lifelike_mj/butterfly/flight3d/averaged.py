@@ -36,6 +36,8 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
+from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+
 #: The rate step (rad/s) of the body's damping of its own turning within the beat (:meth:`Averager.wrench`).
 DAMPING_STEP_RAD_S = 0.5
 #: Phases of a wing beat the wrench is averaged over.
@@ -83,6 +85,13 @@ def command_from_controls(base, u) -> np.ndarray:
     p[8] += fa
     p[10] += ab
     return p
+
+
+def controls_of(p: np.ndarray) -> np.ndarray:
+    """The controls' values (:data:`CONTROLS`) of the kinematics ``p``: the two wings' means and their differences
+    (left less right); :func:`command_from_controls` adds changes of them back."""
+    return np.array([p[0], 0.5 * (p[1] + p[2]), 0.5 * (p[3] + p[4]), p[1] - p[2], p[3] - p[4], 0.5 * (p[5] + p[6]),
+                     p[5] - p[6], 0.5 * (p[7] + p[8]), p[10]])
 
 
 @dataclass
@@ -204,10 +213,12 @@ class Averager:
             out[i] = np.linalg.solve(1j * w[i] * inertia - damping, Mk[i] - damping @ Sk[i])
         return np.fft.irfft(out, n, axis=0)
 
-    def wrench(self, p: np.ndarray, v, w, about: np.ndarray, iterations: int = 8) -> tuple[np.ndarray, np.ndarray]:
-        """The air's force (N) and its moment about the point ``about`` (N m; body axes from the thorax's origin),
-        both in the body's axes, averaged over one beat of the kinematics ``p`` with the body moving at a mean
-        ``v`` (m/s) and turning at ``w`` (rad/s) through still air (module docstring).
+    def wrench(self, p: np.ndarray, v, w, about: np.ndarray | None = None,
+               iterations: int = 8) -> tuple[np.ndarray, np.ndarray]:
+        """The air's force (N) and its moment about the point ``about`` (N m; body axes from the thorax's origin;
+        default the centre of mass of ``p`` averaged over the beat, kept as :attr:`com_m`), both in the body's axes,
+        averaged over one beat of the kinematics ``p`` with the body moving at a mean ``v`` (m/s) and turning at ``w``
+        (rad/s) through still air (module docstring).
 
         Within the beat the body does not move at a constant velocity: the air's force, less its mean, accelerates
         the whole butterfly's centre of mass, and the wings and abdomen move the thorax about that centre. On a
@@ -223,15 +234,20 @@ class Averager:
         n = self.n_phases
         wings = [int(d.userdata[mj3d.U_WING]), int(d.userdata[mj3d.U_WING + 1])]
         thorax = int(d.userdata[mj3d.U_THORAX])
-        rel, spin_momentum = np.empty((n, 3)), np.empty((n, 3))
+        coms, rel, spin_momentum = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
         inertia = np.zeros((3, 3))
         for k in range(n):
             self._pose(p, 2.0 * math.pi * k / n, np.zeros(3), np.zeros(3))
-            rel[k] = d.subtree_com[self._root] - d.xpos[thorax]
+            coms[k] = d.subtree_com[self._root]
+            rel[k] = coms[k] - d.xpos[thorax]
             if self.rotation:
                 mujoco.mj_subtreeVel(m, d)
                 spin_momentum[k] = d.subtree_angmom[self._root]
                 inertia += self._inertia_about(d.subtree_com[self._root]) / n
+        #: the whole butterfly's centre of mass averaged over the beat of the last call (m, body axes from the thorax's
+        #: origin, which the poses put at the world's)
+        self.com_m = coms.mean(axis=0)
+        about = self.com_m if about is None else about
         own = -self._periodic(rel, p[0], integrate=False)  # the thorax's velocity from the kinematics alone
         shake = own.copy()
         tilt, spin = np.zeros((n, 3)), np.zeros((n, 3))
@@ -283,11 +299,6 @@ class Averager:
         #: over the beat, of the last call (untilted axes)
         self.tilt, self.spin, self.shake = tilt, spin, shake
         return forces.mean(axis=0), moments.mean(axis=0)
-
-    def com(self, p: np.ndarray) -> np.ndarray:
-        """The whole butterfly's centre of mass averaged over a beat of the kinematics ``p`` (m, body axes from the
-        thorax's origin)."""
-        return self.mass_properties(p, inertia=False)[0]
 
 
 def rotation(roll: float, pitch: float, yaw: float) -> np.ndarray:
@@ -346,12 +357,12 @@ def derivative(av: Averager, trim: Trim, x, u) -> np.ndarray:
     x, u = np.asarray(x, float), np.asarray(u, float)
     v, w, a = x[0:3], x[3:6], x[6:9]
     p = command_from_controls(trim.command, u)
-    com = av.com(p) if np.any(u != 0.0) else trim.com_m
     R = rotation(0.0, trim.pitch_rad, 0.0) @ _exp(a)
     g = R.T @ np.array([0.0, 0.0, -av.params.gravity])
     v_thorax = v - np.cross(w, trim.com_m)
     force, moment = av.wrench(p, v_thorax, w, trim.com_m)
-    moment = moment + np.cross(com - trim.com_m, av.mass_kg * g)  # gravity at the kinematics' own centre of mass
+    com = av.com_m if np.any(u != 0.0) else trim.com_m  # the kinematics' own centre of mass, where gravity pulls
+    moment = moment + np.cross(com - trim.com_m, av.mass_kg * g)
     I = trim.inertia_kg_m2
     dv = force / av.mass_kg + g - np.cross(w, v)
     dw = np.linalg.solve(I, moment - np.cross(w, I @ w))
@@ -377,8 +388,8 @@ ARM_M = 0.01
 
 def _gait(p: np.ndarray) -> np.ndarray:
     """The trim's unknowns (:data:`TRIM_UNKNOWNS`) of the kinematics ``p`` (symmetric: the wings' means)."""
-    off, amp = 0.5 * (p[1] + p[2]), 0.5 * (p[3] + p[4])
-    return np.array([p[0], off + amp, amp, 0.5 * (p[5] + p[6]), 0.5 * (p[7] + p[8]), p[10]])
+    f, off, amp, _, _, fm, _, fa, ab = controls_of(p)
+    return np.array([f, off + amp, amp, fm, fa, ab])
 
 
 def _command(g: np.ndarray) -> np.ndarray:
@@ -415,7 +426,7 @@ def trim(av: Averager, speed_m_s: float, climb_m_s: float = 0.0, start: Trim | N
         p = _command(z[1:])
         R = rotation(0.0, z[0], 0.0)
         g = R.T @ np.array([0.0, 0.0, -av.params.gravity])
-        force, moment = av.wrench(p, R.T @ v_world, np.zeros(3), av.com(p))
+        force, moment = av.wrench(p, R.T @ v_world, np.zeros(3))  # moments about p's own centre of mass
         return (force + av.mass_kg * g) / av.weight_N, moment / (av.weight_N * ARM_M)
 
     body = math.radians(body_angle_target_deg(speed_m_s))
@@ -425,14 +436,11 @@ def trim(av: Averager, speed_m_s: float, climb_m_s: float = 0.0, start: Trim | N
         return np.concatenate([1e4 * np.array([f[0], f[2], m[1]]), (z[1:] - nat) / scales,
                                [(z[0] - body) / BODY_ANGLE_SCALE, av.power_W / av.mass_kg / POWER_SCALE_W_KG]])
 
-    starts = ([np.concatenate([[body], nat])] if start is None
-              else [np.concatenate([[start.pitch_rad], _gait(start.command)])])
-    sol = None
-    for z0 in starts:  # the filmed gait, or the neighbouring trim (continuation along the envelope)
-        s = least_squares(residual, np.clip(z0, lo, hi), bounds=(lo, hi), diff_step=1e-3, xtol=1e-10, ftol=1e-10,
-                          gtol=1e-10)
-        if sol is None or s.cost < sol.cost:
-            sol = s
+    # from the filmed gait, or from the neighbouring trim (continuation along the envelope)
+    z0 = (np.concatenate([[body], nat]) if start is None
+          else np.concatenate([[start.pitch_rad], _gait(start.command)]))
+    sol = least_squares(residual, np.clip(z0, lo, hi), bounds=(lo, hi), diff_step=1e-3, xtol=1e-10, ftol=1e-10,
+                        gtol=1e-10)
     f, m = balance(sol.x)
     p = _command(sol.x[1:])
     com, inertia = av.mass_properties(p)
@@ -448,7 +456,7 @@ CONTROL_STEPS = np.array([0.1] + [0.01] * (len(CONTROLS) - 1))
 def linearise(av: Averager, trim: Trim) -> tuple[np.ndarray, np.ndarray]:
     """``A = df/dx`` (9 x 9) and ``B = df/du`` (9 x 9) of :func:`derivative` at ``trim`` (module docstring), by central
     differences of whole-beat averages (:data:`STATE_STEPS`, :data:`CONTROL_STEPS`)."""
-    x0 = np.concatenate([trim.velocity_body() + np.cross(np.zeros(3), trim.com_m), np.zeros(6)])
+    x0 = np.concatenate([trim.velocity_body(), np.zeros(6)])
     u0 = np.zeros(len(CONTROLS))
     A = np.empty((9, 9))
     B = np.empty((9, len(CONTROLS)))
@@ -514,7 +522,6 @@ def flown(av: Averager, trim: Trim, beats: int = 6) -> dict:
     (W/kg, without and with perfect elastic storage), the stroke, dorsal gap and frequency flown."""
     from lifelike_mj.butterfly.flight3d import measures as M
     from lifelike_mj.butterfly.flight3d.flight import Flight3D
-    from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
 
     R0 = rotation(0.0, trim.pitch_rad, 0.0)
     v_body = trim.velocity_body()
@@ -563,7 +570,7 @@ def build(speeds=SPEEDS_M_S, climbs=CLIMBS_M_S, force_law: str = "calibrated", p
             t = level[v] if c == 0.0 else trim(av, v, c, start=level[v])
             A, B = linearise(av, t)
             points.append({"speed_m_s": v, "climb_m_s": c, "body_angle_deg": math.degrees(t.pitch_rad),
-                           "command": dict(zip(_COMMAND_NAMES, (float(x) for x in t.command))),
+                           "command": dict(zip(KinematicsCommand.names(), (float(x) for x in t.command))),
                            "com_m": t.com_m.tolist(), "inertia_kg_m2": t.inertia_kg_m2.tolist(),
                            "residual_force_per_weight": t.residual_force, "residual_moment_N_m": t.residual_moment_N_m,
                            "trimmed": bool(t.residual_force <= TRIMMED_RESIDUAL),
@@ -575,11 +582,3 @@ def build(speeds=SPEEDS_M_S, climbs=CLIMBS_M_S, force_law: str = "calibrated", p
     return {"animal": av.animal, "force_law": force_law, "mass_kg": av.mass_kg, "states": list(STATES),
             "controls": list(CONTROLS), "n_phases": av.n_phases, "points": points}
 
-
-def _names():
-    from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
-
-    return KinematicsCommand.names()
-
-
-_COMMAND_NAMES = _names()
