@@ -78,7 +78,7 @@ def picture(model_path: str, seed: int, out: str) -> None:
         t.append(fl.time)
         pos.append(fl.data.qpos[:3].copy())
         true.append(fl.data.userdata[mj3d.U_AIR : mj3d.U_AIR + 3].copy())
-        est.append(ctl.log[-1]["wind"])
+        est.append(ctl.last["wind"])
     fig_wind_course(np.array(t), np.array(pos), [r[:3] for r in task.rows], passed_at, np.array(true), np.array(est),
                     out, title=f"course {seed}: 1 m/s wind to +x, gusts 0.5 m/s (vertical 0.25)")
     print(f"{out}: {len(passed_at)} of {len(task.rows)} waypoints in {fl.time:.1f} s")

@@ -40,6 +40,7 @@ from __future__ import annotations
 import math
 from collections import deque
 
+import mujoco
 import numpy as np
 
 from lifelike_mj.butterfly.flight3d import averaged as av
@@ -131,7 +132,7 @@ def lqr(A: np.ndarray, B: np.ndarray, q_scales=Q_SCALES, r_scales=R_SCALES) -> n
     return np.linalg.solve(R, B.T @ P)
 
 
-def design(model: dict, q_scales=Q_SCALES, r_scales=R_SCALES, beats_per_cycle: float = 1.0) -> dict:
+def design(model: dict, q_scales=Q_SCALES, r_scales=R_SCALES) -> dict:
     """The designed controller's schedule from an averaged model (:func:`~lifelike_mj.butterfly.flight3d.averaged.build`
     output; its level trims): per speed the trim (body angle, kinematics, body velocity), the model rows the wind
     observer needs, the gain, and the closed loop's slowest pole (1/s)."""
@@ -141,7 +142,7 @@ def design(model: dict, q_scales=Q_SCALES, r_scales=R_SCALES, beats_per_cycle: f
         A, B = np.array(p["A"]), np.array(p["B"])
         pitch = math.radians(p["body_angle_deg"])
         v0 = av.rotation(0.0, pitch, 0.0).T @ np.array([p["speed_m_s"], 0.0, 0.0])
-        omega_c = 2.0 * math.pi * p["command"]["frequency_hz"] / beats_per_cycle
+        omega_c = 2.0 * math.pi * p["command"]["frequency_hz"]  # the kinematics follow a command in one beat
         Aa, Ba = augment(A, B, pitch, v0, omega_c)
         K = lqr(Aa, Ba, q_scales, r_scales)
         poles = np.linalg.eigvals(Aa - Ba @ K)
@@ -152,12 +153,17 @@ def design(model: dict, q_scales=Q_SCALES, r_scales=R_SCALES, beats_per_cycle: f
             "r_scales": list(map(float, r_scales))}
 
 
-def _interp(schedule: list[dict], speed: float, key: str) -> np.ndarray:
-    speeds = np.array([s["speed_m_s"] for s in schedule])
+def _lerp(speeds: np.ndarray, values: np.ndarray, speed: float) -> np.ndarray:
+    """``values`` (one row per speed of ``speeds``, ascending) interpolated linearly at ``speed``, held at the ends."""
     x = float(np.clip(speed, speeds[0], speeds[-1]))
     i = int(np.clip(np.searchsorted(speeds, x) - 1, 0, len(speeds) - 2))
     t = (x - speeds[i]) / (speeds[i + 1] - speeds[i])
-    return (1.0 - t) * np.asarray(schedule[i][key], float) + t * np.asarray(schedule[i + 1][key], float)
+    return (1.0 - t) * values[i] + t * values[i + 1]
+
+
+def _interp(schedule: list[dict], speed: float, key: str) -> np.ndarray:
+    """The schedule's ``key`` (:func:`design`) interpolated at the airspeed ``speed`` (m/s)."""
+    return _lerp(np.array([s["speed_m_s"] for s in schedule]), np.array([s[key] for s in schedule], float), speed)
 
 
 def _log(R: np.ndarray) -> np.ndarray:
@@ -188,12 +194,6 @@ def limits() -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
-def _symmetric(p: np.ndarray) -> np.ndarray:
-    """The controls' absolute values (:data:`~lifelike_mj.butterfly.flight3d.averaged.CONTROLS`) of kinematics ``p``."""
-    return np.array([p[0], 0.5 * (p[1] + p[2]), 0.5 * (p[3] + p[4]), p[1] - p[2], p[3] - p[4], 0.5 * (p[5] + p[6]),
-                     p[5] - p[6], 0.5 * (p[7] + p[8]), p[10]])
-
-
 class DesignedController:
     """The designed controller (module docstring) as a Python callable for :class:`Flight3D`
     (``controller=DesignedController(design(model))``, ``control_every=1``): it measures at every step and sets a new
@@ -201,6 +201,10 @@ class DesignedController:
 
     def __init__(self, spec: dict, every: int = 8) -> None:
         self.schedule = spec["schedule"]
+        # the schedule as arrays, made once: what each control step interpolates
+        self._speeds = np.array([s["speed_m_s"] for s in self.schedule])
+        self._table = {k: np.array([s[k] for s in self.schedule], float)
+                       for k in ("body_angle_rad", "v0_body_m_s", "K", "command", "A", "B")}
         self.every = every
         self.lo, self.hi = limits()
         self.reset()
@@ -213,7 +217,11 @@ class DesignedController:
         self.k = 0
         self.heading = None
         self.airspeed = None
-        self.log: list[dict] = []
+        #: what the last control step saw and did: time, wind estimate, references, state and controls
+        self.last: dict | None = None
+
+    def _at(self, speed: float, key: str) -> np.ndarray:
+        return _lerp(self._speeds, self._table[key], speed)
 
     # ---- guidance -----------------------------------------------------------------------------------------------
 
@@ -230,17 +238,10 @@ class DesignedController:
             d = to / dist if dist > 1e-9 else np.array([1.0, 0.0])
             # slower as it closes, so that its turns are tighter than the waypoint's radius
             speed = min(task.speed_m_s, APPROACH_MIN_M_S + APPROACH_PER_S * dist)
-            return self._ref_tuple(d, speed, wind, float(wp[2]))
-        heading, altitude, speed = flight.reference
-        d = np.array([math.cos(heading), math.sin(heading)])
-        return self._ref_tuple(d, speed, wind, altitude, ground=False)
-
-    def _ref_tuple(self, d, speed, wind, altitude, ground: bool = True):
-        if not ground:  # a schedule asks for a heading and an airspeed
-            return float(math.atan2(d[1], d[0])), float(altitude), float(np.clip(speed, MIN_AIRSPEED_M_S,
-                                                                                   MAX_AIRSPEED_M_S))
-        heading, airspeed = self.wind_triangle(d, speed, wind[:2])
-        return heading, float(altitude), airspeed
+            heading, airspeed = self.wind_triangle(d, speed, wind[:2])
+            return heading, float(wp[2]), airspeed
+        heading, altitude, speed = flight.reference  # a schedule asks for a heading and an airspeed
+        return float(heading), float(altitude), float(np.clip(speed, MIN_AIRSPEED_M_S, MAX_AIRSPEED_M_S))
 
     @staticmethod
     def wind_triangle(d: np.ndarray, ground_speed: float, wind_xy: np.ndarray) -> tuple[float, float]:
@@ -269,8 +270,6 @@ class DesignedController:
         dt = flight.dt
         quat = d.qpos[3:7]
         R = np.empty(9)
-        import mujoco
-
         mujoco.mju_quat2Mat(R, quat)
         R = R.reshape(3, 3)
         freq = float(d.userdata[mj3d.U_P0])  # the flap frequency flown
@@ -301,11 +300,11 @@ class DesignedController:
         turn = float(np.clip(_wrap(target - self.heading), -step, step))
         heading = self.heading = _wrap(self.heading + turn)
         turn_rate = turn / t_ctrl  # the heading asked turns at this rate (rad/s, left > 0): a coordinated turn
-        sched = self.schedule
-        pitch0 = float(_interp(sched, airspeed, "body_angle_rad"))
-        v0 = _interp(sched, airspeed, "v0_body_m_s")
-        K = _interp(sched, airspeed, "K")
-        trim_cmd = _interp(sched, airspeed, "command")
+        pitch0 = float(self._at(airspeed, "body_angle_rad"))
+        v0 = self._at(airspeed, "v0_body_m_s")
+        K = self._at(airspeed, "K")
+        trim_cmd = self._at(airspeed, "command")
+        trim_u = av.controls_of(trim_cmd)
         yaw = math.atan2(Rm[1, 0], Rm[0, 0])
         herr = float(np.clip(_wrap(yaw - heading), -MAX_HEADING_ERROR_RAD, MAX_HEADING_ERROR_RAD))
         # the trim attitude at the heading asked (the error clipped), banked into the turn asked: tan(bank) = v r / g
@@ -319,21 +318,19 @@ class DesignedController:
         x[6:9] = np.clip(a, -MAX_ATTITUDE_ERROR_RAD, MAX_ATTITUDE_ERROR_RAD)
         ud = d.userdata
         nu = len(av.CONTROLS)
-        x[N_PLANT : N_PLANT + nu] = _symmetric(ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS]) - _symmetric(np.asarray(trim_cmd))
-        x[N_PLANT + nu :] = _symmetric(ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS])  # the controls' rates as flown
+        x[N_PLANT : N_PLANT + nu] = av.controls_of(ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS]) - trim_u
+        x[N_PLANT + nu :] = av.controls_of(ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS])  # the controls' rates as flown
         zerr = float(np.clip(pos[2] - altitude, -MAX_ALTITUDE_ERROR_M, MAX_ALTITUDE_ERROR_M))
         x[9] = zerr
         x[10:13] = self.integral
         u = -K @ x
-        absolute = _symmetric(trim_cmd) + u
-        clipped = np.clip(absolute, self.lo, self.hi)
+        change = np.clip(trim_u + u, self.lo, self.hi) - trim_u
         fwd = float(np.array([math.cos(heading), math.sin(heading), 0.0]) @ (vel - wind))
         self.integral = np.clip(self.integral + t_ctrl * np.array([zerr, fwd - airspeed, herr]), -INTEGRAL_LIMITS,
                                 INTEGRAL_LIMITS)
-        self.log.append({"t": flight.time, "wind": wind.copy(), "heading": heading, "airspeed": airspeed,
-                         "altitude": altitude, "pos": pos.copy(), "x": x.copy(), "u": clipped - _symmetric(trim_cmd)})
-        p = av.command_from_controls(np.array(trim_cmd), clipped - _symmetric(np.array(trim_cmd)))
-        return KinematicsCommand(*p)
+        self.last = {"t": flight.time, "wind": wind.copy(), "heading": heading, "airspeed": airspeed,
+                     "altitude": altitude, "pos": pos.copy(), "x": x, "u": change}
+        return KinematicsCommand(*av.command_from_controls(trim_cmd, change))
 
     def wind(self, vel: np.ndarray, Rm: np.ndarray, rates: np.ndarray, flown: np.ndarray, dt: float) -> np.ndarray:
         """The wind estimate (world, m/s): one step of the observer (module docstring). The model's acceleration is
@@ -348,15 +345,14 @@ class DesignedController:
             return self.w_hat.copy()
         air = (self.v_hat - self.w_hat)[:2]
         speed = float(np.linalg.norm(air))
-        sched = self.schedule
-        A = _interp(sched, speed, "A")
-        B = _interp(sched, speed, "B")
-        v0 = _interp(sched, speed, "v0_body_m_s")
-        pitch0 = float(_interp(sched, speed, "body_angle_rad"))
-        trim_cmd = _interp(sched, speed, "command")
+        A = self._at(speed, "A")
+        B = self._at(speed, "B")
+        v0 = self._at(speed, "v0_body_m_s")
+        pitch0 = float(self._at(speed, "body_angle_rad"))
+        trim_cmd = self._at(speed, "command")
         yaw = math.atan2(Rm[1, 0], Rm[0, 0])
         a = _log(av.rotation(0.0, pitch0, yaw).T @ Rm)
-        u = _symmetric(flown) - _symmetric(trim_cmd)
+        u = av.controls_of(flown) - av.controls_of(trim_cmd)
         v_b = Rm.T @ (self.v_hat - self.w_hat)
         acc = Rm @ (A[0:3, 0:3] @ (v_b - v0) + A[0:3, 3:6] @ rates + A[0:3, 6:9] @ a + B[0:3] @ u)
         Avv = Rm @ A[0:3, 0:3] @ Rm.T
