@@ -124,11 +124,11 @@ def fig_averaged(model: dict, path: str | os.PathLike | None = None) -> Figure:
     climbs = sorted({p["climb_m_s"] for p in model["points"]})
     for c in climbs:
         pts = sorted((p for p in model["points"] if p["climb_m_s"] == c), key=lambda p: p["speed_m_s"])
-        pts = [p for p in pts if p["residual_force_per_weight"] <= 1e-3]  # no balance inside the envelope: not drawn
+        pts = [p for p in pts if p["trimmed"]]  # no balance inside the envelope: not drawn
         v = [p["speed_m_s"] for p in pts]
         body.plot(v, [p["body_angle_deg"] for p in pts], "o-", ms=3, label=f"climb {c:+g} m/s")
         power.plot(v, [p["flown"]["power_net_W_kg"] for p in pts], "o-", ms=3, label=f"climb {c:+g} m/s")
-    level = sorted((p for p in model["points"] if p["climb_m_s"] == 0.0 and p["residual_force_per_weight"] <= 1e-3),
+    level = sorted((p for p in model["points"] if p["climb_m_s"] == 0.0 and p["trimmed"]),
                    key=lambda p: p["speed_m_s"])
     ax2 = body.twinx()
     ax2.plot([p["speed_m_s"] for p in level], [p["command"]["frequency_hz"] for p in level], "k--", lw=0.9,
