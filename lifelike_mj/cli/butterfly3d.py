@@ -66,10 +66,10 @@ def _task(args):
 def cmd_fly3d(args) -> None:
     import numpy as np
 
-    from lifelike_mj.butterfly.flight3d.controllers import load_controller
+    from lifelike_mj.butterfly.flight3d.designed import load_any
     from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
-    ctrl = load_controller(args.controller)
+    ctrl = load_any(args.controller)
     check_outputs(args, folders={"--out": FLY3D_FILES})
     flight = Flight3D(controller=ctrl, task=_task(args), dt_s=args.dt)
     with stage(f"3D flight, {args.duration:g} s"):
@@ -205,6 +205,48 @@ def cmd_model3d(args) -> None:
                                      if m["real_per_s"] > 1e-6 or m["name"] == "neutral") for p in level))
     emit(args, {"out": args.out, "figure": args.figure, "levels": level and [
         {"speed_m_s": p["speed_m_s"], "body_angle_deg": p["body_angle_deg"], "modes": p["modes"]} for p in level]}, human)
+
+
+def cmd_design3d(args) -> None:
+    import numpy as np
+
+    from lifelike_mj.butterfly.flight3d import averaged, designed
+    from lifelike_mj.io import write_json
+    from lifelike_mj.paths import read_json
+    from lifelike_mj.provenance import provenance
+
+    check_outputs(args, files={"--out": (".json",)})
+    if args.model:
+        model = designed.check_model(read_json(args.model, "averaged model"), f"averaged model {args.model}")
+    else:
+        with stage(f"{len(args.speeds)} level trims and their linear models", total=len(args.speeds),
+                   unit="trim") as bar:
+            model = averaged.build(args.speeds, [0.0], progress=lambda done, _n: bar.update(1))
+    with stage("the gains (LQR at every level trim)"):
+        spec = designed.design(model)
+    name = Path(args.out).stem
+    ctl = designed.DesignedController(spec, name=name, provenance=provenance(
+        model=args.model, model_provenance=model.get("provenance"), speeds_m_s=[s["speed_m_s"] for s in spec["schedule"]],
+        q_scales=spec["q_scales"], r_scales=spec["r_scales"]))
+    with stage("a check: 4 s of level flight at 1.5 m/s"):
+        from lifelike_mj.butterfly.flight3d import tasks
+        from lifelike_mj.butterfly.flight3d.flight import Flight3D
+
+        fl = Flight3D(controller=designed.DesignedController(spec), task=tasks.level(1.5))
+        fl.step(int(round(2.0 / fl.dt)))
+        z = []
+        while fl.time < 4.0:
+            fl.step(8)
+            z.append(fl.data.qpos[2])
+    write_json(args.out, ctl.to_dict())
+    alt_rms = float(np.sqrt(np.mean(np.square(z))))
+    speeds = [s["speed_m_s"] for s in spec["schedule"]]
+    human = (f"wrote {args.out}: a controller designed for the {spec['animal']} at {len(speeds)} airspeeds "
+             f"({speeds[0]:g}-{speeds[-1]:g} m/s), slowest closed-loop pole "
+             f"{min(s['slowest_pole_per_s'] for s in spec['schedule']):.2f}/s; level at 1.5 m/s: altitude within "
+             f"{100 * alt_rms:.1f} cm rms (2-4 s). Fly it: lifelike-mj butterfly fly3d --controller {args.out}")
+    emit(args, {"out": args.out, "speeds_m_s": speeds, "level_altitude_rms_m": alt_rms,
+                "slowest_pole_per_s": [s["slowest_pole_per_s"] for s in spec["schedule"]]}, human)
 
 
 def _values(text: str, lo: float, hi: float) -> list[float]:
@@ -493,6 +535,18 @@ def add_commands(bf) -> None:
     add_overwrite(p)
     add_json(p)
     p.set_defaults(func=cmd_model3d)
+    p = bf.add_parser("design3d", help="design the flight controller from the averaged model: LQR at every level "
+                                       "trim, with integral action and a wind estimate (seconds with --model; minutes "
+                                       "from nothing)")
+    p.add_argument("--out", required=True, help="the controller file to write (.json)")
+    p.add_argument("--model", default=None, help="an averaged model file (lifelike-mj butterfly model3d); without it "
+                                                 "the level trims are built first")
+    p.add_argument("--speeds", type=_speeds, default=[0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5],
+                   help="without --model: forward speeds of the level trims, m/s, comma-separated "
+                        "(default 0.5 to 2.5 by 0.25)")
+    add_overwrite(p)
+    add_json(p)
+    p.set_defaults(func=cmd_design3d)
     p = bf.add_parser("strobe3d", help="a stroboscopic picture of one wing beat in level flight, from the side and "
                                        "from ahead")
     _add_level_flight(p, 3.0, "seconds of flight before the beat")

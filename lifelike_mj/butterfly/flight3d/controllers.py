@@ -75,6 +75,9 @@ FORCE_LAWS_FLOWN = ("exact", "strip", "quasi_steady", "calibrated")
 #: ``from_m`` (m) out, ``take_off`` for ``for_s`` (s); and the reach a new one gets.
 MODES = {"land": "from_m", "take_off": "for_s"}
 MODE_REACH = {"land": 0.6, "take_off": 1.0}
+#: The kinds of 3D controller file: a network (the default, :class:`Controller3D`) or a controller designed from the
+#: averaged model (:mod:`~lifelike_mj.butterfly.flight3d.designed`).
+KINDS = ("network", "designed")
 #: A controller's networks in the compiled loop's order (:meth:`Controller3D.all_weights`,
 #: :func:`~lifelike_mj.butterfly.flight3d.loop.behaviour`'s answer indexes it): the flight network, then the behaviours.
 NETWORKS = ("flight", *MODES)
@@ -351,6 +354,8 @@ def json_schema() -> dict:
 
     max_weights = n_weights([N_OBS, *[MAX_WIDTH] * (MAX_LAYERS - 2), N_ACT])
     props = {
+        "kind": {"const": "network", "description": "a network controller (the default); a designed controller has "
+                 "its own schema (butterfly3d-designed)"},
         "layers": {"type": "array", "minItems": 2, "maxItems": MAX_LAYERS,
                    "items": {"type": "integer", "minimum": 1, "maximum": MAX_WIDTH},
                    "description": f"neurons per layer, from the first {INPUT_COUNTS[0]} observations or all "
@@ -415,12 +420,22 @@ def controller_from_dict(data: object, name: str = "") -> Controller3D:
     """A :class:`Controller3D` from plain data (a parsed controller file); one sentence for anything wrong
     (checked against :func:`json_schema` before any value is used: first the lengths of its lists, then its layers,
     then the numbers of as many weights as the layers need and one more, then their count: the work never grows
-    beyond the network's shape)."""
+    beyond the network's shape). A file of ``"kind": "designed"`` is one sentence saying where it flies
+    (:func:`~lifelike_mj.butterfly.flight3d.designed.load_any` reads either kind)."""
     from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+    from lifelike_mj.errors import UserError
     from lifelike_mj.schema import check_header, validate
 
     where = f"3D controller {name}" if name else "3D controller"
     d = check_header(data, FORMAT, f"file {name}" if name else "the data", kind="3D controller file")
+    kind = d.get("kind", "network")
+    if kind == "designed":
+        raise UserError(f"{where} is a designed controller (kind \"designed\"): for now it flies through "
+                        "'lifelike-mj butterfly fly3d' and Flight3D (designed.load_any), not here, where network "
+                        "controllers fly.")
+    if kind != "network":
+        raise UserError(f"{where}: kind is {' or '.join(repr(k) for k in KINDS)}, got {_short(kind)}.")
+    d = {k: v for k, v in d.items() if k != "kind"}
     schema = json_schema()
     validate(_check_shapes(d, schema, where), schema, where)
     layers = _check_layers(d["layers"], where)
@@ -464,11 +479,11 @@ def withdrawn_file(name: str):
     return path
 
 
-def load_controller(name_or_path) -> Controller3D:
-    """A shipped 3D controller by name (``controllers/butterfly3d/``) or any 3D controller file by path. A withdrawn
-    controller's name (:data:`WITHDRAWN`) gets a :class:`~lifelike_mj.errors.UserError` that says why; a file larger
-    than :data:`MAX_FILE_BYTES` is refused by its size before it is read, and its lists by their lengths before their
-    numbers (:func:`controller_from_dict`)."""
+def read_controller_file(name_or_path) -> tuple[object, str]:
+    """The parsed content and the name of a shipped 3D controller (by name, ``controllers/butterfly3d/``) or of any 3D
+    controller file (by path), either kind. A withdrawn controller's name (:data:`WITHDRAWN`) gets a
+    :class:`~lifelike_mj.errors.UserError` that says why; a file larger than :data:`MAX_FILE_BYTES` is refused by its
+    size before it is read."""
     from pathlib import Path
 
     from lifelike_mj.errors import UserError
@@ -480,4 +495,12 @@ def load_controller(name_or_path) -> Controller3D:
                 if text != "cruise" else "its file is in the repository's history")
         raise UserError(f"the 3D controller {text!r} was withdrawn: {WITHDRAWN[text]}; use 'monarch', or {kept}.")
     path = resolve("butterfly3d", name_or_path, "3D controller")
-    return controller_from_dict(read_json(path, "3D controller", max_bytes=MAX_FILE_BYTES), path.stem)
+    return read_json(path, "3D controller", max_bytes=MAX_FILE_BYTES), path.stem
+
+
+def load_controller(name_or_path) -> Controller3D:
+    """A shipped 3D network controller by name (``controllers/butterfly3d/``) or any 3D controller file by path
+    (:func:`read_controller_file`), its lists checked by their lengths before their numbers
+    (:func:`controller_from_dict`)."""
+    data, name = read_controller_file(name_or_path)
+    return controller_from_dict(data, name)

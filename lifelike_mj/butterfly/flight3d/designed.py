@@ -149,8 +149,8 @@ def design(model: dict, q_scales=Q_SCALES, r_scales=R_SCALES) -> dict:
         out.append({"speed_m_s": p["speed_m_s"], "body_angle_rad": pitch, "command": list(p["command"].values()),
                     "v0_body_m_s": v0.tolist(), "A": A.tolist(), "B": B.tolist(), "K": K.tolist(),
                     "slowest_pole_per_s": float(-poles.real.max())})
-    return {"kind": "designed", "schedule": out, "q_scales": list(map(float, q_scales)),
-            "r_scales": list(map(float, r_scales))}
+    return {"kind": "designed", "animal": model.get("animal", "monarch"), "force_law": model.get("force_law", "calibrated"),
+            "schedule": out, "q_scales": list(map(float, q_scales)), "r_scales": list(map(float, r_scales))}
 
 
 def _lerp(speeds: np.ndarray, values: np.ndarray, speed: float) -> np.ndarray:
@@ -197,9 +197,17 @@ def limits() -> tuple[np.ndarray, np.ndarray]:
 class DesignedController:
     """The designed controller (module docstring) as a Python callable for :class:`Flight3D`
     (``controller=DesignedController(design(model))``, ``control_every=1``): it measures at every step and sets a new
-    command every ``every`` steps."""
+    command every ``every`` steps. ``spec``: :func:`design`'s answer or a designed controller file's content
+    (:func:`controller_from_dict` checks a file first); ``name`` and ``provenance`` as a file gives them. Its
+    ``animal`` and ``force_law`` are those of the model it was designed on (a flight takes them unless told
+    otherwise), :meth:`start_command` the trim to start from."""
 
-    def __init__(self, spec: dict, every: int = 8) -> None:
+    def __init__(self, spec: dict, every: int = 8, name: str = "", provenance: dict | None = None) -> None:
+        self.name = name
+        self.provenance = dict(provenance or spec.get("provenance") or {})
+        self.animal = spec.get("animal", "monarch")
+        self.force_law = spec.get("force_law", "calibrated")
+        self.q_scales, self.r_scales = spec.get("q_scales"), spec.get("r_scales")
         self.schedule = spec["schedule"]
         # the schedule as arrays, made once: what each control step interpolates
         self._speeds = np.array([s["speed_m_s"] for s in self.schedule])
@@ -219,6 +227,27 @@ class DesignedController:
         self.airspeed = None
         #: what the last control step saw and did: time, wind estimate, references, state and controls
         self.last: dict | None = None
+
+    def start_command(self, speed_m_s: float = 1.5):
+        """The trim's kinematics at the airspeed ``speed_m_s`` (m/s, held within the schedule's speeds): where a
+        flight with this controller starts."""
+        from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+
+        return KinematicsCommand(*self._at(speed_m_s, "command"))
+
+    def to_dict(self) -> dict:
+        """The controller file's content (:data:`~lifelike_mj.butterfly.flight3d.controllers.FORMAT`, ``kind``
+        ``"designed"``): what :func:`controller_from_dict` reads back."""
+        from lifelike_mj.butterfly.flight3d.controllers import FORMAT
+
+        out = {"format": FORMAT, "version": 1, "kind": "designed", "animal": self.animal, "force_law": self.force_law,
+               "schedule": self.schedule}
+        if self.q_scales is not None:
+            out["q_scales"], out["r_scales"] = list(self.q_scales), list(self.r_scales)
+        if self.name:
+            out["name"] = self.name
+        out["provenance"] = self.provenance
+        return out
 
     def _at(self, speed: float, key: str) -> np.ndarray:
         return _lerp(self._speeds, self._table[key], speed)
@@ -363,3 +392,126 @@ class DesignedController:
         dw[2] = 0.0
         self.w_hat = self.w_hat + dt * dw
         return self.w_hat.copy()
+
+
+#: Bounds of a designed controller file: speeds in its schedule (at least two), the size of any number in it.
+MAX_SCHEDULE, MAX_VALUE = 64, 1.0e7
+
+
+def json_schema() -> dict:
+    """The JSON Schema of a designed controller file (``docs/schemas/butterfly3d-designed.schema.json``): the 3D
+    controller file's format with ``"kind": "designed"``, what :func:`controller_from_dict` enforces before it builds
+    the controller."""
+    from lifelike_mj.butterfly.flight3d.animals import ANIMALS
+    from lifelike_mj.butterfly.flight3d.controllers import FORCE_LAWS_FLOWN, FORMAT
+    from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+    from lifelike_mj.schema import document_schema, number
+
+    def vector(n: int, what: str = "") -> dict:
+        return {"type": "array", "minItems": n, "maxItems": n, "items": number("", -MAX_VALUE, MAX_VALUE),
+                **({"description": what} if what else {})}
+
+    def matrix(rows: int, cols: int, what: str) -> dict:
+        return {"type": "array", "minItems": rows, "maxItems": rows, "items": vector(cols), "description": what}
+
+    nx, nu, nc = len(av.STATES), len(av.CONTROLS), len(KinematicsCommand.names())
+    point = {"type": "object", "additionalProperties": False,
+             "required": ["speed_m_s", "body_angle_rad", "command", "v0_body_m_s", "A", "B", "K"],
+             "properties": {
+                 "speed_m_s": number("m/s: the trim's airspeed", 0.05, 10.0),
+                 "body_angle_rad": number("rad: the trim's body angle, nose up", -math.pi / 2, math.pi / 2),
+                 "command": vector(nc, "the trim's kinematics (KinematicsCommand's order)"),
+                 "v0_body_m_s": vector(3, "m/s: the trim's air velocity in body axes"),
+                 "A": matrix(nx, nx, "the averaged model's state matrix (states u v w p q r a_x a_y a_z)"),
+                 "B": matrix(nx, nu, "the averaged model's control matrix"),
+                 "K": matrix(nu, N_AUG, "the LQR gain, u = -K x of the augmented state"),
+                 "slowest_pole_per_s": number("1/s: the closed loop's slowest pole"),
+             }}
+    props = {
+        "kind": {"const": "designed", "description": "a controller designed from the averaged model"},
+        "animal": {"enum": list(ANIMALS), "description": "the butterfly it flies"},
+        "force_law": {"enum": list(FORCE_LAWS_FLOWN), "description": "the wing-force law of its model"},
+        "schedule": {"type": "array", "minItems": 2, "maxItems": MAX_SCHEDULE, "items": point,
+                     "description": "per level trim, by rising airspeed: the trim, its linear model and the gain"},
+        "q_scales": vector(N_PLANT, "Bryson's scales of the states it was designed with"),
+        "r_scales": vector(nu, "Bryson's scales of the controls it was designed with"),
+        "provenance": {"type": "object"},
+    }
+    return document_schema(FORMAT, "lifelike-mj 3D butterfly controller, designed", props,
+                           ["kind", "animal", "force_law", "schedule"],
+                           "A flight controller designed from the wing-beat-averaged model: level trims by airspeed, "
+                           "their linear models and LQR gains.")
+
+
+def controller_from_dict(data: object, name: str = "") -> DesignedController:
+    """A :class:`DesignedController` from a parsed designed controller file; one sentence for anything wrong
+    (the header, then :func:`json_schema` with the lengths of its lists first, then the schedule's airspeeds, which
+    must rise, and each trim's kinematics)."""
+    from lifelike_mj.butterfly.flight3d.controllers import FORMAT
+    from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+    from lifelike_mj.errors import UserError
+    from lifelike_mj.schema import check_header, too_long, validate
+
+    where = f"designed 3D controller {name}" if name else "designed 3D controller"
+    d = check_header(data, FORMAT, f"file {name}" if name else "the data", kind="3D controller file")
+    schema = json_schema()
+    too_long(d, schema, where)
+    validate(d, schema, where)
+    speeds = [p["speed_m_s"] for p in d["schedule"]]
+    if any(b <= a for a, b in zip(speeds, speeds[1:])):
+        raise UserError(f"{where}: the schedule's airspeeds must rise from one trim to the next, got {speeds}.")
+    for p in d["schedule"]:
+        KinematicsCommand(*p["command"])  # its own sentence for a command out of bounds
+    return DesignedController(d, name=name, provenance=d.get("provenance"))
+
+
+def model_schema() -> dict:
+    """The JSON Schema of what :func:`design` reads of an averaged model file (``lifelike-mj butterfly model3d``'s
+    output): its animal, force law and points, each with its speed, climb, body angle, kinematics and linear model."""
+    from lifelike_mj.butterfly.flight3d.animals import ANIMALS
+    from lifelike_mj.butterfly.flight3d.controllers import FORCE_LAWS_FLOWN
+    from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+    from lifelike_mj.schema import number
+
+    nx, nu = len(av.STATES), len(av.CONTROLS)
+    row = {"type": "array", "items": number("", -MAX_VALUE, MAX_VALUE)}
+    point = {"type": "object", "required": ["speed_m_s", "climb_m_s", "body_angle_deg", "command", "A", "B"],
+             "properties": {
+                 "speed_m_s": number("m/s", 0.05, 10.0), "climb_m_s": number("m/s", -10.0, 10.0),
+                 "body_angle_deg": number("deg", -90.0, 90.0),
+                 "command": {"type": "object", "additionalProperties": False,
+                             "required": list(KinematicsCommand.names()),
+                             "properties": {k: number("", -MAX_VALUE, MAX_VALUE) for k in KinematicsCommand.names()}},
+                 "A": {"type": "array", "minItems": nx, "maxItems": nx, "items": {**row, "minItems": nx, "maxItems": nx}},
+                 "B": {"type": "array", "minItems": nx, "maxItems": nx, "items": {**row, "minItems": nu, "maxItems": nu}}}}
+    return {"type": "object", "required": ["animal", "force_law", "points"],
+            "properties": {"animal": {"enum": list(ANIMALS)}, "force_law": {"enum": list(FORCE_LAWS_FLOWN)},
+                           "points": {"type": "array", "minItems": 2, "maxItems": 4 * MAX_SCHEDULE, "items": point}}}
+
+
+def check_model(data: object, where: str) -> dict:
+    """``data`` (a parsed averaged model file) checked against :func:`model_schema`, with at least two level trims
+    of different speeds; else one sentence."""
+    from lifelike_mj.errors import UserError
+    from lifelike_mj.schema import too_long, validate
+
+    schema = model_schema()
+    too_long(data, schema, where)
+    validate(data, schema, where)
+    level = sorted({p["speed_m_s"] for p in data["points"] if p["climb_m_s"] == 0.0})
+    if len(level) < 2:
+        raise UserError(f"{where} has {len(level)} level trims (climb 0 m/s); a designed controller needs at least two "
+                        "speeds (lifelike-mj butterfly model3d --climbs 0).")
+    return data
+
+
+def load_any(name_or_path):
+    """A 3D controller of either kind (:data:`~lifelike_mj.butterfly.flight3d.controllers.KINDS`) by name or path: a
+    :class:`DesignedController` for a file of ``"kind": "designed"``, else a network
+    (:class:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D`)."""
+    from lifelike_mj.butterfly.flight3d import controllers
+
+    data, name = controllers.read_controller_file(name_or_path)
+    if isinstance(data, dict) and data.get("kind") == "designed":
+        return controller_from_dict(data, name)
+    return controllers.controller_from_dict(data, name)

@@ -149,6 +149,12 @@ class Flight3D(StepCounter):
         self.network = None
         if isinstance(controller, (str, Path)):
             controller = load_controller(controller)
+        designed = getattr(controller, "start_command", None) is not None and not isinstance(controller, Controller3D)
+        if designed:  # a designed controller: its animal and force law, its trim at the task's speed to start from
+            animal = animal if animal is not None else controller.animal
+            force_law = force_law if force_law is not None else controller.force_law
+            start = 1.5 if not isinstance(task, Task3D) else task.rows[0][3] if task.kind == "schedule" else task.speed_m_s
+            command = command or controller.start_command(start)
         if isinstance(controller, Controller3D):
             self.network, controller = controller, None
             omega_c = self.network.omega_c_rad_s if omega_c is None else omega_c
