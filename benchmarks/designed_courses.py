@@ -1,6 +1,6 @@
 """The designed controller (issue 42, in progress) on courses, beside what the shipped ``monarch`` did.
 
-Run: ``python benchmarks/designed_courses.py`` (about 2 minutes on 2 cores; the averaged model first, if
+Run: ``python benchmarks/designed_courses.py`` (about 5 minutes on 2 cores; the averaged model first, if
 ``benchmarks/results/monarch_model.json`` is missing: ``lifelike-mj butterfly model3d --out
 benchmarks/results/monarch_model.json``). Writes ``benchmarks/results/designed_courses.json``.
 
@@ -10,7 +10,13 @@ the model's level trims (``designed.design``), on the calibrated wing law, for a
 - in a 1 m/s wind toward +x with gusts of 0.5 m/s and vertical gusts at Dryden's ratio near the ground (0.25 m/s);
 - in the same wind with vertical gusts as strong as the horizontal ones (0.5 m/s);
 - in a steady 1.5 m/s wind from one of four sides (toward +x, +y, -x, -y by the seed's remainder by 4).
-The controller was tuned on seeds 100-107; the default seeds, 200-209, were never flown while tuning.
+The controller was tuned on seeds 100-107 (and calm courses 100-119); the default seeds, 200-209, were never flown
+while tuning.
+
+Also measured: level flight in calm air at 1, 1.5 and 2 m/s (``measures.level_measures``: 6 s after 5 s, with the
+altitude's rms over the same window), and ``--calm`` random calm courses (seeds 1000 on, those of
+``courses_3d.py``; 100 by default) for tumbles (roll or pitch beyond 90 deg at any 10 ms sample) and falls (1 m below
+the course's lowest waypoint), at most 40 s each.
 """
 
 from __future__ import annotations
@@ -52,6 +58,50 @@ def fly(job: tuple[str, int]) -> dict:
     return out
 
 
+def calm(job: tuple[str, int]) -> dict:
+    """One random calm course (module docstring): waypoints passed, time, tumbled, fell, the largest roll or pitch."""
+    import math
+
+    import numpy as np
+
+    from lifelike_mj.butterfly.flight3d import designed as D
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D, euler_from_quat
+    from lifelike_mj.butterfly.flight3d.tasks import course
+
+    model_path, seed = job
+    task = course(seed)
+    f = Flight3D(controller=D.DesignedController(D.design(json.loads(Path(model_path).read_text()))), task=task)
+    lowest = min(r[2] for r in task.rows)
+    worst, fell = 0.0, False
+    while f.time < 40.0 and f.waypoints_passed < len(task.rows) and not fell:
+        f.step(8)  # 10 ms
+        worst = max(worst, float(np.abs(euler_from_quat(f.data.qpos[3:7])[:2]).max()))
+        fell = bool(f.data.qpos[2] < lowest - 1.0)
+    return {"seed": seed, "passed": int(f.waypoints_passed), "time_s": float(f.time),
+            "tumbled": worst > math.pi / 2, "fell": fell, "largest_attitude_deg": math.degrees(worst)}
+
+
+def level(job: tuple[str, float]) -> dict:
+    """Level flight in calm air at one speed (module docstring)."""
+    import numpy as np
+
+    from lifelike_mj.butterfly.flight3d import designed as D
+    from lifelike_mj.butterfly.flight3d import measures as M
+    from lifelike_mj.butterfly.flight3d import tasks
+    from lifelike_mj.butterfly.flight3d.flight import Flight3D
+
+    model_path, speed = job
+    f = Flight3D(controller=D.DesignedController(D.design(json.loads(Path(model_path).read_text()))),
+                 task=tasks.level(speed))
+    f.step(int(round(5.0 / f.dt)))
+    s = M.sample(f, 6.0)
+    m = M.measures(s, **M.body_numbers(f))
+    keep = ("roll_mean_deg", "stroke_left_deg", "stroke_right_deg", "flap_frequency_hz", "dorsal_gap_deg",
+            "body_angle_deg", "power_W_kg", "power_net_W_kg", "air_speed_m_s")
+    return {"speed_m_s": speed, "altitude_rms_m": float(np.sqrt(np.mean(s["position_m"][:, 2] ** 2))),
+            **{k: m[k] for k in keep}}
+
+
 def picture(model_path: str, seed: int, out: str) -> None:
     """The course of ``seed`` in the gusts of Dryden's ratio, drawn (``figures.fig_wind_course``): the path, the altitude
     against the waypoints', and the wind estimate against the wind met."""
@@ -91,6 +141,7 @@ def main(argv=None) -> None:
     ap.add_argument("--out", default=str(HERE / "results" / "designed_courses.json"))
     ap.add_argument("--picture", default=None, help="also draw one course in gusts (Dryden's ratio) here (.png)")
     ap.add_argument("--picture-seed", type=int, default=200)
+    ap.add_argument("--calm", type=int, default=100, help="random calm courses from seed 1000 on (0: none)")
     args = ap.parse_args(argv)
     if args.picture:
         picture(args.model, args.picture_seed, args.picture)
@@ -98,14 +149,26 @@ def main(argv=None) -> None:
     start = time.perf_counter()
     with Pool(2) as pool:
         rows = pool.map(fly, [(args.model, s) for s in range(lo, hi + 1)])
+        levels = pool.map(level, [(args.model, v) for v in (1.0, 1.5, 2.0)])
+        calms = pool.map(calm, [(args.model, s) for s in range(1000, 1000 + args.calm)])
     summary = {name: {"completed": sum(r[name]["passed"] == 10 for r in rows), "of": len(rows),
                       "waypoints": [r[name]["passed"] for r in rows]}
                for name in ("calm", "gusts_dryden", "gusts_every_axis", "steady_1_5")}
     write_json(args.out, {"provenance": provenance(benchmark="designed_courses", model=args.model, seeds=[lo, hi]),
                           "machine": machine_info(), "wall_time_s": time.perf_counter() - start,
-                          "summary": summary, "courses": rows})
+                          "summary": summary, "courses": rows, "level": levels,
+                          "calm_courses": {"completed": sum(r["passed"] == 10 for r in calms),
+                                           "tumbled": sum(r["tumbled"] for r in calms),
+                                           "fell": sum(r["fell"] for r in calms), "of": len(calms), "runs": calms}})
     for name, s in summary.items():
         print(f"{name}: {s['completed']} of {s['of']} completed; waypoints {s['waypoints']}")
+    for r in levels:
+        print(", ".join(f"{k} {v:.3g}" for k, v in r.items()))
+    if calms:
+        worst = [r["largest_attitude_deg"] for r in calms]
+        print(f"random calm courses: {sum(r['passed'] == 10 for r in calms)} of {len(calms)} completed, "
+              f"{sum(r['tumbled'] for r in calms)} tumbled, {sum(r['fell'] for r in calms)} fell; largest roll or "
+              f"pitch: median {sorted(worst)[len(worst) // 2]:.0f} deg, most {max(worst):.0f} deg")
 
 
 if __name__ == "__main__":

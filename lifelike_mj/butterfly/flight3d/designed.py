@@ -27,8 +27,9 @@ at the task's speed. The air velocity that does so is that ground velocity less 
 the heading asked (it crabs into a cross wind), its size the airspeed asked, clipped to the envelope; when a head wind
 asks for more than the envelope's top speed, the ground speed asked is lowered so that the track is still held, as
 butterflies that make ground upwind do by flying faster than the wind (Srygley et al. 1996). The altitude asked is the
-waypoint's; errors beyond :data:`MAX_ALTITUDE_ERROR_M` and :data:`MAX_HEADING_ERROR_RAD` are clipped, so that a far
-target asks a steady climb or turn, not a saturated one.
+waypoint's, reached by a climb or descent at :data:`MAX_CLIMB_M_S` at most (the velocity asked includes it), and the
+heading asked turns at :data:`MAX_TURN_RATE_RAD_S` at most; errors beyond :data:`MAX_ALTITUDE_ERROR_M` and
+:data:`MAX_HEADING_ERROR_RAD` are clipped, so that a far target asks a steady climb or turn, not a saturated one.
 
 **Saturation.** Every control is clipped to the natural envelope (:data:`~lifelike_mj.butterfly.flight3d.averaged.ENVELOPE`
 for the symmetric ones, :data:`DIFFERENCE_LIMITS` for left against right); the integrals are bounded
@@ -50,8 +51,12 @@ from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
 #: Bryson's scales of the augmented state: 9 model states (m/s, rad/s, rad), then the altitude error (m), its integral
 #: (m s), the airspeed error's integral (m) and the heading error's integral (rad s).
 Q_SCALES = np.array([0.9, 0.9, 0.9, 9.0, 9.0, 9.0, 0.45, 0.45, 0.3, 0.15, 0.15, 0.45, 0.3])
-#: Bryson's scales of the controls (Hz, rad), :data:`~lifelike_mj.butterfly.flight3d.averaged.CONTROLS` order.
-R_SCALES = np.array([0.5, 0.06, 0.06, 0.05, 0.05, 0.1, 0.1, 0.1, 0.15])
+#: Bryson's scales of the controls (Hz, rad), :data:`~lifelike_mj.butterfly.flight3d.averaged.CONTROLS` order. The
+#: left-right differences are kept small (0.03 rad): at 0.1 rad for the feathering difference the lateral loop, which
+#: sees the body half a beat late through its moving mean, fell into a 2 Hz roll-and-yaw cycle of +-60 deg with that
+#: control slamming between its limits, in turns and gusts (seeds 100-119: 2 of 20 calm courses tumbled; at 0.2 rad,
+#: 14 of 20; at 0.03, none).
+R_SCALES = np.array([0.5, 0.06, 0.06, 0.03, 0.03, 0.1, 0.03, 0.1, 0.15])
 #: Limits of the antisymmetric controls (rad): offset, amplitude and feathering differences left less right.
 DIFFERENCE_LIMITS = {"offset_difference": math.radians(15.0), "amplitude_difference": math.radians(15.0),
                      "feather_mean_difference": math.radians(20.0)}
@@ -63,6 +68,9 @@ MAX_SPEED_ERROR_M_S, MAX_RATE_RAD_S, MAX_ATTITUDE_ERROR_RAD = 0.4, 4.0, math.rad
 #: The integrals of the altitude, airspeed and heading errors are kept within these (m s, m, rad s): a clipped
 #: control cannot wind them up further than what their own gains turn into a full correction.
 INTEGRAL_LIMITS = np.array([0.3, 0.6, 0.3])
+#: The most the altitude asked moves toward a waypoint's (m/s): a new waypoint's altitude is a climb at this rate,
+#: flown as such (the climb rate is part of the velocity asked), not a step that the regulator meets by pitching up.
+MAX_CLIMB_M_S = 0.3
 #: Poles of the wind observer's error (1/s, per axis): its natural frequency and damping ratio.
 OBSERVER_HZ, OBSERVER_ZETA = 0.5, 1.0
 #: Near a waypoint the ground speed asked is at most ``APPROACH_MIN_M_S + APPROACH_PER_S * distance`` (m/s, 1/s).
@@ -225,6 +233,7 @@ class DesignedController:
         self.k = 0
         self.heading = None
         self.airspeed = None
+        self.altitude = None
         #: what the last control step saw and did: time, wind estimate, references, state and controls
         self.last: dict | None = None
 
@@ -318,7 +327,14 @@ class DesignedController:
         Rm = Rm @ av._exp(a_mean)
         t_ctrl = self.every * dt
         wind = self.wind(vel, Rm, rates, d.userdata[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS].copy(), t_ctrl)
-        target, altitude, asked = self.references(flight, pos, wind)
+        target, altitude_asked, asked = self.references(flight, pos, wind)
+        # the altitude asked moves toward the target's at most MAX_CLIMB_M_S: a climb, not a step
+        if self.altitude is None:
+            self.altitude = float(pos[2])
+        dz_max = MAX_CLIMB_M_S * t_ctrl
+        climb = float(np.clip(altitude_asked - self.altitude, -dz_max, dz_max))
+        altitude = self.altitude = self.altitude + climb
+        climb_rate = climb / t_ctrl
         if self.airspeed is None:
             self.airspeed = asked
         dv = MAX_SPEED_CHANGE_M_S2 * self.every * dt
@@ -340,7 +356,7 @@ class DesignedController:
         bank = -math.atan(airspeed * turn_rate / 9.81)
         R0 = av.rotation(bank, pitch0, yaw - herr)
         a = _log(R0.T @ Rm)
-        v_air = Rm.T @ (vel - wind)
+        v_air = Rm.T @ (vel - wind - np.array([0.0, 0.0, climb_rate]))  # the air velocity less the climb asked
         x = np.zeros(N_AUG)
         x[0:3] = np.clip(v_air - v0, -MAX_SPEED_ERROR_M_S, MAX_SPEED_ERROR_M_S)
         x[3:6] = np.clip(rates - R0.T @ np.array([0.0, 0.0, turn_rate]), -MAX_RATE_RAD_S, MAX_RATE_RAD_S)

@@ -87,3 +87,32 @@ def test_the_designed_controller_holds_level_flight_in_calm_air_with_a_natural_g
     assert abs(m["roll_mean_deg"]) <= 3.0 and abs(m["air_speed_m_s"] - V) < 0.15
     assert 110.0 <= m["stroke_left_deg"] <= 130.0 and m["stroke_difference_deg"] <= 5.0
     assert 9.5 <= m["flap_frequency_hz"] <= 11.0 and 35.0 <= m["dorsal_gap_deg"] <= 50.5
+
+
+def test_a_new_altitude_is_a_climb_at_the_rate_allowed_not_a_step(spec):
+    """Asked 0.3 m higher at once, the altitude asked rises at MAX_CLIMB_M_S (the regulator flies a climb, which it meets
+    with the velocity asked, instead of pitching up toward a clipped step), and the butterfly follows within 5 cm."""
+    fl = Flight3D(controller=D.DesignedController(spec), task=level(1.5, altitude_m=0.3))
+    ctl = fl.controller
+    asked, flown = [], []
+    while fl.time < 2.5:
+        fl.step(8)
+        asked.append(ctl.last["altitude"])
+        flown.append(float(fl.data.qpos[2]))
+    rate = np.diff(asked) / (ctl.every * fl.dt)
+    assert rate.max() == pytest.approx(D.MAX_CLIMB_M_S) and rate.min() > -1e-9
+    assert asked[-1] == pytest.approx(0.3) and abs(asked[0]) < 0.05  # from where it started, to the target's
+    assert abs(flown[-1] - 0.3) < 0.05 and max(flown) < 0.35
+
+
+def test_a_calm_course_is_flown_without_a_tumble(spec):
+    """A random calm course (seed 1000, of the 100 in benchmarks/designed_courses.py, none of which tumbles): all ten
+    waypoints, with the roll and pitch within 90 deg throughout (sampled every 10 ms)."""
+    from lifelike_mj.butterfly.flight3d.tasks import course
+
+    fl = Flight3D(controller=D.DesignedController(spec), task=course(1000))
+    worst = 0.0
+    while fl.time < 40.0 and fl.waypoints_passed < 10:
+        fl.step(8)
+        worst = max(worst, float(np.abs(euler_from_quat(fl.data.qpos[3:7])[:2]).max()))
+    assert fl.waypoints_passed == 10 and worst < math.pi / 2
