@@ -418,7 +418,7 @@ def _hidden(text: str) -> list[int]:
 def add_commands(bf) -> None:
     """``fly3d``, ``evolve3d`` and ``assess3d`` under ``lifelike-mj butterfly``."""
     p = bf.add_parser("fly3d", help="fly the 3D butterfly with a 3D controller")
-    p.add_argument("--controller", default="monarch", help=CONTROLLER_HELP)
+    p.add_argument("--controller", default="monarch", help=CONTROLLER_HELP + ", a network or one designed (design3d)")
     p.add_argument("--task", default="level", choices=("level", "turn", "course"),
                    help="level flight, a turn (--angle) or a course of 10 waypoints drawn by --seed")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
