@@ -74,10 +74,12 @@ MAX_CLIMB_M_S = 0.3
 #: Poles of the wind observer's error (1/s, per axis): its natural frequency and damping ratio.
 OBSERVER_HZ, OBSERVER_ZETA = 0.5, 1.0
 #: Near a waypoint the ground speed asked is at most ``APPROACH_MIN_M_S + APPROACH_PER_S * distance`` (m/s, 1/s).
-APPROACH_MIN_M_S, APPROACH_PER_S = 0.7, 1.0
-#: Airspeed limits of guidance (m/s): the envelope of the trims, less the top 0.3 m/s, whose trims fly at the top of
-#: the frequency's range and leave nothing to climb with.
-MIN_AIRSPEED_M_S, MAX_AIRSPEED_M_S = 0.5, 2.0
+APPROACH_MIN_M_S, APPROACH_PER_S = 1.0, 1.0
+#: Airspeed limits of guidance (m/s): below 1 m/s the loop, which sees the body half a beat late, cannot hold the
+#: slow trims' lateral divergence (:func:`lagged_poles`: unstable at 0.5 and 0.75 m/s, damping 0.2 at 1 m/s; flown, a
+#: 20 deg roll upset at 0.75 m/s leaves a roll cycle of +-36 deg); above 2 m/s the trims fly at the top of the
+#: frequency's range and leave nothing to climb with.
+MIN_AIRSPEED_M_S, MAX_AIRSPEED_M_S = 1.0, 2.0
 #: The most the airspeed asked changes (m/s^2): a wind triangle that flips as a waypoint passes does not jerk the
 #: speed loop.
 MAX_SPEED_CHANGE_M_S2 = 1.0
@@ -159,6 +161,49 @@ def design(model: dict, q_scales=Q_SCALES, r_scales=R_SCALES) -> dict:
                     "slowest_pole_per_s": float(-poles.real.max())})
     return {"kind": "designed", "animal": model.get("animal", "monarch"), "force_law": model.get("force_law", "calibrated"),
             "schedule": out, "q_scales": list(map(float, q_scales)), "r_scales": list(map(float, r_scales))}
+
+
+def _pade2(tau: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """A state-space form ``(A, B, C, D)`` of the second-order Pade approximation of a delay of ``tau`` (s),
+    ``(1 - s tau/2 + (s tau)^2/12) / (1 + s tau/2 + (s tau)^2/12)``."""
+    a2, a1 = tau * tau / 12.0, tau / 2.0
+    return (np.array([[0.0, 1.0], [-1.0 / a2, -a1 / a2]]), np.array([0.0, 1.0]), np.array([0.0, -2.0 * a1 / a2]), 1.0)
+
+
+def lagged_poles(model: dict, spec: dict, extra_s: float = 0.0) -> list[dict]:
+    """The closed loop's poles at each level trim of ``spec`` (:func:`design` of ``model``) when the controller sees
+    the body's motion as it flies it: through the moving mean of one wing beat, which lags half a beat (a delay of
+    ``0.5 / f``, plus ``extra_s``, in a second-order Pade form, on the 9 model states and the altitude error; the
+    controls as flown are the controller's own and seen at once). Per speed: the fastest growth or slowest decay
+    (``growth_per_s``, 1/s: positive is unstable) and the least damped oscillation (``damping``, its ``frequency_hz``).
+    The design itself assumes no lag: this is how much of its margin the lag takes."""
+    points = {p["speed_m_s"]: p for p in model["points"] if p["climb_m_s"] == 0.0}
+    out = []
+    for s in spec["schedule"]:
+        p = points[s["speed_m_s"]]
+        f = p["command"]["frequency_hz"]
+        Aa, Ba = augment(np.array(p["A"]), np.array(p["B"]), s["body_angle_rad"], np.array(s["v0_body_m_s"]),
+                         2.0 * math.pi * f)
+        K = np.array(s["K"])
+        n, lagged = Aa.shape[0], range(N_PLANT - 3)  # the 9 model states and the altitude error
+        Ap, Bp, Cp, Dp = _pade2(0.5 / f + extra_s)
+        M = np.zeros((n + 2 * len(lagged), n + 2 * len(lagged)))
+        M[:n, :n] = Aa
+        Kfb = np.zeros((K.shape[0], M.shape[0]))  # u = -Kfb [x, z]: the lagged states through their filters
+        Kfb[:, :n] = K
+        for j, i in enumerate(lagged):
+            z = slice(n + 2 * j, n + 2 * j + 2)
+            M[z, z], M[z, i] = Ap, Bp
+            Kfb[:, i] = K[:, i] * Dp
+            Kfb[:, z] += np.outer(K[:, i], Cp)
+        M[:n] -= Ba @ Kfb
+        ev = np.linalg.eigvals(M)
+        osc = ev[np.abs(ev.imag) > 1.0]
+        zeta = -osc.real / np.abs(osc)
+        k = int(np.argmin(zeta))
+        out.append({"speed_m_s": s["speed_m_s"], "growth_per_s": float(ev.real.max()), "damping": float(zeta[k]),
+                    "frequency_hz": float(abs(osc[k].imag) / (2.0 * math.pi))})
+    return out
 
 
 def _lerp(speeds: np.ndarray, values: np.ndarray, speed: float) -> np.ndarray:

@@ -116,3 +116,17 @@ def test_a_calm_course_is_flown_without_a_tumble(spec):
         fl.step(8)
         worst = max(worst, float(np.abs(euler_from_quat(fl.data.qpos[3:7])[:2]).max()))
     assert fl.waypoints_passed == 10 and worst < math.pi / 2
+
+
+def test_the_lagged_loop_is_the_designed_one_without_lag_and_loses_its_margin_at_slow_speeds(spec):
+    """lagged_poles: with the lag shrunk to 0.1 ms the slowest closed-loop pole is the design's own; with the beat's
+    half-beat lag the slow trims lose their margin (why guidance flies 1 m/s at least) and the cruise keeps it."""
+    model = json.loads((Path(__file__).resolve().parents[3] / "benchmarks" / "results" / "monarch_model.json").read_text())
+    f15 = next(p for p in model["points"] if p["climb_m_s"] == 0.0 and p["speed_m_s"] == 1.5)["command"]["frequency_hz"]
+    near = {r["speed_m_s"]: r for r in D.lagged_poles(model, spec, extra_s=1e-4 - 0.5 / f15)}
+    assert near[1.5]["growth_per_s"] == pytest.approx(-next(s for s in spec["schedule"] if s["speed_m_s"] == 1.5)
+                                                      ["slowest_pole_per_s"], abs=1e-3)
+    lagged = {r["speed_m_s"]: r for r in D.lagged_poles(model, spec, extra_s=0.0125)}
+    assert lagged[0.75]["growth_per_s"] > 0.0 and lagged[0.5]["growth_per_s"] > 0.0  # unstable below the floor
+    assert lagged[1.0]["damping"] > 0.0 and all(lagged[v]["damping"] > 0.3 for v in (1.25, 1.5, 2.0))
+    assert D.MIN_AIRSPEED_M_S >= 1.0
