@@ -224,7 +224,7 @@ def cmd_design3d(args) -> None:
             model = averaged.build(args.speeds, [0.0], progress=lambda done, _n: bar.update(1))
     with stage("the gains (LQR at every level trim)"):
         spec = designed.design(model)
-        lagged = designed.lagged_poles(model, spec)
+        lagged = designed.lagged_poles(model, spec, designed.CONTROL_LAG_S)
     name = Path(args.out).stem
     ctl = designed.DesignedController(spec, name=name, provenance=provenance(
         model=args.model, model_provenance=model.get("provenance"), speeds_m_s=[s["speed_m_s"] for s in spec["schedule"]],
@@ -245,7 +245,8 @@ def cmd_design3d(args) -> None:
     human = (f"wrote {args.out}: a controller designed for the {spec['animal']} at {len(speeds)} airspeeds "
              f"({speeds[0]:g}-{speeds[-1]:g} m/s), slowest closed-loop pole "
              f"{min(s['slowest_pole_per_s'] for s in spec['schedule']):.2f}/s; level at 1.5 m/s: altitude within "
-             f"{100 * alt_rms:.1f} cm rms (2-4 s); seen half a beat late, the loop is "
+             f"{100 * alt_rms:.1f} cm rms (2-4 s); seen {1000 * designed.CONTROL_LAG_S:.0f} ms late, as it flies, the "
+             "loop is "
              + ", ".join(f"{r['speed_m_s']:g} m/s " + (f"unstable ({r['growth_per_s']:+.1f}/s)" if r["growth_per_s"] > 0
                                                        else f"damped {r['damping']:.2f}") for r in lagged)
              + f" (guidance flies {designed.MIN_AIRSPEED_M_S:g}-{designed.MAX_AIRSPEED_M_S:g} m/s). Fly it: "

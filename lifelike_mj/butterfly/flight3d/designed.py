@@ -3,9 +3,11 @@ a wind estimate from the body's own motion, and guidance that crabs and speeds u
 
 **What it sees.** Its own motion only: the thorax's position and velocity over the ground, its attitude and its
 rates of turn (what an insect has from its eyes, halteres or antennae' mechanosensors, and gravity). Never the wind.
-Every measurement is averaged over the last wing beat (a moving mean one beat long), which removes the beat's own
-periodic shake and costs half a beat of delay: insects correct upsets with about one beat of latency (Ristroph et al.
-2010; Beatus et al. 2015).
+The beat shakes and rocks the body periodically. A moving mean one beat long removes that, but it lags half a beat,
+which leaves the loop no margin on the slow trims (:func:`lagged_poles`). So the velocity, rates and attitude are
+the latest sample less the beat's periodic part at its phase, a template learnt in flight from the samples half a
+beat back against the mean centred on them (:meth:`DesignedController._unlagged`); the position stays the moving
+mean. Insects correct upsets with about one beat of latency (Ristroph et al. 2010; Beatus et al. 2015).
 
 **The plant.** At each forward speed of the envelope the trim and the linear model of
 :mod:`~lifelike_mj.butterfly.flight3d.averaged` (``A``, ``B``: 9 states, 9 controls), augmented with the altitude
@@ -50,13 +52,13 @@ from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
 
 #: Bryson's scales of the augmented state: 9 model states (m/s, rad/s, rad), then the altitude error (m), its integral
 #: (m s), the airspeed error's integral (m) and the heading error's integral (rad s).
-Q_SCALES = np.array([0.9, 0.9, 0.9, 9.0, 9.0, 9.0, 0.45, 0.45, 0.3, 0.15, 0.15, 0.45, 0.3])
+Q_SCALES = np.array([0.9, 0.9, 0.9, 3.0, 3.0, 3.0, 0.45, 0.45, 0.3, 0.15, 0.15, 0.45, 0.3])
 #: Bryson's scales of the controls (Hz, rad), :data:`~lifelike_mj.butterfly.flight3d.averaged.CONTROLS` order. The
-#: left-right differences are kept small (0.03 rad): at 0.1 rad for the feathering difference the lateral loop, which
-#: sees the body half a beat late through its moving mean, fell into a 2 Hz roll-and-yaw cycle of +-60 deg with that
-#: control slamming between its limits, in turns and gusts (seeds 100-119: 2 of 20 calm courses tumbled; at 0.2 rad,
-#: 14 of 20; at 0.03, none).
-R_SCALES = np.array([0.5, 0.06, 0.06, 0.03, 0.03, 0.1, 0.03, 0.1, 0.15])
+#: left-right differences are kept small (0.06 rad). Seen through the moving mean alone (half a beat late), the lateral
+#: loop needed 0.03: at 0.1 rad for the feathering difference it fell into a 2 Hz roll-and-yaw cycle of +-60 deg with
+#: that control slamming between its limits (seeds 100-119: 2 of 20 calm courses tumbled; at 0.2 rad, 14 of 20).
+#: Without that lag (:meth:`DesignedController._unlagged`) it carries 0.06, and the rates' weights three times more.
+R_SCALES = np.array([0.5, 0.06, 0.06, 0.06, 0.06, 0.1, 0.06, 0.1, 0.15])
 #: Limits of the antisymmetric controls (rad): offset, amplitude and feathering differences left less right.
 DIFFERENCE_LIMITS = {"offset_difference": math.radians(15.0), "amplitude_difference": math.radians(15.0),
                      "feather_mean_difference": math.radians(20.0)}
@@ -71,14 +73,20 @@ INTEGRAL_LIMITS = np.array([0.3, 0.6, 0.3])
 #: The most the altitude asked moves toward a waypoint's (m/s): a new waypoint's altitude is a climb at this rate,
 #: flown as such (the climb rate is part of the velocity asked), not a step that the regulator meets by pitching up.
 MAX_CLIMB_M_S = 0.3
+#: The beat's periodic motion, learnt per phase (:meth:`DesignedController._unlagged`): bins per beat, the share of
+#: each new sample in its bin's mean, and how many samples a bin needs before it is used.
+N_BINS, TEMPLATE_RATE, TEMPLATE_MIN = 40, 0.5, 3
+#: The lag the controller sees the body's motion with (s): one control step of 10 ms (its sample held until the next).
+CONTROL_LAG_S = 0.01
 #: Poles of the wind observer's error (1/s, per axis): its natural frequency and damping ratio.
 OBSERVER_HZ, OBSERVER_ZETA = 0.5, 1.0
 #: Near a waypoint the ground speed asked is at most ``APPROACH_MIN_M_S + APPROACH_PER_S * distance`` (m/s, 1/s).
 APPROACH_MIN_M_S, APPROACH_PER_S = 1.0, 1.0
-#: Airspeed limits of guidance (m/s): below 1 m/s the loop, which sees the body half a beat late, cannot hold the
-#: slow trims' lateral divergence (:func:`lagged_poles`: unstable at 0.5 and 0.75 m/s, damping 0.2 at 1 m/s; flown, a
-#: 20 deg roll upset at 0.75 m/s leaves a roll cycle of +-36 deg); above 2 m/s the trims fly at the top of the
-#: frequency's range and leave nothing to climb with.
+#: Airspeed limits of guidance (m/s). Below 1 m/s: seen through the beat's moving mean, the slow trims' lateral
+#: divergence was too fast for the loop (:func:`lagged_poles`: unstable at 0.5 and 0.75 m/s; flown, a 20 deg roll upset
+#: at 0.75 m/s left a roll cycle of +-36 deg); seen without that lag the loop holds them, but those trims are the model's
+#: least accurate (they speed up by 0.3 m/s in free flight) and a floor of 0.8 m/s completed fewer courses (19 of 20
+#: calm, seeds 100-119). Above 2 m/s the trims fly at the top of the frequency's range and leave nothing to climb with.
 MIN_AIRSPEED_M_S, MAX_AIRSPEED_M_S = 1.0, 2.0
 #: The most the airspeed asked changes (m/s^2): a wind triangle that flips as a waypoint passes does not jerk the
 #: speed loop.
@@ -88,7 +96,7 @@ MAX_SPEED_CHANGE_M_S2 = 1.0
 #: controller knows its own motor state, as an animal's efference copy does).
 N_PLANT, N_AUG = 13, 31
 #: The most the heading asked turns (rad/s) toward where guidance points: a turn is a steady bank, not a step.
-MAX_TURN_RATE_RAD_S = 1.5
+MAX_TURN_RATE_RAD_S = 2.0
 
 
 def _outputs(trim_pitch: float, v0_body: np.ndarray) -> np.ndarray:
@@ -170,13 +178,13 @@ def _pade2(tau: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     return (np.array([[0.0, 1.0], [-1.0 / a2, -a1 / a2]]), np.array([0.0, 1.0]), np.array([0.0, -2.0 * a1 / a2]), 1.0)
 
 
-def lagged_poles(model: dict, spec: dict, extra_s: float = 0.0) -> list[dict]:
+def lagged_poles(model: dict, spec: dict, lag_s: float | None = None, extra_s: float = 0.0) -> list[dict]:
     """The closed loop's poles at each level trim of ``spec`` (:func:`design` of ``model``) when the controller sees
-    the body's motion as it flies it: through the moving mean of one wing beat, which lags half a beat (a delay of
-    ``0.5 / f``, plus ``extra_s``, in a second-order Pade form, on the 9 model states and the altitude error; the
-    controls as flown are the controller's own and seen at once). Per speed: the fastest growth or slowest decay
-    (``growth_per_s``, 1/s: positive is unstable) and the least damped oscillation (``damping``, its ``frequency_hz``).
-    The design itself assumes no lag: this is how much of its margin the lag takes."""
+    the body's motion late: by ``lag_s`` (s), or with ``None`` by half a beat (``0.5 / f``), as a moving mean of one
+    wing beat sees it; plus ``extra_s``. The lag is a second-order Pade form on the 9 model states and the altitude
+    error; the controls as flown are the controller's own and seen at once. Per speed: the fastest growth or slowest
+    decay (``growth_per_s``, 1/s: positive is unstable) and the least damped oscillation (``damping``, its
+    ``frequency_hz``). The design itself assumes no lag: this is how much of its margin a lag takes."""
     points = {p["speed_m_s"]: p for p in model["points"] if p["climb_m_s"] == 0.0}
     out = []
     for s in spec["schedule"]:
@@ -186,7 +194,7 @@ def lagged_poles(model: dict, spec: dict, extra_s: float = 0.0) -> list[dict]:
                          2.0 * math.pi * f)
         K = np.array(s["K"])
         n, lagged = Aa.shape[0], range(N_PLANT - 3)  # the 9 model states and the altitude error
-        Ap, Bp, Cp, Dp = _pade2(0.5 / f + extra_s)
+        Ap, Bp, Cp, Dp = _pade2((0.5 / f if lag_s is None else lag_s) + extra_s)
         M = np.zeros((n + 2 * len(lagged), n + 2 * len(lagged)))
         M[:n, :n] = Aa
         Kfb = np.zeros((K.shape[0], M.shape[0]))  # u = -Kfb [x, z]: the lagged states through their filters
@@ -279,8 +287,27 @@ class DesignedController:
         self.heading = None
         self.airspeed = None
         self.altitude = None
+        self.template = np.zeros((N_BINS, 9))
+        self.learnt = np.zeros(N_BINS, dtype=int)
         #: what the last control step saw and did: time, wind estimate, references, state and controls
         self.last: dict | None = None
+
+    def _unlagged(self, vel: np.ndarray, rates: np.ndarray, Rm: np.ndarray):
+        """The slow motion now, without the moving mean's half-beat lag: the latest sample less the beat's periodic
+        part at its phase, a template learnt from the samples half a beat back against the beat's mean, which is
+        centred on them (per phase bin, body axes)."""
+        two_pi = 2.0 * math.pi
+        mid = self.buffer[len(self.buffer) // 2]
+        k = int((mid[4] % two_pi) / two_pi * N_BINS) % N_BINS
+        dev = np.concatenate([mid[3].T @ (mid[1] - vel), mid[2] - rates, _log(Rm.T @ mid[3])])
+        self.template[k] += TEMPLATE_RATE * (dev - self.template[k])
+        self.learnt[k] += 1
+        now = self.buffer[-1]
+        j = int((now[4] % two_pi) / two_pi * N_BINS) % N_BINS
+        if self.learnt[j] < TEMPLATE_MIN:
+            return vel, rates, Rm
+        t = self.template[j]
+        return now[1] - now[3] @ t[0:3], now[2] - t[3:6], now[3] @ av._exp(-t[6:9])
 
     def start_command(self, speed_m_s: float = 1.5):
         """The trim's kinematics at the airspeed ``speed_m_s`` (m/s, held within the schedule's speeds): where a
@@ -357,7 +384,8 @@ class DesignedController:
         R = R.reshape(3, 3)
         freq = float(d.userdata[mj3d.U_P0])  # the flap frequency flown
         n_beat = max(1, int(round(1.0 / (freq * dt))))
-        self.buffer.append((d.qpos[0:3].copy(), d.qvel[0:3].copy(), d.qvel[3:6].copy(), R.copy()))
+        self.buffer.append((d.qpos[0:3].copy(), d.qvel[0:3].copy(), d.qvel[3:6].copy(), R.copy(),
+                            float(d.userdata[mj3d.U_PSI0])))
         while len(self.buffer) > n_beat:
             self.buffer.popleft()
         self.k += 1
@@ -370,6 +398,8 @@ class DesignedController:
         # a mean attitude: the beat's rotations averaged about the latest (small swings)
         a_mean = np.mean([_log(Rm.T @ b[3]) for b in self.buffer], axis=0)
         Rm = Rm @ av._exp(a_mean)
+        if len(self.buffer) == n_beat:
+            vel, rates, Rm = self._unlagged(vel, rates, Rm)
         t_ctrl = self.every * dt
         wind = self.wind(vel, Rm, rates, d.userdata[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS].copy(), t_ctrl)
         target, altitude_asked, asked = self.references(flight, pos, wind)
