@@ -39,14 +39,20 @@ WEATHER = {"calm": None,
            "gusts_every_axis": {"wind_to_m_s": [1.0, 0.0, 0.0], "gust_m_s": 0.5, "gust_vertical_m_s": 0.5}}
 
 
-def fly(job: tuple[str, int]) -> dict:
+def _spec(model_path: str) -> dict:
+    """The designed controller's schedule from the averaged model file (``designed.design``), made once per run."""
+    from lifelike_mj.butterfly.flight3d import designed as D
+
+    return D.design(json.loads(Path(model_path).read_text()))
+
+
+def fly(job: tuple[dict, int]) -> dict:
     """One seed's four courses (module docstring)."""
     from lifelike_mj.butterfly.flight3d import designed as D
     from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
     from lifelike_mj.butterfly.flight3d.validate import course_check
 
-    model_path, seed = job
-    spec = D.design(json.loads(Path(model_path).read_text()))
+    spec, seed = job
     start = KinematicsCommand(*D._interp(spec["schedule"], 1.5, "command"))
     dx, dy = DIRECTIONS[seed % 4]
     weather = dict(WEATHER, steady_1_5={"wind_to_m_s": [1.5 * dx, 1.5 * dy, 0.0]})
@@ -58,7 +64,7 @@ def fly(job: tuple[str, int]) -> dict:
     return out
 
 
-def calm(job: tuple[str, int]) -> dict:
+def calm(job: tuple[dict, int]) -> dict:
     """One random calm course (module docstring): waypoints passed, time, tumbled, fell, the largest roll or pitch."""
     import math
 
@@ -68,9 +74,9 @@ def calm(job: tuple[str, int]) -> dict:
     from lifelike_mj.butterfly.flight3d.flight import Flight3D, euler_from_quat
     from lifelike_mj.butterfly.flight3d.tasks import course
 
-    model_path, seed = job
+    spec, seed = job
     task = course(seed)
-    f = Flight3D(controller=D.DesignedController(D.design(json.loads(Path(model_path).read_text()))), task=task)
+    f = Flight3D(controller=D.DesignedController(spec), task=task)
     lowest = min(r[2] for r in task.rows)
     worst, fell = 0.0, False
     while f.time < 40.0 and f.waypoints_passed < len(task.rows) and not fell:
@@ -81,7 +87,7 @@ def calm(job: tuple[str, int]) -> dict:
             "tumbled": worst > math.pi / 2, "fell": fell, "largest_attitude_deg": math.degrees(worst)}
 
 
-def level(job: tuple[str, float]) -> dict:
+def level(job: tuple[dict, float]) -> dict:
     """Level flight in calm air at one speed (module docstring)."""
     import numpy as np
 
@@ -90,9 +96,8 @@ def level(job: tuple[str, float]) -> dict:
     from lifelike_mj.butterfly.flight3d import tasks
     from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
-    model_path, speed = job
-    f = Flight3D(controller=D.DesignedController(D.design(json.loads(Path(model_path).read_text()))),
-                 task=tasks.level(speed))
+    spec, speed = job
+    f = Flight3D(controller=D.DesignedController(spec), task=tasks.level(speed))
     f.step(int(round(5.0 / f.dt)))
     s = M.sample(f, 6.0)
     m = M.measures(s, **M.body_numbers(f))
@@ -114,7 +119,7 @@ def picture(model_path: str, seed: int, out: str) -> None:
     from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
     from lifelike_mj.butterfly.flight3d.tasks import course
 
-    spec = D.design(json.loads(Path(model_path).read_text()))
+    spec = _spec(model_path)
     ctl = D.DesignedController(spec)
     task = course(seed).with_weather(**WEATHER["gusts_dryden"])
     fl = Flight3D(KinematicsCommand(*D._interp(spec["schedule"], 1.5, "command")), animal="monarch",
@@ -147,10 +152,11 @@ def main(argv=None) -> None:
         picture(args.model, args.picture_seed, args.picture)
     lo, hi = (int(v) for v in args.seeds.split("-"))
     start = time.perf_counter()
+    spec = _spec(args.model)
     with Pool(2) as pool:
-        rows = pool.map(fly, [(args.model, s) for s in range(lo, hi + 1)])
-        levels = pool.map(level, [(args.model, v) for v in (1.0, 1.5, 2.0)])
-        calms = pool.map(calm, [(args.model, s) for s in range(1000, 1000 + args.calm)])
+        rows = pool.map(fly, [(spec, s) for s in range(lo, hi + 1)])
+        levels = pool.map(level, [(spec, v) for v in (1.0, 1.5, 2.0)])
+        calms = pool.map(calm, [(spec, s) for s in range(1000, 1000 + args.calm)])
     summary = {name: {"completed": sum(r[name]["passed"] == 10 for r in rows), "of": len(rows),
                       "waypoints": [r[name]["passed"] for r in rows]}
                for name in ("calm", "gusts_dryden", "gusts_every_axis", "steady_1_5")}

@@ -225,15 +225,15 @@ def cmd_design3d(args) -> None:
     with stage("the gains (LQR at every level trim)"):
         spec = designed.design(model)
         lagged = designed.lagged_poles(model, spec, designed.CONTROL_LAG_S)
-    name = Path(args.out).stem
-    ctl = designed.DesignedController(spec, name=name, provenance=provenance(
-        model=args.model, model_provenance=model.get("provenance"), speeds_m_s=[s["speed_m_s"] for s in spec["schedule"]],
-        q_scales=spec["q_scales"], r_scales=spec["r_scales"]))
+    speeds = [s["speed_m_s"] for s in spec["schedule"]]
+    ctl = designed.DesignedController(spec, name=Path(args.out).stem, provenance=provenance(
+        model=args.model, model_provenance=model.get("provenance"), speeds_m_s=speeds, q_scales=spec["q_scales"],
+        r_scales=spec["r_scales"]))
     with stage("a check: 4 s of level flight at 1.5 m/s"):
         from lifelike_mj.butterfly.flight3d import tasks
         from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
-        fl = Flight3D(controller=designed.DesignedController(spec), task=tasks.level(1.5))
+        fl = Flight3D(controller=ctl, task=tasks.level(1.5))  # the flight's state is not in the file
         fl.step(int(round(2.0 / fl.dt)))
         z = []
         while fl.time < 4.0:
@@ -241,7 +241,6 @@ def cmd_design3d(args) -> None:
             z.append(fl.data.qpos[2])
     write_json(args.out, ctl.to_dict())
     alt_rms = float(np.sqrt(np.mean(np.square(z))))
-    speeds = [s["speed_m_s"] for s in spec["schedule"]]
     human = (f"wrote {args.out}: a controller designed for the {spec['animal']} at {len(speeds)} airspeeds "
              f"({speeds[0]:g}-{speeds[-1]:g} m/s), slowest closed-loop pole "
              f"{min(s['slowest_pole_per_s'] for s in spec['schedule']):.2f}/s; level at 1.5 m/s: altitude within "

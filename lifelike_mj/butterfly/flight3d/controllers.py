@@ -435,7 +435,6 @@ def controller_from_dict(data: object, name: str = "") -> Controller3D:
                         "controllers fly.")
     if kind != "network":
         raise UserError(f"{where}: kind is {' or '.join(repr(k) for k in KINDS)}, got {_short(kind)}.")
-    d = {k: v for k, v in d.items() if k != "kind"}
     schema = json_schema()
     validate(_check_shapes(d, schema, where), schema, where)
     layers = _check_layers(d["layers"], where)

@@ -296,14 +296,16 @@ class DesignedController:
         """The slow motion now, without the moving mean's half-beat lag: the latest sample less the beat's periodic
         part at its phase, a template learnt from the samples half a beat back against the beat's mean, which is
         centred on them (per phase bin, body axes)."""
-        two_pi = 2.0 * math.pi
+        def phase_bin(sample) -> int:
+            return int(sample[4] % (2.0 * math.pi) / (2.0 * math.pi) * N_BINS) % N_BINS
+
         mid = self.buffer[len(self.buffer) // 2]
-        k = int((mid[4] % two_pi) / two_pi * N_BINS) % N_BINS
+        k = phase_bin(mid)
         dev = np.concatenate([mid[3].T @ (mid[1] - vel), mid[2] - rates, _log(Rm.T @ mid[3])])
         self.template[k] += TEMPLATE_RATE * (dev - self.template[k])
         self.learnt[k] += 1
         now = self.buffer[-1]
-        j = int((now[4] % two_pi) / two_pi * N_BINS) % N_BINS
+        j = phase_bin(now)
         if self.learnt[j] < TEMPLATE_MIN:
             return vel, rates, Rm
         t = self.template[j]
