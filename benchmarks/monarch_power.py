@@ -27,6 +27,7 @@ import numpy as np
 from lifelike_mj.butterfly.flight3d import measures as M
 from lifelike_mj.butterfly.flight3d.controllers import default_base
 from lifelike_mj.butterfly.flight3d.flight import Flight3D
+from lifelike_mj.butterfly.flight3d.parts import Butterfly
 from lifelike_mj.io import write_json
 from lifelike_mj.machine import machine_info
 from lifelike_mj.provenance import provenance
@@ -46,7 +47,8 @@ def point(law: str, f: float, amp: float, pitch: float, feather: float, settle_s
     """One grid point (module docstring): the flight measured over ``window_s`` after ``settle_s``."""
     cmd = replace(default_base("monarch"), frequency_hz=f, amplitude_left=math.radians(amp),
                   amplitude_right=math.radians(amp), feather_amplitude_left=feather, feather_amplitude_right=feather)
-    fl = Flight3D(cmd, animal="monarch", force_law=law, assist="hold", pitch_law=lambda _f: math.radians(pitch))
+    fl = Flight3D(cmd, butterfly=Butterfly("monarch", force_law=law), assist="hold",
+                  pitch_law=lambda _f: math.radians(pitch))
     fl.step(int(round(settle_s / fl.dt)))
     s = M.sample(fl, window_s)
     m = M.measures(s, **M.body_numbers(fl))

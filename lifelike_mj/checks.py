@@ -172,16 +172,18 @@ def known_keywords(func):
 _RENAMED: set[str] = set()
 
 
-def renamed(old: str, new: str, why: str = "") -> None:
+def renamed(old: str, new: str, why: str = "", stacklevel: int = 3) -> None:
     """A one-line note (a ``DeprecationWarning``, once per name and process) that ``old`` is now spelled ``new``
-    (``why``: what the new name says); the old spelling goes in the next release."""
+    (``why``: what the new name says); the old spelling goes in the next release. ``stacklevel``: as
+    ``warnings.warn``'s, counted from the caller of this function's caller (3: the line that used the old name, where
+    that caller is the function called with it)."""
     if old in _RENAMED:
         return
     import warnings
 
     _RENAMED.add(old)
     warnings.warn(f"{old} is now {new}{f' ({why})' if why else ''}; the old name goes in the next release.",
-                  DeprecationWarning, stacklevel=3)
+                  DeprecationWarning, stacklevel=stacklevel)
 
 
 def one_wind(where: str, to_m_s, from_m_s, old_m_s=None, old_means: str = "to", n: int = 3):

@@ -42,6 +42,8 @@ What is here, one layer on the next:
 * :mod:`~lifelike_mj.butterfly.flight3d.calibrate`: the calibrated wing law, fitted to a filmed monarch;
   :mod:`~lifelike_mj.butterfly.flight3d.averaged`: the butterfly averaged over its wing beat, trims, linear models and
   modes; :mod:`~lifelike_mj.butterfly.flight3d.designed`: a controller designed from them (in progress);
+* :mod:`~lifelike_mj.butterfly.flight3d.parts`: :class:`Butterfly` and :class:`World`, what a :class:`Flight3D` is
+  made of besides its controller and task;
 * :mod:`~lifelike_mj.butterfly.flight3d.validate`: the checks of a controller (level, turn, course, the
   reduction to the planar model); :mod:`~lifelike_mj.butterfly.flight3d.figures`: their figures.
 """
@@ -66,5 +68,5 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "animals": ".", "measures": ".", "Animal": "animals", "ANIMALS": "animals", "animal": "animals",
     "level_measures": "measures", "default_base": "controllers", "strobe": ".",
     "flowers": ".", "landing": ".", "land": "tasks", "visit_flowers": "landing", "place_flowers": "flowers",
-    "calibrate": ".", "averaged": ".", "designed": ".",
+    "calibrate": ".", "averaged": ".", "designed": ".", "parts": ".", "Butterfly": "parts", "World": "parts",
 }, globals())

@@ -59,9 +59,10 @@ def filmed_flight(scales=None, force_law: str = "calibrated", settle_s: float = 
     from lifelike_mj.butterfly.flight3d import model as mj3d
     from lifelike_mj.butterfly.flight3d.controllers import default_base
     from lifelike_mj.butterfly.flight3d.flight import Flight3D
+    from lifelike_mj.butterfly.flight3d.parts import Butterfly
 
     law = "quasi_steady" if scales is not None else force_law
-    fl = Flight3D(default_base("monarch"), animal="monarch", force_law=law, assist="hold",
+    fl = Flight3D(default_base("monarch"), butterfly=Butterfly("monarch", force_law=law), assist="hold",
                   pitch_law=lambda f: filmed_pitch_rad(float(f.data.userdata[mj3d.U_PSI0])))
     if scales is not None:
         k_l, k_d = (float(x) for x in scales)

@@ -73,8 +73,9 @@ def force_breakdown(controller, force_law: str = "strip", speed_m_s: float = 1.5
     panel (the exact law splits it by the flow at the wing's centroid)."""
     from lifelike_mj.butterfly.flight3d import tasks
     from lifelike_mj.butterfly.flight3d.flight import Flight3D
+    from lifelike_mj.butterfly.flight3d.parts import with_force_law
 
-    f = Flight3D(controller=controller, task=tasks.level(speed_m_s), force_law=force_law, **flight)
+    f = Flight3D(controller=controller, task=tasks.level(speed_m_s), **with_force_law(flight, force_law))
     f.step(int(round(settle_s / f.dt)))
     n = int(round(beats / f.kinematics.p[0] / f.dt))
     rows = {"t_s": [], "lift_N": [], "drag_N": [], "rotational_N": [], "total_N": [], "flap_rad": []}

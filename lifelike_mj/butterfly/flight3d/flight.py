@@ -37,6 +37,7 @@ from lifelike_mj.butterfly.flight3d import model as mj3d
 from lifelike_mj.butterfly.flight3d.controllers import Controller3D, load_controller
 from lifelike_mj.butterfly.flight3d.kinematics import JOINTS, N_PARAMS, Kinematics, KinematicsCommand, joint_refs
 from lifelike_mj.butterfly.flight3d.loop import TUMBLE_RAD, Batch
+from lifelike_mj.butterfly.flight3d.parts import BUTTERFLY_KEYWORDS, WORLD_KEYWORDS, Butterfly, World
 from lifelike_mj.butterfly.flight3d.tasks import (
     R_DIVERGED,
     R_PASSED,
@@ -102,34 +103,56 @@ def quat_from_pitch(pitch_rad: float) -> np.ndarray:
     return np.array([math.cos(0.5 * pitch_rad), 0.0, -math.sin(0.5 * pitch_rad), 0.0])
 
 
+def _parts(butterfly, world, flat: dict) -> tuple[Butterfly, World]:
+    """The flight's butterfly and world: as given, or made from ``Flight3D``'s flat keywords of before (``flat``, name
+    to value, ``None`` where not given), each taken with a note once per name (a ``DeprecationWarning``); the same
+    part given both ways is a :class:`~lifelike_mj.errors.UserError`."""
+    given = {k: v for k, v in flat.items() if v is not None}
+    for part, cls, names in (("butterfly", Butterfly, BUTTERFLY_KEYWORDS), ("world", World, WORLD_KEYWORDS)):
+        mine = {k: v for k, v in given.items() if k in names}
+        value = butterfly if part == "butterfly" else world
+        if value is not None and not isinstance(value, cls):
+            raise UserError(f"{part} is a flight3d.{cls.__name__}, got {value!r}.")
+        if mine and value is not None:
+            raise UserError(f"give the {part} once: {part}={cls.__name__}(...) or the keywords "
+                            f"{', '.join(sorted(mine))}, not both.")
+        for k in mine:
+            if k != "wind_m_s":  # the older spelling of the wind has its own note (checks.one_wind)
+                checks.renamed(f"Flight3D({k}=...)", f"Flight3D({part}={cls.__name__}({k}=...))",
+                               "the butterfly, the world and the flight are given apart", stacklevel=5)
+        if part == "butterfly":
+            butterfly = value if value is not None else Butterfly(**mine)
+        else:
+            if "wind_m_s" in mine:
+                wind = checks.one_wind("Flight3D", mine.pop("wind_to_m_s", None), mine.pop("wind_from_m_s", None),
+                                       mine.pop("wind_m_s"), "to")
+                mine["wind_to_m_s"] = wind
+            world = value if value is not None else World(**mine)
+    return butterfly, world
+
+
 class Flight3D(StepCounter):
     """One 3D butterfly in free flight (module docstring).
 
-    ``command``: the kinematics at the start (default: the controller's base command, else the paper's
-    10 Hz flap over [-60, 75] deg, no feathering); ``params``: the physical constants (mass, wing size,
-    air; Oe 2010 Table 1). ``controller``: a 3D controller (:class:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D`,
-    or the name or path of a controller file), flown in the compiled loop towards ``task``'s references
-    (:class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`; default level flight at 1.5 m/s), or any callable
-    ``controller(flight) -> KinematicsCommand | None`` run from Python before every ``control_every``-th
-    step. ``wind_to_m_s`` (where it blows to) or ``wind_from_m_s`` (where it comes from): the mean wind (world
-    frame, m/s), replacing the task's (``wind_m_s``, the older spelling of ``wind_to_m_s``, with a note; gusts and
-    flutter are the task's: :class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`); ``start_m``: the thorax's start
-    position.
-    Model options: ``force_law`` (default the 3D controller's, else ``exact``; ``exact``: eq. 1 integrated exactly
-    over each wing; ``strip``: eq. 1 on wing
-    panels; ``quasi_steady``: blade elements on the panels; ``calibrated``: the same scaled to a filmed monarch's flight,
-    :mod:`~lifelike_mj.butterfly.flight3d.calibrate`; ``tip``: the paper's tip-speed formula; ``none``),
-    ``drag_frame`` (``body`` or ``world``), ``body_areas_m2`` (the body's drag areas along x, y, z; default the
-    paper's ``A_b`` on every axis), ``masses`` (``animal`` or ``paper``), ``n_strips`` and ``n_chord`` (panels
-    per wing, for the panel laws), ``drive_hz`` (the joints' tracking bandwidth), ``omega_c`` (rad/s, how
-    fast the kinematics follow a command; default the controller's, else one wing beat).
-    ``animal``: the butterfly (``"swallowtail"``, the paper's, or ``"monarch"``, with measured wings:
-    :mod:`~lifelike_mj.butterfly.flight3d.animals`); default the controller's, else the swallowtail.
-    ``contact``: the butterfly has legs that touch the ground (:func:`~lifelike_mj.butterfly.flight3d.model.add_contact`);
-    without it nothing touches anything. ``flowers``: blossoms' centres (``(n, 3)``, m) whose blossoms the legs touch
-    too (:mod:`~lifelike_mj.butterfly.flight3d.flowers`; implies ``contact``), for landings
-    (:func:`~lifelike_mj.butterfly.flight3d.tasks.land`, :meth:`land_on`, :meth:`take_off`); ``ground_m``: the
-    ground's height (m; default 4 m below the start's altitude 0).
+    A flight is made of three parts, given apart (:mod:`~lifelike_mj.butterfly.flight3d.parts`):
+
+    * ``butterfly``: what flies, a :class:`~lifelike_mj.butterfly.flight3d.parts.Butterfly` (the animal, its physical
+      constants, masses and wing force law, the panels and the joints' drive); its ``None`` fields are the
+      controller's (a network's or a designed controller's animal, force law and kinematics filter), else the paper's
+      swallowtail, the ``exact`` law and one wing beat;
+    * ``world``: where it flies, a :class:`~lifelike_mj.butterfly.flight3d.parts.World` (the mean wind, replacing the
+      task's, whose gusts and flutter go on; legs that touch the ground, flowers, the ground's height);
+    * the flight: ``command``, the kinematics at the start (default: the controller's base command or trim, else the
+      paper's 10 Hz flap over [-60, 75] deg, no feathering); ``controller``, a 3D controller
+      (:class:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D`, or the name or path of a controller file),
+      flown in the compiled loop towards ``task``'s references (:class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`;
+      default level flight at 1.5 m/s), or any callable ``controller(flight) -> KinematicsCommand | None`` run from
+      Python before every ``control_every``-th step; ``start_m``, the thorax's start position; ``dt_s``, the time step.
+
+    The flat keywords of before (``params`` and ``animal``, ``force_law``, ``masses``, ``drag_frame``,
+    ``body_areas_m2``, ``n_strips``, ``n_chord``, ``drive_hz``, ``omega_c`` for the butterfly; ``wind_to_m_s``,
+    ``wind_from_m_s``, ``wind_m_s``, ``contact``, ``flowers``, ``ground_m`` for the world) are taken for one more
+    release, with a note once per name.
     ``end_on_tumble``: a roll or pitch beyond :data:`~lifelike_mj.butterfly.flight3d.loop.TUMBLE_RAD` ends the
     flight there (as in an evolution; :attr:`tumbled`), else it flies on.
     ``assist="hold"`` holds the attitude at ``pitch_law(flight)`` (rad, nose up), set once per step, roll
@@ -138,14 +161,26 @@ class Flight3D(StepCounter):
 
     @checks.known_keywords
     def __init__(self, command: KinematicsCommand | None = None, params: ButterflyParams | None = None, *,
-                 controller=None, task=None, control_every: int = 1, wind_to_m_s=None, wind_from_m_s=None,
-                 wind_m_s=None,
-                 start_m=(0.0, 0.0, 0.0), force_law: str | None = None, drag_frame: str = "body",
-                 body_areas_m2=None, masses: str = "animal", dt_s: float = DT_S, n_strips: int = 8,
-                 n_chord: int = 2, drive_hz: float = 50.0, omega_c: float | None = None, assist: str = "none",
-                 pitch_law: Callable | None = None, end_on_tumble: bool = False, animal: str | None = None,
-                 contact: bool = False, flowers=None, ground_m: float | None = None,
-                 _model: mujoco.MjModel | None = None) -> None:
+                 butterfly: Butterfly | None = None, world: World | None = None, controller=None, task=None,
+                 control_every: int = 1, start_m=(0.0, 0.0, 0.0), dt_s: float = DT_S, assist: str = "none",
+                 pitch_law: Callable | None = None, end_on_tumble: bool = False,
+                 animal: str | None = None, force_law: str | None = None, masses: str | None = None,
+                 drag_frame: str | None = None, body_areas_m2=None, n_strips: int | None = None,
+                 n_chord: int | None = None, drive_hz: float | None = None, omega_c: float | None = None,
+                 wind_to_m_s=None, wind_from_m_s=None, wind_m_s=None, contact: bool | None = None, flowers=None,
+                 ground_m: float | None = None, _model: mujoco.MjModel | None = None) -> None:
+        butterfly, world = _parts(butterfly, world, {
+            "animal": animal, "force_law": force_law, "params": params, "masses": masses, "drag_frame": drag_frame,
+            "body_areas_m2": body_areas_m2, "n_strips": n_strips, "n_chord": n_chord, "drive_hz": drive_hz,
+            "omega_c": omega_c, "wind_to_m_s": wind_to_m_s, "wind_from_m_s": wind_from_m_s, "wind_m_s": wind_m_s,
+            "contact": contact, "flowers": flowers, "ground_m": ground_m})
+        #: The butterfly flown and the world it flies in, as given (:mod:`~lifelike_mj.butterfly.flight3d.parts`;
+        #: ``None`` fields filled from the controller where it has them).
+        self.butterfly, self.world = butterfly, world
+        animal, force_law, params, omega_c = butterfly.animal, butterfly.force_law, butterfly.params, butterfly.omega_c
+        masses, drag_frame, body_areas_m2 = butterfly.masses, butterfly.drag_frame, butterfly.body_areas_m2
+        n_strips, n_chord, drive_hz = butterfly.n_strips, butterfly.n_chord, butterfly.drive_hz
+        contact, flowers, ground_m = world.contact, world.flowers, world.ground_m
         self.network = None
         if isinstance(controller, (str, Path)):
             controller = load_controller(controller)
@@ -181,7 +216,7 @@ class Flight3D(StepCounter):
         if assist == "hold" and not callable(pitch_law):
             raise UserError("the attitude hold needs pitch_law, a function of the flight returning the pitch (rad).")
         self.controller, self.control_every = controller, checks.whole("control_every", control_every, 1)
-        wind = checks.one_wind("Flight3D", wind_to_m_s, wind_from_m_s, wind_m_s, "to")
+        wind = checks.one_wind("Flight3D", world.wind_to_m_s, world.wind_from_m_s, None, "to")
         if wind is not None:
             from dataclasses import replace
 

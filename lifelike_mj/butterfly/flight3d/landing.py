@@ -44,10 +44,11 @@ def visit_flowers(controller, flowers, perch_s: float = 2.0, *, dt_s: float | No
     ``landed`` (how many), and with ``record_every_s`` the path: ``t_s``, ``position_m``, ``attitude_rad``,
     ``perched`` and the flight itself (``flight``)."""
     from lifelike_mj.butterfly.flight3d.flight import DT_S, Flight3D
+    from lifelike_mj.butterfly.flight3d.parts import World
 
     perch_s = checks.number("perch_s", perch_s, 0.0, 600.0, unit="s")
-    kw = {} if ground_m is None else {"ground_m": ground_m}
-    f = Flight3D(controller=controller, flowers=flowers, dt_s=DT_S if dt_s is None else dt_s, **kw)
+    f = Flight3D(controller=controller, world=World(flowers=flowers, ground_m=ground_m),
+                 dt_s=DT_S if dt_s is None else dt_s)
     n = len(f.flowers)
     if n < 2:
         from lifelike_mj.errors import UserError
@@ -114,11 +115,13 @@ def take_off_measures(controller, beats: int = 3, *, dt_s: float | None = None) 
     from lifelike_mj.butterfly.flight3d.flight import DT_S, Flight3D
     from lifelike_mj.butterfly.flight3d.flowers import blossom_under
     from lifelike_mj.butterfly.flight3d.model import standing_height_m
+    from lifelike_mj.butterfly.flight3d.parts import World
 
     beats = checks.whole("beats", beats, 1, 100)
     ctl = controller if isinstance(controller, Controller3D) else load_controller(controller)
     start = blossom_under((0.0, 0.0, -standing_height_m(ctl.animal)))
-    f = Flight3D(controller=ctl, flowers=[start, start + (1.2, 0.0, 0.0)], dt_s=DT_S if dt_s is None else dt_s)
+    f = Flight3D(controller=ctl, world=World(flowers=[start, start + (1.2, 0.0, 0.0)]),
+                 dt_s=DT_S if dt_s is None else dt_s)
     f.perch_on(0)
     f.step(int(round(0.3 / f.dt)))
     m, d = f.model, f.data

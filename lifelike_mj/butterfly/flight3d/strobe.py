@@ -103,10 +103,11 @@ def landing_strobe(controller, flowers=((0.0, 0.0, -0.1), (1.2, 0.4, -0.25)), ev
 
     from lifelike_mj.butterfly.flight3d.flight import Flight3D
     from lifelike_mj.butterfly.flight3d.landing import MAX_LANDING_S
+    from lifelike_mj.butterfly.flight3d.parts import World
     from lifelike_mj.butterfly.render import dress
     from lifelike_mj.render.offscreen import Offscreen
 
-    f = Flight3D(controller=controller, flowers=flowers)
+    f = Flight3D(controller=controller, world=World(flowers=flowers))
     m = f.model
     f.perch_on(0)
     f.step(int(round(0.3 / f.dt)))

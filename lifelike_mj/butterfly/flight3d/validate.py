@@ -16,6 +16,7 @@ from lifelike_mj import checks
 from lifelike_mj.butterfly.controllers import ButterflyController
 from lifelike_mj.butterfly.flight import pitch_command
 from lifelike_mj.butterfly.flight3d.measures import MAX_CHECK_S, check_window
+from lifelike_mj.butterfly.flight3d.parts import Butterfly
 
 
 def kinematics_of(controller: ButterflyController):
@@ -50,8 +51,8 @@ def reduction(controller: ButterflyController | str = "simple_rule", duration_s:
         last[0] = pitch_command(kind, cp, f.time, ref[0, 0], ref[0, 1], q[2], 0.0, v[2], v[0], 0.0, 0.0, last[0])
         return last[0]
 
-    flight = Flight3D(kinematics_of(ctrl), masses="paper", force_law="tip", drag_frame="world", assist="hold",
-                      pitch_law=law, dt_s=dt_s)
+    flight = Flight3D(kinematics_of(ctrl), butterfly=Butterfly(masses="paper", force_law="tip", drag_frame="world"),
+                      assist="hold", pitch_law=law, dt_s=dt_s)
     path = np.empty((len(planar.t), 3))
     path[0] = flight.state()["position_m"]
     for k in range(1, len(planar.t)):
@@ -183,8 +184,9 @@ def kinematics_check(controller, speed_m_s: float = 1.5, settle_s: float = 5.0, 
     area: the figure Sunada et al. 1993 estimate at about 4 for a cabbage white taking off. ``roll_mean_deg``:
     whether the flight stayed upright enough for these to mean anything."""
     from lifelike_mj.butterfly.flight3d.measures import level_measures
+    from lifelike_mj.butterfly.flight3d.parts import with_force_law
 
-    m = level_measures(controller, speed_m_s, settle_s, window_s, force_law=force_law, **flight)
+    m = level_measures(controller, speed_m_s, settle_s, window_s, **with_force_law(flight, force_law))
     return {"force_law": force_law, "speed_command_m_s": speed_m_s, "flap_frequency_hz": m["flap_frequency_hz"],
             "stroke_amplitude_deg": 0.5 * (m["stroke_left_deg"] + m["stroke_right_deg"]),
             "speed_m_s": m["ground_speed_m_s"], "advance_ratio": m["advance_ratio"],
