@@ -50,6 +50,7 @@ def fly(job: tuple[dict, int]) -> dict:
     """One seed's four courses (module docstring)."""
     from lifelike_mj.butterfly.flight3d import designed as D
     from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+    from lifelike_mj.butterfly.flight3d.parts import Butterfly
     from lifelike_mj.butterfly.flight3d.validate import course_check
 
     spec, seed = job
@@ -58,8 +59,8 @@ def fly(job: tuple[dict, int]) -> dict:
     weather = dict(WEATHER, steady_1_5={"wind_to_m_s": [1.5 * dx, 1.5 * dy, 0.0]})
     out = {"seed": seed}
     for name, w in weather.items():
-        r = course_check(D.DesignedController(spec), seed, weather=w, animal="monarch", force_law="calibrated",
-                         command=start)
+        r = course_check(D.DesignedController(spec), seed, weather=w, command=start,
+                         butterfly=Butterfly("monarch", force_law="calibrated"))
         out[name] = {"passed": r["passed"], "time_s": r["time_s"]}
     return out
 
@@ -117,13 +118,14 @@ def picture(model_path: str, seed: int, out: str) -> None:
     from lifelike_mj.butterfly.flight3d.figures import fig_wind_course
     from lifelike_mj.butterfly.flight3d.flight import Flight3D
     from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+    from lifelike_mj.butterfly.flight3d.parts import Butterfly
     from lifelike_mj.butterfly.flight3d.tasks import course
 
     spec = _spec(model_path)
     ctl = D.DesignedController(spec)
     task = course(seed).with_weather(**WEATHER["gusts_dryden"])
-    fl = Flight3D(KinematicsCommand(*D._interp(spec["schedule"], 1.5, "command")), animal="monarch",
-                  force_law="calibrated", controller=ctl, task=task)
+    fl = Flight3D(KinematicsCommand(*D._interp(spec["schedule"], 1.5, "command")),
+                  butterfly=Butterfly("monarch", force_law="calibrated"), controller=ctl, task=task)
     t, pos, true, est, passed_at = [], [], [], [], []
     while fl.time < 60.0 and fl.waypoints_passed < len(task.rows):
         before = fl.waypoints_passed

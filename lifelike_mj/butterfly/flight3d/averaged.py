@@ -37,6 +37,7 @@ import mujoco
 import numpy as np
 
 from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+from lifelike_mj.butterfly.flight3d.parts import Butterfly
 
 #: The rate step (rad/s) of the body's damping of its own turning within the beat (:meth:`Averager.wrench`).
 DAMPING_STEP_RAD_S = 0.5
@@ -56,10 +57,26 @@ ENVELOPE = {"frequency_hz": (9.5, 11.0), "offset": (math.radians(2.0), math.radi
             "amplitude": (math.radians(55.0), math.radians(65.0)), "feather_mean": (math.radians(-20.0), math.radians(20.0)),
             "feather_amplitude": (math.radians(25.0), math.radians(45.0)),
             "abdomen_mean": (math.radians(-31.0), math.radians(-3.0))}
-#: The top of the stroke (offset plus amplitude, rad) that keeps the dorsal gap at 35-50 deg: with the stroke plane
-#: tilted, the filmed gait's top at 68 deg leaves the wing tips 48.5 deg apart, and each degree higher about 2.8 deg
-#: less (measured in the simulator, :func:`flown`).
-TOP_RANGE = (math.radians(69.0), math.radians(72.5))
+#: The top of the stroke (offset plus amplitude, rad) inside the natural envelope: the wing tips stop 35-50 deg apart
+#: above the body (the filmed gait's top at 68 deg leaves them 48.5 deg apart, and each degree higher about 1.7 deg
+#: less, measured in the simulator, :func:`flown`): the range the designed controller's stroke offset may move the top
+#: in (its lowest at the largest amplitude); trims keep above :func:`top_floor`.
+TOP_RANGE = (math.radians(69.0), math.radians(75.0))
+#: The lowest top of the stroke a trim may take (deg) at forward speeds (m/s), linear between and held beyond. Where a
+#: wing's tip stops depends on its feathering as well as on the top, and the slow trims feather more (15 deg at 1 m/s,
+#: 7.5 at 1.5), so the same top leaves the tips further apart in slow flight (flown at a top of 69 deg: 50.2 deg at
+#: 1 m/s, 48.4 at 1.5, 45.7 at 2), and the closed loop flies about 1.5 deg below its trim's top at 1 m/s. A floor of
+#: 72.5 deg at every speed held the gap at 1-1.5 m/s, but the 2 m/s trim then needed a 129 deg stroke and its altitude
+#: wandered 4.8 cm rms in calm air (0.4 before), and the 0.75 m/s level trim had no balance (4.4 % of the weight left);
+#: below the guidance's slowest airspeed, 1 m/s, the floor returns to the envelope's 69 deg, where the slow trims
+#: balance.
+TOP_FLOOR_DEG = ((0.75, 69.0), (1.0, 72.5), (2.0, 70.0))
+
+
+def top_floor(speed_m_s: float) -> float:
+    """The lowest top of the stroke (rad) a trim at ``speed_m_s`` may take (:data:`TOP_FLOOR_DEG`)."""
+    speeds, tops = zip(*TOP_FLOOR_DEG)
+    return math.radians(float(np.interp(speed_m_s, speeds, tops)))
 
 
 def natural_command():
@@ -370,8 +387,8 @@ def derivative(av: Averager, trim: Trim, x, u) -> np.ndarray:
 
 
 #: Trim's unknowns besides the body angle, each with its bounds (the natural envelope: :data:`ENVELOPE`, the top of the
-#: stroke in :data:`TOP_RANGE`) and the size of a change from the filmed gait that costs as much as any other (Hz or
-#: rad): trim keeps as close to the filmed monarch's gait as the balance allows.
+#: stroke from :func:`top_floor` to :data:`TOP_RANGE`'s top) and the size of a change from the filmed gait that costs
+#: as much as any other (Hz or rad): trim keeps as close to the filmed monarch's gait as the balance allows.
 TRIM_UNKNOWNS = {"frequency_hz": 0.5, "top": math.radians(3.0), "amplitude": math.radians(3.0),
                  "feather_mean": math.radians(3.0), "feather_amplitude": math.radians(5.0),
                  "abdomen_mean": math.radians(5.0)}
@@ -414,9 +431,9 @@ def trim(av: Averager, speed_m_s: float, climb_m_s: float = 0.0, start: Trim | N
     from lifelike_mj.butterfly.flight3d.evolution import body_angle_target_deg
 
     nat = _gait(natural_command().as_array())
-    bounds = {"frequency_hz": ENVELOPE["frequency_hz"], "top": TOP_RANGE, "amplitude": ENVELOPE["amplitude"],
-              "feather_mean": ENVELOPE["feather_mean"], "feather_amplitude": ENVELOPE["feather_amplitude"],
-              "abdomen_mean": ENVELOPE["abdomen_mean"]}
+    bounds = {"frequency_hz": ENVELOPE["frequency_hz"], "top": (top_floor(speed_m_s), TOP_RANGE[1]),
+              "amplitude": ENVELOPE["amplitude"], "feather_mean": ENVELOPE["feather_mean"],
+              "feather_amplitude": ENVELOPE["feather_amplitude"], "abdomen_mean": ENVELOPE["abdomen_mean"]}
     lo = [math.radians(-30.0)] + [bounds[k][0] for k in TRIM_UNKNOWNS]
     hi = [math.radians(60.0)] + [bounds[k][1] for k in TRIM_UNKNOWNS]
     scales = np.array(list(TRIM_UNKNOWNS.values()))
@@ -526,7 +543,7 @@ def flown(av: Averager, trim: Trim, beats: int = 6) -> dict:
     R0 = rotation(0.0, trim.pitch_rad, 0.0)
     v_body = trim.velocity_body()
     av.wrench(trim.command, v_body, np.zeros(3), trim.com_m)
-    fl = Flight3D(KinematicsCommand(*trim.command), animal=av.animal, force_law=av.force_law)
+    fl = Flight3D(KinematicsCommand(*trim.command), butterfly=Butterfly(av.animal, force_law=av.force_law))
     R = R0 @ _exp(av.tilt[0])
     q = np.empty(4)
     mujoco.mju_mat2Quat(q, R.ravel())
