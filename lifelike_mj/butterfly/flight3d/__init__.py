@@ -68,5 +68,6 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "animals": ".", "measures": ".", "Animal": "animals", "ANIMALS": "animals", "animal": "animals",
     "level_measures": "measures", "default_base": "controllers", "strobe": ".",
     "flowers": ".", "landing": ".", "land": "tasks", "visit_flowers": "landing", "place_flowers": "flowers",
-    "calibrate": ".", "averaged": ".", "designed": ".", "parts": ".", "Butterfly": "parts", "World": "parts",
+    "calibrate": ".", "averaged": ".", "designed": ".", "designed_kernel": ".", "parts": ".", "Butterfly": "parts",
+    "World": "parts",
 }, globals())

@@ -1,0 +1,345 @@
+"""The designed controller (:mod:`~lifelike_mj.butterfly.flight3d.designed`) compiled: the same measurement, wind
+observer, guidance and gain-scheduled regulator as :class:`~lifelike_mj.butterfly.flight3d.designed.DesignedController`,
+step by step, in numba, on arrays a compiled loop can hold per flight (issue 42, point 2). The Python class is its
+twin and the reference: ``tests/butterfly/flight3d/test_flight3d_designed_kernel.py`` flies both and finds the same
+flight.
+
+A flight's controller state is three arrays (:func:`new_state`): ``st`` (the scalars, :data:`ST_NAMES`), ``buf`` (the
+last wing beat's samples, a ring of :data:`N_BUF` rows: position, velocity, rates, attitude matrix, stroke phase) and
+``tmpl`` (the beat's periodic template, :data:`~lifelike_mj.butterfly.flight3d.designed.N_BINS` rows of 9 and a count).
+The schedule is :func:`tables`' arrays, the same for every flight of one controller.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from lifelike_mj.butterfly.flight3d import designed as D
+
+#: The scalars of a flight's state, in ``st``'s order.
+ST_NAMES = ("k", "count", "head", "int_z", "int_v", "int_h", "v_hat_set", "v_hat_x", "v_hat_y", "v_hat_z", "w_hat_x",
+            "w_hat_y", "w_hat_z", "heading_set", "heading", "airspeed_set", "airspeed", "altitude_set", "altitude")
+#: Rows of the sample ring: more than any wing beat holds at the coarsest time step and slowest frequency allowed.
+N_BUF = 512
+#: A sample's columns: position (3), velocity (3), rates (3), attitude matrix (9, row major), stroke phase (1).
+N_SAMPLE = 19
+
+
+def new_state() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A flight's controller state at its start: ``st``, ``buf`` and ``tmpl`` (module docstring)."""
+    return np.zeros(len(ST_NAMES)), np.zeros((N_BUF, N_SAMPLE)), np.zeros((D.N_BINS, 10))
+
+
+def tables(spec: dict) -> tuple[np.ndarray, ...]:
+    """The schedule of a designed controller (:func:`~lifelike_mj.butterfly.flight3d.designed.design`) as arrays:
+    speeds, body angles, trim velocities, gains, trim kinematics, ``A``, ``B``."""
+    s = spec["schedule"]
+    return (np.array([p["speed_m_s"] for p in s], float), np.array([p["body_angle_rad"] for p in s], float),
+            np.array([p["v0_body_m_s"] for p in s], float), np.array([p["K"] for p in s], float),
+            np.array([p["command"] for p in s], float), np.array([p["A"] for p in s], float),
+            np.array([p["B"] for p in s], float))
+
+
+def constants() -> np.ndarray:
+    """The controller's constants in the order :func:`control` reads them (the module's values now)."""
+    lo, hi = D.limits()
+    return np.concatenate([[D.MAX_ALTITUDE_ERROR_M, D.MAX_HEADING_ERROR_RAD, D.MAX_SPEED_ERROR_M_S, D.MAX_RATE_RAD_S,
+                            D.MAX_ATTITUDE_ERROR_RAD, D.MAX_CLIMB_M_S, D.TEMPLATE_RATE, D.TEMPLATE_MIN,
+                            D.OBSERVER_HZ, D.OBSERVER_ZETA, D.APPROACH_MIN_M_S, D.APPROACH_PER_S, D.MIN_AIRSPEED_M_S,
+                            D.MAX_AIRSPEED_M_S, D.MAX_SPEED_CHANGE_M_S2, D.MAX_TURN_RATE_RAD_S],
+                           D.INTEGRAL_LIMITS, lo, hi])
+
+
+@njit(cache=True)
+def _wrap(a):
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@njit(cache=True)
+def _exp(a):
+    t = math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+    k = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+    if t < 1e-12:
+        return np.eye(3) + k
+    return np.eye(3) + math.sin(t) / t * k + (1.0 - math.cos(t)) / t ** 2 * (k @ k)
+
+
+@njit(cache=True)
+def _log(R):
+    c = max(-1.0, min(1.0, 0.5 * (R[0, 0] + R[1, 1] + R[2, 2] - 1.0)))
+    t = math.acos(c)
+    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    if t < 1e-9:
+        return 0.5 * w
+    return t / (2.0 * math.sin(t)) * w
+
+
+@njit(cache=True)
+def _rotation(roll, pitch, yaw):
+    cr, sr, cp, sp, cy, sy = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch), math.cos(yaw), math.sin(yaw)
+    rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
+    ry = np.array([[cp, 0.0, -sp], [0.0, 1.0, 0.0], [sp, 0.0, cp]])
+    rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
+    return rz @ ry @ rx
+
+
+@njit(cache=True)
+def _at(speeds, speed):
+    """The row below ``speed`` and the weight of the row above (``designed._lerp``)."""
+    x = min(max(speed, speeds[0]), speeds[-1])
+    i = np.searchsorted(speeds, x) - 1
+    i = min(max(i, 0), len(speeds) - 2)
+    return i, (x - speeds[i]) / (speeds[i + 1] - speeds[i])
+
+
+@njit(cache=True)
+def _controls_of(p):
+    return np.array([p[0], 0.5 * (p[1] + p[2]), 0.5 * (p[3] + p[4]), p[1] - p[2], p[3] - p[4], 0.5 * (p[5] + p[6]),
+                     p[5] - p[6], 0.5 * (p[7] + p[8]), p[10]])
+
+
+@njit(cache=True)
+def _command_from_controls(base, u):
+    p = base.copy()
+    p[0] += u[0]
+    p[1] += u[1] + 0.5 * u[3]
+    p[2] += u[1] - 0.5 * u[3]
+    p[3] += u[2] + 0.5 * u[4]
+    p[4] += u[2] - 0.5 * u[4]
+    p[5] += u[5] + 0.5 * u[6]
+    p[6] += u[5] - 0.5 * u[6]
+    p[7] += u[7]
+    p[8] += u[7]
+    p[10] += u[8]
+    return p
+
+
+@njit(cache=True)
+def _wind_triangle(d, ground_speed, wind_xy, vmin, vmax):
+    air = ground_speed * d - wind_xy
+    if math.sqrt(air[0] ** 2 + air[1] ** 2) > vmax:
+        along = d[0] * wind_xy[0] + d[1] * wind_xy[1]
+        disc = along * along - (wind_xy[0] ** 2 + wind_xy[1] ** 2) + vmax ** 2
+        g = along + math.sqrt(disc) if disc >= 0.0 else 0.0
+        air = max(g, 0.0) * d - wind_xy
+        n = math.sqrt(air[0] ** 2 + air[1] ** 2)
+        if n > vmax:
+            air = air * (vmax / n)
+    speed = math.sqrt(air[0] ** 2 + air[1] ** 2)
+    if speed < 1e-9:
+        return math.atan2(d[1], d[0]), vmin
+    return math.atan2(air[1], air[0]), min(max(speed, vmin), vmax)
+
+
+@njit(cache=True)
+def sample(st, buf, qpos, qvel, R, psi, n_beat):
+    """One physics step's sample into the ring (``DesignedController.__call__``'s first lines): the thorax's position
+    and velocity, its rates, attitude matrix ``R`` and the stroke phase ``psi``; the ring keeps the last ``n_beat``.
+    Returns whether this step sets a new command (every ``every``-th sample, counted by the caller through ``st[0]``)."""
+    h = int(st[2])
+    buf[h, 0:3] = qpos[0:3]
+    buf[h, 3:6] = qvel[0:3]
+    buf[h, 6:9] = qvel[3:6]
+    buf[h, 9:18] = R.ravel()
+    buf[h, 18] = psi
+    st[2] = (h + 1) % N_BUF
+    st[1] = min(st[1] + 1.0, float(n_beat))
+    st[0] += 1.0
+
+
+@njit(cache=True)
+def _row(buf, st, j):
+    """The ring's ``j``-th sample from the oldest kept."""
+    n = int(st[1])
+    return buf[(int(st[2]) - n + j) % N_BUF]
+
+
+@njit(cache=True)
+def control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins, ud_p, ud_dp, dt, every, kind,
+            waypoint, task_speed, reference, n_beat):
+    """The command (kinematics parameters) of one control step (``DesignedController.__call__`` after the sample):
+    ``c`` the :func:`constants`, ``ud_p`` and ``ud_dp`` the kinematics' parameters and rates as flown, ``kind`` 0 for
+    a waypoint (``waypoint``, at ``task_speed``), 1 for a reference (heading, altitude, airspeed)."""
+    (max_alt, max_head, max_speed, max_rate, max_att, max_climb, t_rate, t_min, obs_hz, obs_zeta, app_min, app_per,
+     vmin, vmax, max_dv, max_turn) = c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11], c[12], \
+        c[13], c[14], c[15]
+    int_lim = c[16:19]
+    lo, hi = c[19:28], c[28:37]
+    n = int(st[1])
+    pos = np.zeros(3)
+    vel = np.zeros(3)
+    rates = np.zeros(3)
+    for j in range(n):
+        r = _row(buf, st, j)
+        pos += r[0:3]
+        vel += r[3:6]
+        rates += r[6:9]
+    pos /= n
+    vel /= n
+    rates /= n
+    last = _row(buf, st, n - 1)
+    Rm = last[9:18].copy().reshape(3, 3)
+    a_mean = np.zeros(3)
+    for j in range(n):
+        a_mean += _log(Rm.T @ _row(buf, st, j)[9:18].copy().reshape(3, 3))
+    a_mean /= n
+    Rm = Rm @ _exp(a_mean)
+    if n == n_beat:  # the slow motion without the mean's half-beat lag (DesignedController._unlagged)
+        mid = _row(buf, st, n // 2)
+        Rmid = mid[9:18].copy().reshape(3, 3)
+        k = int(mid[18] % (2.0 * math.pi) / (2.0 * math.pi) * n_bins) % n_bins
+        dev = np.empty(9)
+        dev[0:3] = Rmid.T @ (mid[3:6] - vel)
+        dev[3:6] = mid[6:9] - rates
+        dev[6:9] = _log(Rm.T @ Rmid)
+        tmpl[k, 0:9] += t_rate * (dev - tmpl[k, 0:9])
+        tmpl[k, 9] += 1.0
+        j = int(last[18] % (2.0 * math.pi) / (2.0 * math.pi) * n_bins) % n_bins
+        if tmpl[j, 9] >= t_min:
+            Rl = last[9:18].copy().reshape(3, 3)
+            vel = last[3:6] - Rl @ tmpl[j, 0:3]
+            rates = last[6:9] - tmpl[j, 3:6]
+            Rm = Rl @ _exp(-tmpl[j, 6:9])
+    t_ctrl = every * dt
+    # the wind observer (DesignedController.wind)
+    wind = st[10:13].copy()
+    if st[6] == 0.0:
+        st[6] = 1.0
+        st[7:10] = vel
+    else:
+        air = st[7:9] - st[10:12]
+        spd = math.sqrt(air[0] ** 2 + air[1] ** 2)
+        i, t = _at(speeds, spd)
+        A = (1.0 - t) * As[i] + t * As[i + 1]
+        B = (1.0 - t) * Bs[i] + t * Bs[i + 1]
+        v0 = (1.0 - t) * v0s[i] + t * v0s[i + 1]
+        pitch0 = (1.0 - t) * pitches[i] + t * pitches[i + 1]
+        trim_cmd = (1.0 - t) * commands[i] + t * commands[i + 1]
+        yaw = math.atan2(Rm[1, 0], Rm[0, 0])
+        a = _log(_rotation(0.0, pitch0, yaw).T @ Rm)
+        u = _controls_of(ud_p) - _controls_of(trim_cmd)
+        v_b = Rm.T @ (st[7:10] - st[10:13])
+        Avv_b = np.ascontiguousarray(A[0:3, 0:3])
+        acc = Rm @ (Avv_b @ (v_b - v0) + np.ascontiguousarray(A[0:3, 3:6]) @ rates
+                    + np.ascontiguousarray(A[0:3, 6:9]) @ a + np.ascontiguousarray(B[0:3]) @ u)
+        Avv = Rm @ Avv_b @ np.ascontiguousarray(Rm.T)
+        e = vel - st[7:10]
+        wn = 2.0 * math.pi * obs_hz
+        st[7:10] = st[7:10] + t_ctrl * (acc + 2.0 * obs_zeta * wn * e)
+        dw = -wn * wn * np.linalg.solve(Avv, e)
+        dw[2] = 0.0
+        st[10:13] = st[10:13] + t_ctrl * dw
+        wind = st[10:13].copy()
+    # guidance (DesignedController.references)
+    if kind == 0:
+        to = waypoint[0:2] - pos[0:2]
+        dist = math.sqrt(to[0] ** 2 + to[1] ** 2)
+        d = to / dist if dist > 1e-9 else np.array([1.0, 0.0])
+        gs = min(task_speed, app_min + app_per * dist)
+        target, asked = _wind_triangle(d, gs, wind[0:2], vmin, vmax)
+        altitude_asked = waypoint[2]
+    else:
+        target, altitude_asked, asked = reference[0], reference[1], min(max(reference[2], vmin), vmax)
+    if st[17] == 0.0:
+        st[17] = 1.0
+        st[18] = pos[2]
+    dz_max = max_climb * t_ctrl
+    climb = min(max(altitude_asked - st[18], -dz_max), dz_max)
+    st[18] = st[18] + climb
+    altitude = st[18]
+    climb_rate = climb / t_ctrl
+    if st[15] == 0.0:
+        st[15] = 1.0
+        st[16] = asked
+    dv = max_dv * every * dt
+    st[16] = st[16] + min(max(asked - st[16], -dv), dv)
+    airspeed = st[16]
+    if st[13] == 0.0:
+        st[13] = 1.0
+        st[14] = math.atan2(Rm[1, 0], Rm[0, 0])
+    step = max_turn * t_ctrl
+    turn = min(max(_wrap(target - st[14]), -step), step)
+    st[14] = _wrap(st[14] + turn)
+    heading = st[14]
+    turn_rate = turn / t_ctrl
+    # the regulator
+    i, t = _at(speeds, airspeed)
+    pitch0 = (1.0 - t) * pitches[i] + t * pitches[i + 1]
+    v0 = (1.0 - t) * v0s[i] + t * v0s[i + 1]
+    K = (1.0 - t) * Ks[i] + t * Ks[i + 1]
+    trim_cmd = (1.0 - t) * commands[i] + t * commands[i + 1]
+    trim_u = _controls_of(trim_cmd)
+    yaw = math.atan2(Rm[1, 0], Rm[0, 0])
+    herr = min(max(_wrap(yaw - heading), -max_head), max_head)
+    bank = -math.atan(airspeed * turn_rate / 9.81)
+    R0 = _rotation(bank, pitch0, yaw - herr)
+    a = _log(R0.T @ Rm)
+    v_air = Rm.T @ (vel - wind - np.array([0.0, 0.0, climb_rate]))
+    x = np.zeros(K.shape[1])
+    ez = R0.T @ np.array([0.0, 0.0, turn_rate])
+    for q in range(3):
+        x[q] = min(max(v_air[q] - v0[q], -max_speed), max_speed)
+        x[3 + q] = min(max(rates[q] - ez[q], -max_rate), max_rate)
+        x[6 + q] = min(max(a[q], -max_att), max_att)
+    nu = 9
+    x[13 : 13 + nu] = _controls_of(ud_p) - trim_u
+    x[13 + nu :] = _controls_of(ud_dp)
+    zerr = min(max(pos[2] - altitude, -max_alt), max_alt)
+    x[9] = zerr
+    x[10:13] = st[3:6]
+    u = -(K @ x)
+    change = np.empty(nu)
+    for q in range(nu):
+        change[q] = min(max(trim_u[q] + u[q], lo[q]), hi[q]) - trim_u[q]
+    fwd = math.cos(heading) * (vel[0] - wind[0]) + math.sin(heading) * (vel[1] - wind[1])
+    inc = np.array([zerr, fwd - airspeed, herr])
+    for q in range(3):
+        st[3 + q] = min(max(st[3 + q] + t_ctrl * inc[q], -int_lim[q]), int_lim[q])
+    return _command_from_controls(trim_cmd, change)
+
+
+class KernelController:
+    """The compiled controller run from Python (``Flight3D(controller=KernelController(spec))``), flying exactly as
+    :class:`~lifelike_mj.butterfly.flight3d.designed.DesignedController` does: the check that the two are one."""
+
+    def __init__(self, spec: dict, every: int = 8) -> None:
+        self.spec, self.every = spec, every
+        self.animal = spec.get("animal", "monarch")
+        self.force_law = spec.get("force_law", "calibrated")
+        self.tables, self.constants = tables(spec), constants()
+        self.st, self.buf, self.tmpl = new_state()
+
+    def start_command(self, speed_m_s: float = 1.5):
+        from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
+
+        return KinematicsCommand(*D._lerp(self.tables[0], self.tables[4], speed_m_s))
+
+    def __call__(self, flight):
+        import mujoco
+
+        from lifelike_mj.butterfly.flight3d import model as mj3d
+        from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS, KinematicsCommand
+        from lifelike_mj.butterfly.flight3d.tasks import R_PASSED
+
+        d = flight.data
+        R = np.empty(9)
+        mujoco.mju_quat2Mat(R, d.qpos[3:7])
+        freq = float(d.userdata[mj3d.U_P0])
+        n_beat = max(1, int(round(1.0 / (freq * flight.dt))))
+        sample(self.st, self.buf, d.qpos, d.qvel, R.reshape(3, 3), float(d.userdata[mj3d.U_PSI0]), n_beat)
+        if (int(self.st[0]) - 1) % self.every:
+            return None
+        task = flight.task
+        if task.kind == "waypoints":
+            i = min(int(flight._rec[R_PASSED]), len(task.rows) - 1)
+            kind, wp, ref = 0, np.array(task.rows[i][:3], float), np.zeros(3)
+        else:
+            kind, wp, ref = 1, np.zeros(3), np.array(flight.reference, float)
+        ud = d.userdata
+        p = control(self.st, self.buf, self.tmpl, *self.tables, self.constants, D.N_BINS,
+                    ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS].copy(), ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS].copy(),
+                    flight.dt, self.every, kind, wp, float(task.speed_m_s), ref, n_beat)
+        return KinematicsCommand(*p)

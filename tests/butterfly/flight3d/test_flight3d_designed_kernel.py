@@ -1,0 +1,50 @@
+"""The designed controller compiled (``designed_kernel``) against its Python twin (``designed.DesignedController``):
+the same flight, sample by sample, on a course in gusts (waypoint guidance, the wind observer at work) and in a turn
+(a schedule's references)."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from lifelike_mj.butterfly.flight3d import designed as D
+from lifelike_mj.butterfly.flight3d import designed_kernel as DK
+from lifelike_mj.butterfly.flight3d.flight import Flight3D
+from lifelike_mj.butterfly.flight3d.tasks import course, turn
+
+MODEL = Path(__file__).resolve().parents[3] / "benchmarks" / "results" / "monarch_model.json"
+
+
+@pytest.fixture(scope="module")
+def spec():
+    return D.design(json.loads(MODEL.read_text()))
+
+
+def _flight(controller, task, seconds: float) -> np.ndarray:
+    f = Flight3D(controller=controller, task=task)
+    rows = []
+    while f.time < seconds - 1e-9:
+        f.step(40)
+        rows.append(np.concatenate([f.data.qpos[:7], f.data.qvel[:6], [f.waypoints_passed]]))
+    return np.array(rows)
+
+
+@pytest.mark.parametrize("task,seconds", [
+    (course(201).with_weather(wind_to_m_s=(1.0, 0.0, 0.0), gust_m_s=0.5, gust_vertical_m_s=0.5), 6.0),
+    (turn(90.0, speed_m_s=1.2), 4.0)], ids=["gusty course", "turn"])
+def test_the_compiled_controller_flies_as_its_python_twin(spec, task, seconds):
+    python = _flight(D.DesignedController(spec), task, seconds)
+    compiled = _flight(DK.KernelController(spec), task, seconds)
+    assert np.ptp(python[:, 0]) > 1.0  # it flew somewhere
+    np.testing.assert_allclose(compiled, python, rtol=0.0, atol=1e-9)
+
+
+def test_the_ring_keeps_the_last_beat_as_the_twins_deque_does():
+    st, buf, _ = DK.new_state()
+    R = np.eye(3)
+    for k in range(30):
+        DK.sample(st, buf, np.full(7, float(k)), np.zeros(6), R, 0.0, 20 if k < 25 else 12)
+    assert st[0] == 30 and st[1] == 12  # a shorter beat drops the oldest samples at once
+    kept = [DK._row(buf, st, j)[0] for j in range(int(st[1]))]
+    assert kept == [float(k) for k in range(18, 30)]
