@@ -71,6 +71,8 @@ def cmd_fly3d(args) -> None:
 
     ctrl = load_any(args.controller)
     check_outputs(args, folders={"--out": FLY3D_FILES})
+    if hasattr(ctrl, "to_compiled"):  # a designed controller flies in the compiled loop
+        ctrl = ctrl.to_compiled()
     flight = Flight3D(controller=ctrl, task=_task(args), dt_s=args.dt)
     with stage(f"3D flight, {args.duration:g} s"):
         rec = flight.record(duration_s=args.duration, every=max(1, round(0.01 / args.dt)))  # every 10 ms

@@ -15,9 +15,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from lifelike_mj.butterfly.flight3d import designed as D
+from lifelike_mj.butterfly.flight3d import loop as L
+from lifelike_mj.butterfly.flight3d import model as mj3d
+from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
 
 #: The scalars of a flight's state, in ``st``'s order.
 ST_NAMES = ("k", "count", "head", "int_z", "int_v", "int_h", "v_hat_set", "v_hat_x", "v_hat_y", "v_hat_z", "w_hat_x",
@@ -301,45 +304,132 @@ def control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins
     return _command_from_controls(trim_cmd, change)
 
 
-class KernelController:
-    """The compiled controller run from Python (``Flight3D(controller=KernelController(spec))``), flying exactly as
-    :class:`~lifelike_mj.butterfly.flight3d.designed.DesignedController` does: the check that the two are one."""
+class CompiledDesigned:
+    """A designed controller (:func:`~lifelike_mj.butterfly.flight3d.designed.design`'s answer or a controller file's
+    content) for the compiled loop: ``Flight3D(controller=CompiledDesigned(spec))`` flies it inside
+    :class:`~lifelike_mj.butterfly.flight3d.loop.Batch` (:func:`fly_designed`), as a network is flown, bit for bit as
+    :class:`~lifelike_mj.butterfly.flight3d.designed.DesignedController` flies from Python."""
 
-    def __init__(self, spec: dict, every: int = 8) -> None:
-        self.spec, self.every = spec, every
+    #: what ``Flight3D`` looks for to fly it in the compiled loop
+    compiled = True
+
+    def __init__(self, spec: dict, every: int = 8, name: str = "", provenance: dict | None = None) -> None:
+        self.spec, self.every, self.name = spec, int(every), name
+        self.provenance = dict(provenance or spec.get("provenance") or {})
         self.animal = spec.get("animal", "monarch")
         self.force_law = spec.get("force_law", "calibrated")
         self.tables, self.constants = tables(spec), constants()
-        self.st, self.buf, self.tmpl = new_state()
 
     def start_command(self, speed_m_s: float = 1.5):
+        """The trim's kinematics at ``speed_m_s`` (``DesignedController.start_command``)."""
         from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
 
         return KinematicsCommand(*D._lerp(self.tables[0], self.tables[4], speed_m_s))
 
-    def __call__(self, flight):
-        import mujoco
+    def advance(self, batch, n_steps: int, path: np.ndarray, path_every: int) -> None:
+        """Fly ``batch`` (:class:`~lifelike_mj.butterfly.flight3d.loop.Batch`, made with ``designed=self``, its
+        per-flight states in ``batch.designed_states``) ``n_steps`` steps (:func:`fly_designed`, threads over the
+        flights of a batch of more than one); ``path`` as ``Batch.advance`` takes it (a batch of one only)."""
+        from lifelike_mj.physics import mjabi
 
-        from lifelike_mj.butterfly.flight3d import model as mj3d
-        from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS, KinematicsCommand
-        from lifelike_mj.butterfly.flight3d.tasks import R_PASSED
-
-        d = flight.data
-        R = np.empty(9)
-        mujoco.mju_quat2Mat(R, d.qpos[3:7])
-        freq = float(d.userdata[mj3d.U_P0])
-        n_beat = max(1, int(round(1.0 / (freq * flight.dt))))
-        sample(self.st, self.buf, d.qpos, d.qvel, R.reshape(3, 3), float(d.userdata[mj3d.U_PSI0]), n_beat)
-        if (int(self.st[0]) - 1) % self.every:
-            return None
-        task = flight.task
-        if task.kind == "waypoints":
-            i = min(int(flight._rec[R_PASSED]), len(task.rows) - 1)
-            kind, wp, ref = 0, np.array(task.rows[i][:3], float), np.zeros(3)
+        m = batch.model
+        sts, bufs, tmpls = batch.designed_states
+        args = (*self.tables, self.constants, D.N_BINS)
+        if batch.n == 1:
+            fly_designed(m._address, int(batch.ptrs[0]), mjabi.offsets_tuple(), m.nq, m.nv, n_steps, batch.dt,
+                         self.every, batch.tasks[0], batch.records[0], path, path_every, batch.tumble_rad, batch.base,
+                         sts[0], bufs[0], tmpls[0], *args)
         else:
-            kind, wp, ref = 1, np.zeros(3), np.array(flight.reference, float)
-        ud = d.userdata
-        p = control(self.st, self.buf, self.tmpl, *self.tables, self.constants, D.N_BINS,
-                    ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS].copy(), ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS].copy(),
-                    flight.dt, self.every, kind, wp, float(task.speed_m_s), ref, n_beat)
-        return KinematicsCommand(*p)
+            fly_designed_batch(m._address, batch.ptrs, mjabi.offsets_tuple(), m.nq, m.nv, n_steps, batch.dt,
+                               self.every, batch.tasks, batch.records, batch.tumble_rad, batch.base, sts, bufs, tmpls,
+                               *args)
+
+    def states(self, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Fresh controller states for ``n`` flights (:func:`new_state`, stacked)."""
+        st, buf, tmpl = new_state()
+        return (np.zeros((n, *st.shape)), np.zeros((n, *buf.shape)), np.zeros((n, *tmpl.shape)))
+
+
+@njit(cache=True)
+def _quat2mat(q):
+    """MuJoCo's ``mju_quat2Mat``, operation for operation (the twin reads its attitude through MuJoCo's)."""
+    R = np.empty((3, 3))
+    if q[0] == 1.0 and q[1] == 0.0 and q[2] == 0.0 and q[3] == 0.0:
+        return np.eye(3)
+    q00, q01, q02, q03 = q[0] * q[0], q[0] * q[1], q[0] * q[2], q[0] * q[3]
+    q11, q12, q13 = q[1] * q[1], q[1] * q[2], q[1] * q[3]
+    q22, q23, q33 = q[2] * q[2], q[2] * q[3], q[3] * q[3]
+    R[0, 0] = q00 + q11 - q22 - q33
+    R[1, 1] = q00 - q11 + q22 - q33
+    R[2, 2] = q00 - q11 - q22 + q33
+    R[0, 1] = 2.0 * (q12 - q03)
+    R[0, 2] = 2.0 * (q13 + q02)
+    R[1, 0] = 2.0 * (q12 + q03)
+    R[1, 2] = 2.0 * (q23 - q01)
+    R[2, 0] = 2.0 * (q13 - q02)
+    R[2, 1] = 2.0 * (q23 + q01)
+    return R
+
+
+@njit(cache=True)
+def fly_designed(mptr, dptr, off, nq, nv, n_steps, dt, every, task, rec, path, path_every, tumble_rad, base, st, buf,
+                 tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins):
+    """:func:`~lifelike_mj.butterfly.flight3d.loop.fly_steps` with the designed controller in place of the network:
+    each step its sample (:func:`sample`), every ``every`` steps a new command (:func:`control`, the waypoint or the
+    schedule's references the task gives), then the loop's step as for every controller (gusts, air, references,
+    one ``mj_step``, the kinematics advanced)."""
+    ud = L._f64(L._ptr_at(dptr + off[L._O_UD]), mj3d.N_USERDATA)
+    qpos = L._f64(L._ptr_at(dptr + off[L._O_QPOS]), nq)
+    qvel = L._f64(L._ptr_at(dptr + off[L._O_QVEL]), nv)
+    time = L._f64(dptr + off[L._O_TIME], 1)
+    obs = np.empty(L.N_OBS)
+    p = np.empty(N_PARAMS)
+    dp = np.empty(N_PARAMS)
+    ddp = np.empty(N_PARAMS)
+    ground = np.zeros(3)
+    opts = np.zeros(3)
+    wp = np.zeros(3)
+    ref = np.zeros(3)
+    n_path = 0
+    for _ in range(n_steps):
+        if rec[L.R_DIVERGED] >= 0 or rec[L.R_TUMBLED] >= 0:
+            return
+        freq = ud[mj3d.U_P0]
+        n_beat = max(1, int(round(1.0 / (freq * dt))))
+        sample(st, buf, qpos, qvel, _quat2mat(qpos[3:7]), ud[mj3d.U_PSI0], n_beat)
+        if (int(st[0]) - 1) % every == 0:
+            kind = int(task[L.T_KIND])
+            if kind == L.TASK_WAYPOINTS:
+                i = min(int(rec[L.R_PASSED]), int(task[L.T_ROWS]) - 1)
+                b = L.T_ROW0 + 4 * i
+                wp[0], wp[1], wp[2] = task[b], task[b + 1], task[b + 2]
+                k = 0
+            elif kind == L.TASK_SCHEDULE:
+                # the schedule's row at steps x dt, the time Flight3D.reference reads (the data's clock, a sum of
+                # steps, can fall a rounding short of a row's start)
+                ref[0], ref[1], ref[2] = L.reference(task, rec[L.R_STEPS] * dt, qpos[0:3], rec)
+                k = 1
+            else:
+                ref[0], ref[1], ref[2] = L.attitude(qpos[3:7])[2], qpos[2], task[L.T_SPEED]
+                k = 1
+            cmd = control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins,
+                          ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS].copy(), ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS].copy(),
+                          dt, every, k, wp, task[L.T_SPEED], ref, n_beat)
+            for j in range(N_PARAMS):
+                ud[mj3d.U_TARGET + j] = cmd[j]
+        tumbled, n_path = L._before(ud, qpos, qvel, time, dt, task, rec, obs, opts, ground, path, path_every,
+                                    n_path, tumble_rad, base)
+        if tumbled:
+            return
+        if not L._after(mptr, dptr, off, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
+            return
+
+
+@njit(cache=True, parallel=True)
+def fly_designed_batch(mptr, dptrs, off, nq, nv, n_steps, dt, every, tasks, recs, tumble_rad, base, sts, bufs, tmpls,
+                       speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins):
+    """:func:`fly_designed` for many butterflies at once (threads over the copies), each with its own state."""
+    none = np.empty((0, 7))
+    for i in prange(len(dptrs)):
+        fly_designed(mptr, dptrs[i], off, nq, nv, n_steps, dt, every, tasks[i], recs[i], none, 0, tumble_rad, base,
+                     sts[i], bufs[i], tmpls[i], speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins)

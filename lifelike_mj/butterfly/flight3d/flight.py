@@ -182,6 +182,8 @@ class Flight3D(StepCounter):
         n_strips, n_chord, drive_hz = butterfly.n_strips, butterfly.n_chord, butterfly.drive_hz
         contact, flowers, ground_m = world.contact, world.flowers, world.ground_m
         self.network = None
+        #: A designed controller flown in the compiled loop (``designed_kernel.CompiledDesigned``), or ``None``.
+        self.designed = None
         if isinstance(controller, (str, Path)):
             controller = load_controller(controller)
         designed = getattr(controller, "start_command", None) is not None and not isinstance(controller, Controller3D)
@@ -190,6 +192,8 @@ class Flight3D(StepCounter):
             force_law = force_law if force_law is not None else controller.force_law
             start = 1.5 if not isinstance(task, Task3D) else task.rows[0][3] if task.kind == "schedule" else task.speed_m_s
             command = command or controller.start_command(start)
+            if getattr(controller, "compiled", False):
+                self.designed, controller = controller, None
         if isinstance(controller, Controller3D):
             self.network, controller = controller, None
             omega_c = self.network.omega_c_rad_s if omega_c is None else omega_c
@@ -275,7 +279,7 @@ class Flight3D(StepCounter):
         # the task afresh: a landing turns its array's kind into a perch
         self._batch = Batch(self._model, [self._data], self.task.as_array(self._n_rows), net, dt_s=self.dt,
                             records=new_record(1, self._n_rows), base=None if net else self.command.as_array(),
-                            tumble_rad=TUMBLE_RAD if self.end_on_tumble else math.inf)
+                            tumble_rad=TUMBLE_RAD if self.end_on_tumble else math.inf, designed=self.designed)
         self._task = self._batch.tasks[0]
         self._rec = self._batch.records[0]
         self._diverged = ""
@@ -476,7 +480,7 @@ class Flight3D(StepCounter):
         self.task, self._n_rows = task, len(task.rows)
         self._batch = Batch(self._model, [self._data], task.as_array(self._n_rows), self.network, dt_s=self.dt,
                             records=records, base=None if self.network else self.command.as_array(),
-                            tumble_rad=self._batch.tumble_rad)
+                            tumble_rad=self._batch.tumble_rad, designed=self.designed)
         self._task = self._batch.tasks[0]
         self._rec = self._batch.records[0]
 

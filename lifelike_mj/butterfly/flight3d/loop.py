@@ -603,7 +603,8 @@ class Batch:
     ``tumble_rad``: a roll or pitch beyond which a flight ends (``inf``: never)."""
 
     def __init__(self, model, datas, tasks: np.ndarray, controller=None, *, weights=None, dt_s: float,
-                 records: np.ndarray, tumble_rad: float = math.inf, base: np.ndarray | None = None) -> None:
+                 records: np.ndarray, tumble_rad: float = math.inf, base: np.ndarray | None = None,
+                 designed=None) -> None:
         self.model, self.datas = model, list(datas)
         self.n = len(self.datas)
         self.tasks = np.ascontiguousarray(tasks, dtype=np.float64).reshape(self.n, -1)
@@ -624,6 +625,11 @@ class Batch:
             w = own if weights is None else weights
             self.weights = np.ascontiguousarray(np.broadcast_to(w, (self.n, len(own))), dtype=np.float64)
             self.reach = controller.mode_reach()
+        #: A designed controller flown in the loop (``designed_kernel.CompiledDesigned``), with each flight's state.
+        self.designed = designed
+        if designed is not None:
+            self.every = designed.every
+            self.designed_states = designed.states(self.n)
 
     def advance(self, n_steps: int, path: np.ndarray | None = None, path_every: int = 0) -> None:
         """Fly every butterfly ``n_steps`` steps (threads over the butterflies), with the model's compiled air
@@ -635,8 +641,12 @@ class Batch:
 
         m = self.model
         group = "flight3d-steps" if self.n == 1 else "flight3d-batch"
+        if self.designed is not None:
+            group = "flight3d-designed" if self.n == 1 else "flight3d-designed-batch"
         with compile_notice(group, "the 3D flight", COMPILE_S), passive_callback(mj3d.COMPILED_PASSIVE), watching():
-            if self.n == 1:
+            if self.designed is not None:  # its own loop (designed_kernel.fly_designed), given this batch's state
+                self.designed.advance(self, n_steps, _NO_PATH if path is None else path, path_every)
+            elif self.n == 1:
                 fly_steps(m._address, int(self.ptrs[0]), mjabi.offsets_tuple(), m.nq, m.nv, n_steps, self.dt,
                           self.every, self.layers, self.weights[0], self.reach, self.base, self.scale, self.tasks[0],
                           self.records[0], _NO_PATH if path is None else path, path_every, self.tumble_rad,
@@ -654,6 +664,11 @@ class Batch:
         from lifelike_mj.physics.callbacks import passive_callback
         from lifelike_mj.physics.stability import watching
 
+        if self.designed is not None:
+            from lifelike_mj.errors import UserError
+
+            raise UserError("a designed controller flies by itself: decide() takes a policy's actions in place of a "
+                            "network's, and this flight has none (fly it with step()).")
         m = self.model
         act = np.full(self.n, actions is not None) if act is None else np.asarray(act, dtype=np.bool_) & (
             actions is not None)
