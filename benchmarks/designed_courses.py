@@ -4,8 +4,10 @@ Run: ``python benchmarks/designed_courses.py`` (about 5 minutes on 2 cores; the 
 ``benchmarks/results/monarch_model.json`` is missing: ``lifelike-mj butterfly model3d --out
 benchmarks/results/monarch_model.json``). Writes ``benchmarks/results/designed_courses.json``.
 
-Each seed's course (``tasks.course``: ten waypoints) is flown four times by ``designed.DesignedController`` built from
-the model's level trims (``designed.design``), on the calibrated wing law, for at most 60 s:
+Each seed's course (``tasks.course``: ten waypoints) is flown four times by the designed controller built from
+the model's level trims (``designed.design``), in the compiled loop (``designed_kernel.CompiledDesigned``, the same
+flights as its Python twin, ``designed.DesignedController``, which draws the picture), on the calibrated wing law, for
+at most 60 s:
 - in calm air;
 - in a 1 m/s wind toward +x with gusts of 0.5 m/s and vertical gusts at Dryden's ratio near the ground (0.25 m/s);
 - in the same wind with vertical gusts as strong as the horizontal ones (0.5 m/s);
@@ -49,6 +51,7 @@ def _spec(model_path: str) -> dict:
 def fly(job: tuple[dict, int]) -> dict:
     """One seed's four courses (module docstring)."""
     from lifelike_mj.butterfly.flight3d import designed as D
+    from lifelike_mj.butterfly.flight3d import designed_kernel as DK
     from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
     from lifelike_mj.butterfly.flight3d.parts import Butterfly
     from lifelike_mj.butterfly.flight3d.validate import course_check
@@ -59,7 +62,7 @@ def fly(job: tuple[dict, int]) -> dict:
     weather = dict(WEATHER, steady_1_5={"wind_to_m_s": [1.5 * dx, 1.5 * dy, 0.0]})
     out = {"seed": seed}
     for name, w in weather.items():
-        r = course_check(D.DesignedController(spec), seed, weather=w, command=start,
+        r = course_check(DK.CompiledDesigned(spec), seed, weather=w, command=start,
                          butterfly=Butterfly("monarch", force_law="calibrated"))
         out[name] = {"passed": r["passed"], "time_s": r["time_s"]}
     return out
@@ -71,13 +74,13 @@ def calm(job: tuple[dict, int]) -> dict:
 
     import numpy as np
 
-    from lifelike_mj.butterfly.flight3d import designed as D
+    from lifelike_mj.butterfly.flight3d import designed_kernel as DK
     from lifelike_mj.butterfly.flight3d.flight import Flight3D, euler_from_quat
     from lifelike_mj.butterfly.flight3d.tasks import course
 
     spec, seed = job
     task = course(seed)
-    f = Flight3D(controller=D.DesignedController(spec), task=task)
+    f = Flight3D(controller=DK.CompiledDesigned(spec), task=task)
     lowest = min(r[2] for r in task.rows)
     worst, fell = 0.0, False
     while f.time < 40.0 and f.waypoints_passed < len(task.rows) and not fell:
@@ -92,13 +95,13 @@ def level(job: tuple[dict, float]) -> dict:
     """Level flight in calm air at one speed (module docstring)."""
     import numpy as np
 
-    from lifelike_mj.butterfly.flight3d import designed as D
+    from lifelike_mj.butterfly.flight3d import designed_kernel as DK
     from lifelike_mj.butterfly.flight3d import measures as M
     from lifelike_mj.butterfly.flight3d import tasks
     from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
     spec, speed = job
-    f = Flight3D(controller=D.DesignedController(spec), task=tasks.level(speed))
+    f = Flight3D(controller=DK.CompiledDesigned(spec), task=tasks.level(speed))
     f.step(int(round(5.0 / f.dt)))
     s = M.sample(f, 6.0)
     m = M.measures(s, **M.body_numbers(f))

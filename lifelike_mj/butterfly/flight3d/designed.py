@@ -43,8 +43,8 @@ from __future__ import annotations
 import math
 from collections import deque
 
-import mujoco
 import numpy as np
+from numba import njit
 
 from lifelike_mj.butterfly.flight3d import averaged as av
 from lifelike_mj.butterfly.flight3d import model as mj3d
@@ -237,6 +237,29 @@ def _log(R: np.ndarray) -> np.ndarray:
     return t / (2.0 * math.sin(t)) * w
 
 
+@njit(cache=True)
+def quat2mat(q):
+    """The rotation matrix of the unit quaternion ``q`` (w, x, y, z): MuJoCo's ``mju_quat2Mat`` formula, compiled once
+    for both forms of the controller, so that the Python twin and the compiled loop read the same attitude to the
+    last bit (MuJoCo's own build may fuse a multiply into an add, and its matrices differ by a rounding)."""
+    R = np.empty((3, 3))
+    if q[0] == 1.0 and q[1] == 0.0 and q[2] == 0.0 and q[3] == 0.0:
+        return np.eye(3)
+    q00, q01, q02, q03 = q[0] * q[0], q[0] * q[1], q[0] * q[2], q[0] * q[3]
+    q11, q12, q13 = q[1] * q[1], q[1] * q[2], q[1] * q[3]
+    q22, q23, q33 = q[2] * q[2], q[2] * q[3], q[3] * q[3]
+    R[0, 0] = q00 + q11 - q22 - q33
+    R[1, 1] = q00 - q11 + q22 - q33
+    R[2, 2] = q00 - q11 - q22 + q33
+    R[0, 1] = 2.0 * (q12 - q03)
+    R[0, 2] = 2.0 * (q13 + q02)
+    R[1, 0] = 2.0 * (q12 + q03)
+    R[1, 2] = 2.0 * (q23 - q01)
+    R[2, 0] = 2.0 * (q13 - q02)
+    R[2, 1] = 2.0 * (q23 + q01)
+    return R
+
+
 def _wrap(a: float) -> float:
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
@@ -389,9 +412,7 @@ class DesignedController:
         d = flight.data
         dt = flight.dt
         quat = d.qpos[3:7]
-        R = np.empty(9)
-        mujoco.mju_quat2Mat(R, quat)
-        R = R.reshape(3, 3)
+        R = quat2mat(np.ascontiguousarray(quat))
         freq = float(d.userdata[mj3d.U_P0])  # the flap frequency flown
         n_beat = max(1, int(round(1.0 / (freq * dt))))
         self.buffer.append((d.qpos[0:3].copy(), d.qvel[0:3].copy(), d.qvel[3:6].copy(), R.copy(),

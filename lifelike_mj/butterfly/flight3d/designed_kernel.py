@@ -351,27 +351,6 @@ class CompiledDesigned:
 
 
 @njit(cache=True)
-def _quat2mat(q):
-    """MuJoCo's ``mju_quat2Mat``, operation for operation (the twin reads its attitude through MuJoCo's)."""
-    R = np.empty((3, 3))
-    if q[0] == 1.0 and q[1] == 0.0 and q[2] == 0.0 and q[3] == 0.0:
-        return np.eye(3)
-    q00, q01, q02, q03 = q[0] * q[0], q[0] * q[1], q[0] * q[2], q[0] * q[3]
-    q11, q12, q13 = q[1] * q[1], q[1] * q[2], q[1] * q[3]
-    q22, q23, q33 = q[2] * q[2], q[2] * q[3], q[3] * q[3]
-    R[0, 0] = q00 + q11 - q22 - q33
-    R[1, 1] = q00 - q11 + q22 - q33
-    R[2, 2] = q00 - q11 - q22 + q33
-    R[0, 1] = 2.0 * (q12 - q03)
-    R[0, 2] = 2.0 * (q13 + q02)
-    R[1, 0] = 2.0 * (q12 + q03)
-    R[1, 2] = 2.0 * (q23 - q01)
-    R[2, 0] = 2.0 * (q13 - q02)
-    R[2, 1] = 2.0 * (q23 + q01)
-    return R
-
-
-@njit(cache=True)
 def fly_designed(mptr, dptr, off, nq, nv, n_steps, dt, every, task, rec, path, path_every, tumble_rad, base, st, buf,
                  tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins):
     """:func:`~lifelike_mj.butterfly.flight3d.loop.fly_steps` with the designed controller in place of the network:
@@ -396,7 +375,7 @@ def fly_designed(mptr, dptr, off, nq, nv, n_steps, dt, every, task, rec, path, p
             return
         freq = ud[mj3d.U_P0]
         n_beat = max(1, int(round(1.0 / (freq * dt))))
-        sample(st, buf, qpos, qvel, _quat2mat(qpos[3:7]), ud[mj3d.U_PSI0], n_beat)
+        sample(st, buf, qpos, qvel, D.quat2mat(qpos[3:7]), ud[mj3d.U_PSI0], n_beat)
         if (int(st[0]) - 1) % every == 0:
             kind = int(task[L.T_KIND])
             if kind == L.TASK_WAYPOINTS:
