@@ -66,13 +66,15 @@ def _task(args):
 def cmd_fly3d(args) -> None:
     import numpy as np
 
-    from lifelike_mj.butterfly.flight3d.designed import load_any
+    from lifelike_mj.butterfly.flight3d.designed import DesignedController, load_any
     from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
     ctrl = load_any(args.controller)
     check_outputs(args, folders={"--out": FLY3D_FILES})
-    if hasattr(ctrl, "to_compiled"):  # a designed controller flies in the compiled loop
-        ctrl = ctrl.to_compiled()
+    if isinstance(ctrl, DesignedController):  # it flies in the compiled loop, the same flight
+        from lifelike_mj.butterfly.flight3d.designed_kernel import CompiledDesigned
+
+        ctrl = CompiledDesigned.of(ctrl)
     flight = Flight3D(controller=ctrl, task=_task(args), dt_s=args.dt)
     with stage(f"3D flight, {args.duration:g} s"):
         rec = flight.record(duration_s=args.duration, every=max(1, round(0.01 / args.dt)))  # every 10 ms

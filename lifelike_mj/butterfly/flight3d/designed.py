@@ -341,14 +341,6 @@ class DesignedController:
 
         return KinematicsCommand(*self._at(speed_m_s, "command"))
 
-    def to_compiled(self):
-        """The same controller for the compiled loop (:class:`~lifelike_mj.butterfly.flight3d.designed_kernel.
-        CompiledDesigned`): it flies bit for bit as this one, without a Python call per step."""
-        from lifelike_mj.butterfly.flight3d.designed_kernel import CompiledDesigned
-
-        spec = {"animal": self.animal, "force_law": self.force_law, "schedule": self.schedule}
-        return CompiledDesigned(spec, self.every, self.name, self.provenance)
-
     def to_dict(self) -> dict:
         """The controller file's content (:data:`~lifelike_mj.butterfly.flight3d.controllers.FORMAT`, ``kind``
         ``"designed"``): what :func:`controller_from_dict` reads back."""

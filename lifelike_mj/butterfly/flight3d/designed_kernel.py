@@ -326,6 +326,12 @@ class CompiledDesigned:
 
         return KinematicsCommand(*D._lerp(self.tables[0], self.tables[4], speed_m_s))
 
+    @classmethod
+    def of(cls, controller: D.DesignedController) -> CompiledDesigned:
+        """The same controller as ``controller`` (its schedule, rate, name and provenance), for the compiled loop."""
+        spec = {"animal": controller.animal, "force_law": controller.force_law, "schedule": controller.schedule}
+        return cls(spec, controller.every, controller.name, controller.provenance)
+
     def advance(self, batch, n_steps: int, path: np.ndarray, path_every: int) -> None:
         """Fly ``batch`` (:class:`~lifelike_mj.butterfly.flight3d.loop.Batch`, made with ``designed=self``, its
         per-flight states in ``batch.designed_states``) ``n_steps`` steps (:func:`fly_designed`, threads over the

@@ -73,7 +73,7 @@ def test_a_batch_flies_each_butterfly_as_it_would_fly_alone(spec):
 
 
 def test_a_designed_controller_converts_for_the_compiled_loop(spec):
-    ctl = D.DesignedController(spec, name="d").to_compiled()
+    ctl = DK.CompiledDesigned.of(D.DesignedController(spec, name="d"))
     assert isinstance(ctl, DK.CompiledDesigned) and ctl.name == "d"
     f = Flight3D(controller=ctl, task=turn(90.0, speed_m_s=1.2))
     assert f.controller is None and f.designed is ctl  # no Python call per step
