@@ -140,8 +140,8 @@ def _wind_triangle(d, ground_speed, wind_xy, vmin, vmax):
 @njit(cache=True)
 def sample(st, buf, qpos, qvel, R, psi, n_beat):
     """One physics step's sample into the ring (``DesignedController.__call__``'s first lines): the thorax's position
-    and velocity, its rates, attitude matrix ``R`` and the stroke phase ``psi``; the ring keeps the last ``n_beat``.
-    Returns whether this step sets a new command (every ``every``-th sample, counted by the caller through ``st[0]``)."""
+    and velocity, its rates, attitude matrix ``R`` and the stroke phase ``psi``; the ring keeps the last ``n_beat``,
+    and ``st[0]`` counts the samples (the caller sets a new command at every ``every``-th)."""
     h = int(st[2])
     buf[h, 0:3] = qpos[0:3]
     buf[h, 3:6] = qvel[0:3]
@@ -184,7 +184,8 @@ def control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins
     vel /= n
     rates /= n
     last = _row(buf, st, n - 1)
-    Rm = last[9:18].copy().reshape(3, 3)
+    R_last = last[9:18].copy().reshape(3, 3)
+    Rm = R_last
     a_mean = np.zeros(3)
     for j in range(n):
         a_mean += _log(Rm.T @ _row(buf, st, j)[9:18].copy().reshape(3, 3))
@@ -202,10 +203,9 @@ def control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins
         tmpl[k, 9] += 1.0
         j = int(last[18] % (2.0 * math.pi) / (2.0 * math.pi) * n_bins) % n_bins
         if tmpl[j, 9] >= t_min:
-            Rl = last[9:18].copy().reshape(3, 3)
-            vel = last[3:6] - Rl @ tmpl[j, 0:3]
+            vel = last[3:6] - R_last @ tmpl[j, 0:3]
             rates = last[6:9] - tmpl[j, 3:6]
-            Rm = Rl @ _exp(-tmpl[j, 6:9])
+            Rm = R_last @ _exp(-tmpl[j, 6:9])
     t_ctrl = every * dt
     # the wind observer (DesignedController.wind)
     wind = st[10:13].copy()
@@ -314,7 +314,7 @@ class CompiledDesigned:
     compiled = True
 
     def __init__(self, spec: dict, every: int = 8, name: str = "", provenance: dict | None = None) -> None:
-        self.spec, self.every, self.name = spec, int(every), name
+        self.every, self.name = int(every), name
         self.provenance = dict(provenance or spec.get("provenance") or {})
         self.animal = spec.get("animal", "monarch")
         self.force_law = spec.get("force_law", "calibrated")
