@@ -110,6 +110,21 @@ def check_actions3d(actions: Any, n: int | None = None) -> np.ndarray:
     return a
 
 
+def _designed(controller):
+    """``controller`` as a designed controller for the compiled loop (``designed_kernel.CompiledDesigned``) if it is
+    one (a designed controller's name, path or object), else ``None``."""
+    from pathlib import Path
+
+    from lifelike_mj.butterfly.flight3d.designed import DesignedController, load_any
+    from lifelike_mj.butterfly.flight3d.designed_kernel import CompiledDesigned
+
+    if isinstance(controller, (str, Path)):
+        controller = load_any(controller)
+    if isinstance(controller, DesignedController):
+        controller = CompiledDesigned.of(controller)
+    return controller if isinstance(controller, CompiledDesigned) else None
+
+
 def _still_controller() -> flight3d.Controller3D:
     """A linear controller of zeros on every observation: the base command as it is (the actions come from outside)."""
     return flight3d.Controller3D([flight3d.N_OBS, flight3d.N_ACT], np.zeros(flight3d.n_weights([flight3d.N_OBS,
@@ -192,6 +207,17 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
     OSMesa, no display needed; a camera following the butterfly) or ``"human"`` (the MuJoCo viewer; only where a
     window can open).
 
+    ## A residual policy on the designed controller
+
+    With ``controller`` a designed controller (``lifelike-mj butterfly design3d``'s file, its name or object) the
+    designed controller flies every episode as a baseline policy, deciding every ``every`` steps of its own (8, 100
+    Hz), and the nine actions are a **residual**: one per control (the flap frequency, the stroke offset and
+    amplitude, their left-right differences, the mean feathering and its difference, the feathering amplitude, the
+    abdomen), times :data:`~lifelike_mj.butterfly.flight3d.designed.RESIDUAL_SCALE` (0.5 Hz, 0.06 rad, ...), added
+    to its command and kept within its limits (the natural envelope). Zeros fly the designed controller alone, bit
+    for bit. ``info["baseline_command"]`` is its own command at each decision (the 13 kinematics parameters of
+    ``flight3d.KinematicsCommand``). ``every``, ``inputs`` and ``animal`` are a network's and are refused.
+
     ## From a policy to a controller file
 
     :class:`NetworkInputs3D` divides the observation as a controller's network does, and :class:`NetworkActions3D`
@@ -220,10 +246,18 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
         self.duration_s = checks.number("duration_s", duration_s, 0.0, 3600.0, lo_open=True, unit="s")
         self.n_steps = checks.work(f"an episode of {duration_s:g} s at {dt_s:g} s", checks.steps_of(duration_s, dt_s),
                                    checks.MAX_BODY_STEPS, "time steps")
-        ctl = controller if isinstance(controller, flight3d.Controller3D) else (
-            flight3d.load_controller(controller) if controller is not None else
-            _still_controller())
-        if every is not None or inputs is not None or animal is not None:
+        ctl = _designed(controller)
+        #: The designed controller flown under a residual policy (``designed_kernel.CompiledDesigned``), or ``None``.
+        self.designed = ctl
+        if ctl is not None:
+            if every is not None or inputs is not None or (animal is not None and animal != ctl.animal):
+                raise UserError("a designed controller keeps its own rate, inputs and butterfly: every, inputs and "
+                                "animal are a network's (leave them out).")
+        else:
+            ctl = controller if isinstance(controller, flight3d.Controller3D) else (
+                flight3d.load_controller(controller) if controller is not None else
+                _still_controller())
+        if ctl is not self.designed and (every is not None or inputs is not None or animal is not None):
             ctl = ctl.replace(every=ctl.every if every is None else every, inputs=inputs or ctl.inputs,
                               animal=animal or ctl.animal)
         self.controller = ctl
@@ -252,7 +286,10 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
         self.flight = flight3d.Flight3D(controller=self.controller, task=self.episode_task, dt_s=self.dt_s,
                                         end_on_tumble=True, _model=self._model)
         obs = self.flight.decide(max_steps=self.n_steps)
-        return self._shown(obs), {"observation_names": OBSERVATION_NAMES, "task": self.episode_task.name}
+        info = {"observation_names": OBSERVATION_NAMES, "task": self.episode_task.name}
+        if self.designed is not None:
+            info["baseline_command"] = self.flight.baseline_command
+        return self._shown(obs), info
 
     def step(self, action):
         if self.flight is None:
@@ -268,6 +305,8 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
         terminated = terminated or self.flight.tumbled
         truncated = not terminated and self.flight.steps >= self.n_steps
         info["waypoints_passed"] = self.flight.waypoints_passed
+        if self.designed is not None:
+            info["baseline_command"] = self.flight.baseline_command
         reward = (self.flight.reward - before) / self.duration_s
         return self._shown(obs), float(reward), terminated, truncated, info
 
@@ -376,14 +415,21 @@ class ButterflyFlight3DVectorEnv(VectorEnv):
         task = self.single.task if chosen is None else self.single._check_task(chosen)
         s = self.single
         tasks = [s.draw_task(r, task) for r in self._rngs]
-        datas = [self._new_data() for _ in tasks]
+        datas = [self._new_data(t) for t in tasks]
         self._tasks = tasks
-        self._batch = flight3d.Batch(self._model, datas, np.array([t.as_array(self._rows) for t in tasks]),
-                                     s.controller, dt_s=s.dt_s, records=flight3d.new_record(self.num_envs, self._rows),
-                                     tumble_rad=flight3d.TUMBLE_RAD)
+        if s.designed is None:
+            self._batch = flight3d.Batch(self._model, datas, np.array([t.as_array(self._rows) for t in tasks]),
+                                         s.controller, dt_s=s.dt_s, records=flight3d.new_record(self.num_envs,
+                                                                                                 self._rows),
+                                         tumble_rad=flight3d.TUMBLE_RAD)
+        else:  # the designed controller decides; its start command is the first task's (only perches read it)
+            self._batch = flight3d.Batch(self._model, datas, np.array([t.as_array(self._rows) for t in tasks]), None,
+                                         dt_s=s.dt_s, records=flight3d.new_record(self.num_envs, self._rows),
+                                         tumble_rad=flight3d.TUMBLE_RAD, base=self._start(tasks[0]).as_array(),
+                                         designed=s.designed)
         self._batch.decide(None, s.n_steps)
         self._ended[:] = False
-        return self.single._shown(self._batch.observations), {"observation_names": OBSERVATION_NAMES}
+        return self.single._shown(self._batch.observations), self._info({"observation_names": OBSERVATION_NAMES})
 
     def step(self, actions):
         b, s, n = self._batch, self.single, self.num_envs
@@ -406,14 +452,30 @@ class ButterflyFlight3DVectorEnv(VectorEnv):
         info: dict[str, Any] = {"waypoints_passed": rec[:, flight3d.tasks.R_PASSED].astype(int)}
         if diverged.any():
             info["diverged"] = diverged
-        return obs, rewards, terminated, truncated, info
+        return obs, rewards, terminated, truncated, self._info(info)
+
+    def _info(self, info: dict) -> dict:
+        """``info`` with the designed controller's commands (``baseline_command``, one row per copy), if it flies."""
+        if self.single.designed is not None:
+            info["baseline_command"] = self._batch.baselines.copy()
+        return info
+
+    def _start(self, task: flight3d.Task3D) -> flight3d.KinematicsCommand:
+        """The kinematics a copy starts from: a designed controller's trim at the task's speed (as ``Flight3D`` takes
+        it), else the network's base command."""
+        if self.single.designed is None:
+            return self.single.controller.base
+        return self.single.designed.start_command(task.rows[0][3] if task.kind == "schedule" else task.speed_m_s)
 
     # ---- internals ------------------------------------------------------------------------------
 
-    def _new_data(self):
+    def _new_data(self, task: flight3d.Task3D | None = None):
         from lifelike_mj.butterfly.flight3d import model as mj3d
 
         c = self.single.controller
+        if self.single.designed is not None:
+            return mj3d.setup_data(self._model, flight3d.Kinematics(self._start(task), None), animal=c.animal,
+                                   force_law=c.force_law)
         return mj3d.setup_data(self._model, flight3d.Kinematics(c.base, c.omega_c_rad_s), animal=c.animal,
                                force_law=c.force_law)
 
@@ -421,10 +483,13 @@ class ButterflyFlight3DVectorEnv(VectorEnv):
         b, s = self._batch, self.single
         task = s.draw_task(self._rngs[i], s.task)
         self._tasks[i] = task
-        b.datas[i] = self._new_data()
+        b.datas[i] = self._new_data(task)
         b.ptrs[i] = b.datas[i]._address
         b.tasks[i] = task.as_array(self._rows)
         b.records[i] = flight3d.new_record(1, self._rows)[0]
+        if s.designed is not None:  # the designed controller's state afresh
+            for state in b.designed_states:
+                state[i] = 0.0
 
 
 class NetworkInputs3D(gym.ObservationWrapper):

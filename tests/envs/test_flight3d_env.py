@@ -163,3 +163,60 @@ def test_the_monarch_flies_through_the_env_with_its_own_wings_and_law():
     d = venv.unwrapped._new_data()
     assert d.userdata[mj3d.U_MODE] == mj3d.FORCE_LAWS["quasi_steady"]
     assert venv.unwrapped._model.body_subtreemass[1] == pytest.approx(flight.model.body_subtreemass[1])
+
+
+@pytest.fixture(scope="module")
+def designed_controller():
+    import json
+    from pathlib import Path
+
+    from lifelike_mj.butterfly.flight3d import designed
+
+    model = json.loads((Path(__file__).resolve().parents[2] / "benchmarks" / "results" / "monarch_model.json")
+                       .read_text())
+    return designed.DesignedController(designed.design(model), name="designed")
+
+
+def test_the_designed_controller_is_a_baseline_a_residual_policy_acts_on(designed_controller):
+    """With a designed controller the env flies it as the baseline (its command in info) and the actions are a
+    residual: zeros give the flight Flight3D flies alone, bit for bit; the vector form is single envs; Gymnasium's
+    checker passes; a network's every, inputs or animal are refused."""
+    from gymnasium.utils.env_checker import check_env
+
+    from lifelike_mj.butterfly.flight3d.designed_kernel import CompiledDesigned
+
+    kw = {"task": "wind", "duration_s": 0.5, "controller": designed_controller}
+    check_env(ButterflyFlight3DEnv(**kw), skip_render_check=True)
+    env = ButterflyFlight3DEnv(**kw)
+    obs, info = env.reset(seed=3)
+    assert info["baseline_command"].shape == (13,) and env.observation_space.contains(obs)
+    total, done, steps = 0.0, False, 0
+    while not done:
+        obs, r, term, trunc, info = env.step(np.zeros(flight3d.N_ACT))
+        total, done, steps = total + r, term or trunc, steps + 1
+    assert steps == 50  # 0.5 s at the controller's 100 decisions per second
+    alone = flight3d.Flight3D(controller=CompiledDesigned.of(designed_controller), task=env.episode_task,
+                              end_on_tumble=True)
+    alone.step(env.n_steps)
+    assert np.array_equal(alone.data.qpos, env.flight.data.qpos)
+    assert total == pytest.approx(alone.reward / 0.5, rel=1e-12) and total > 0.1
+    n = 3
+    vec = ButterflyFlight3DVectorEnv(num_envs=n, **kw)
+    singles = [ButterflyFlight3DEnv(**kw) for _ in range(n)]
+    obs, info = vec.reset(seed=7)
+    assert np.array_equal(obs, [s.reset(seed=7 + i)[0] for i, s in enumerate(singles)])
+    actions = np.random.default_rng(1).uniform(-1.0, 1.0, (60, n, flight3d.N_ACT))
+    ended = [False] * n
+    for a in actions:
+        obs, rewards, term, trunc, info = vec.step(a)
+        for i, s in enumerate(singles):
+            if ended[i]:
+                (o, si), r, t, tr = s.reset(), 0.0, False, False
+            else:
+                o, r, t, tr, si = s.step(a[i])
+            ended[i] = t or tr
+            assert np.array_equal(obs[i], o) and rewards[i] == r and (term[i], trunc[i]) == (t, tr)
+            assert np.array_equal(info["baseline_command"][i], si["baseline_command"])
+    for bad in ({"every": 4}, {"inputs": "air"}, {"animal": "swallowtail"}):
+        with pytest.raises(UserError, match="designed controller keeps its own rate"):
+            ButterflyFlight3DEnv(controller=designed_controller, **bad)

@@ -59,6 +59,10 @@ Q_SCALES = np.array([0.9, 0.9, 0.9, 3.0, 3.0, 3.0, 0.45, 0.45, 0.3, 0.15, 0.15, 
 #: that control slamming between its limits (seeds 100-119: 2 of 20 calm courses tumbled; at 0.2 rad, 14 of 20).
 #: Without that lag (:meth:`DesignedController._unlagged`) it carries 0.06, and the rates' weights three times more.
 R_SCALES = np.array([0.5, 0.06, 0.06, 0.06, 0.06, 0.1, 0.06, 0.1, 0.15])
+#: A residual policy's reach (:mod:`~lifelike_mj.envs.butterfly3d`: the designed controller as a baseline, a policy's
+#: nine actions in [-1, 1] times these added to its controls, in :data:`~lifelike_mj.butterfly.flight3d.averaged.CONTROLS`
+#: order; Hz, rad): the controls' Bryson scales, the change the design itself counts as large.
+RESIDUAL_SCALE = R_SCALES.copy()
 #: Limits of the antisymmetric controls (rad): offset, amplitude and feathering differences left less right.
 DIFFERENCE_LIMITS = {"offset_difference": math.radians(15.0), "amplitude_difference": math.radians(15.0),
                      "feather_mean_difference": math.radians(20.0)}

@@ -350,6 +350,30 @@ class CompiledDesigned:
                                self.every, batch.tasks, batch.records, batch.tumble_rad, batch.base, sts, bufs, tmpls,
                                *args)
 
+    def decide(self, batch, actions: np.ndarray, n_max: int, act: np.ndarray) -> np.ndarray:
+        """Fly every flight of ``batch`` to the controller's next command with a residual policy's ``actions`` (one
+        row of nine per flight, in ``[-1, 1]``, times :data:`~lifelike_mj.butterfly.flight3d.designed.RESIDUAL_SCALE`)
+        added to this command (:func:`decide_designed`); ``act``: which flights act (the others fly on to their next
+        command). The designed commands reached are then in ``batch.baselines``, the observations in
+        ``batch.observations``. Returns whether each flight goes on."""
+        from lifelike_mj.physics import mjabi
+
+        m = batch.model
+        sts, bufs, tmpls = batch.designed_states
+        args = (*self.tables, self.constants, D.N_BINS)
+        scale = D.RESIDUAL_SCALE
+        going = np.zeros(batch.n, dtype=np.bool_)
+        if batch.n == 1:
+            going[0] = decide_designed(m._address, int(batch.ptrs[0]), mjabi.offsets_tuple(), m.nq, m.nv, int(n_max),
+                                       batch.dt, self.every, actions[0], bool(act[0]), scale, batch.tasks[0],
+                                       batch.records[0], batch.observations[0], batch.tumble_rad, batch.base, sts[0],
+                                       bufs[0], tmpls[0], batch.baselines[0], *args)
+        else:
+            decide_designed_batch(m._address, batch.ptrs, mjabi.offsets_tuple(), m.nq, m.nv, int(n_max), batch.dt,
+                                  self.every, actions, act, scale, batch.tasks, batch.records, batch.observations,
+                                  batch.tumble_rad, batch.base, sts, bufs, tmpls, batch.baselines, *args, going)
+        return going
+
     def states(self, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Fresh controller states for ``n`` flights (:func:`new_state`, stacked)."""
         st, buf, tmpl = new_state()
@@ -357,57 +381,136 @@ class CompiledDesigned:
 
 
 @njit(cache=True)
+def _views(dptr, off, nq, nv):
+    """The ``mjData`` at ``dptr``'s userdata, ``qpos``, ``qvel`` and clock, as arrays the loop writes through."""
+    return (L._f64(L._ptr_at(dptr + off[L._O_UD]), mj3d.N_USERDATA), L._f64(L._ptr_at(dptr + off[L._O_QPOS]), nq),
+            L._f64(L._ptr_at(dptr + off[L._O_QVEL]), nv), L._f64(dptr + off[L._O_TIME], 1))
+
+
+@njit(cache=True)
+def _scratch():
+    """A flight loop's working arrays: the kinematics' parameters, rates and accelerations, the calm air of speeds
+    over the ground, the loop's options (none), a waypoint and a reference."""
+    return (np.empty(N_PARAMS), np.empty(N_PARAMS), np.empty(N_PARAMS), np.zeros(3), np.zeros(3), np.zeros(3),
+            np.zeros(3))
+
+
+@njit(cache=True)
+def _head(ud, qpos, qvel, time, dt, every, task, rec, st, buf, tmpl, wp, ref, baseline, speeds, pitches, v0s, Ks,
+          commands, As, Bs, c, n_bins):
+    """A step's first part for the designed controller: its sample (:func:`sample`) and, every ``every`` samples, its
+    command (:func:`control`, the waypoint or the schedule's references the task gives) into ``baseline`` and the
+    kinematics' target. Returns whether a new command was set (a control step: a residual policy's decision)."""
+    freq = ud[mj3d.U_P0]
+    n_beat = max(1, int(round(1.0 / (freq * dt))))
+    sample(st, buf, qpos, qvel, D.quat2mat(qpos[3:7]), ud[mj3d.U_PSI0], n_beat)
+    if (int(st[0]) - 1) % every != 0:
+        return False
+    kind = int(task[L.T_KIND])
+    if kind == L.TASK_WAYPOINTS:
+        i = min(int(rec[L.R_PASSED]), int(task[L.T_ROWS]) - 1)
+        b = L.T_ROW0 + 4 * i
+        wp[0], wp[1], wp[2] = task[b], task[b + 1], task[b + 2]
+        k = 0
+    elif kind == L.TASK_SCHEDULE:
+        # the schedule's row at steps x dt, the time Flight3D.reference reads (the data's clock, a sum of steps, can
+        # fall a rounding short of a row's start)
+        ref[0], ref[1], ref[2] = L.reference(task, rec[L.R_STEPS] * dt, qpos[0:3], rec)
+        k = 1
+    else:
+        ref[0], ref[1], ref[2] = L.attitude(qpos[3:7])[2], qpos[2], task[L.T_SPEED]
+        k = 1
+    cmd = control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins,
+                  ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS].copy(), ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS].copy(), dt, every,
+                  k, wp, task[L.T_SPEED], ref, n_beat)
+    for j in range(N_PARAMS):
+        baseline[j] = cmd[j]
+        ud[mj3d.U_TARGET + j] = cmd[j]
+    return True
+
+
+@njit(cache=True)
 def fly_designed(mptr, dptr, off, nq, nv, n_steps, dt, every, task, rec, path, path_every, tumble_rad, base, st, buf,
                  tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins):
     """:func:`~lifelike_mj.butterfly.flight3d.loop.fly_steps` with the designed controller in place of the network:
-    each step its sample (:func:`sample`), every ``every`` steps a new command (:func:`control`, the waypoint or the
-    schedule's references the task gives), then the loop's step as for every controller (gusts, air, references,
-    one ``mj_step``, the kinematics advanced)."""
-    ud = L._f64(L._ptr_at(dptr + off[L._O_UD]), mj3d.N_USERDATA)
-    qpos = L._f64(L._ptr_at(dptr + off[L._O_QPOS]), nq)
-    qvel = L._f64(L._ptr_at(dptr + off[L._O_QVEL]), nv)
-    time = L._f64(dptr + off[L._O_TIME], 1)
+    each step :func:`_head` (the sample, and every ``every`` steps a new command), then the loop's step as for every
+    controller (gusts, air, references, one ``mj_step``, the kinematics advanced)."""
+    ud, qpos, qvel, time = _views(dptr, off, nq, nv)
     obs = np.empty(L.N_OBS)
-    p = np.empty(N_PARAMS)
-    dp = np.empty(N_PARAMS)
-    ddp = np.empty(N_PARAMS)
-    ground = np.zeros(3)
-    opts = np.zeros(3)
-    wp = np.zeros(3)
-    ref = np.zeros(3)
+    p, dp, ddp, ground, opts, wp, ref = _scratch()
+    baseline = np.empty(N_PARAMS)
     n_path = 0
     for _ in range(n_steps):
         if rec[L.R_DIVERGED] >= 0 or rec[L.R_TUMBLED] >= 0:
             return
-        freq = ud[mj3d.U_P0]
-        n_beat = max(1, int(round(1.0 / (freq * dt))))
-        sample(st, buf, qpos, qvel, D.quat2mat(qpos[3:7]), ud[mj3d.U_PSI0], n_beat)
-        if (int(st[0]) - 1) % every == 0:
-            kind = int(task[L.T_KIND])
-            if kind == L.TASK_WAYPOINTS:
-                i = min(int(rec[L.R_PASSED]), int(task[L.T_ROWS]) - 1)
-                b = L.T_ROW0 + 4 * i
-                wp[0], wp[1], wp[2] = task[b], task[b + 1], task[b + 2]
-                k = 0
-            elif kind == L.TASK_SCHEDULE:
-                # the schedule's row at steps x dt, the time Flight3D.reference reads (the data's clock, a sum of
-                # steps, can fall a rounding short of a row's start)
-                ref[0], ref[1], ref[2] = L.reference(task, rec[L.R_STEPS] * dt, qpos[0:3], rec)
-                k = 1
-            else:
-                ref[0], ref[1], ref[2] = L.attitude(qpos[3:7])[2], qpos[2], task[L.T_SPEED]
-                k = 1
-            cmd = control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins,
-                          ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS].copy(), ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS].copy(),
-                          dt, every, k, wp, task[L.T_SPEED], ref, n_beat)
-            for j in range(N_PARAMS):
-                ud[mj3d.U_TARGET + j] = cmd[j]
+        _head(ud, qpos, qvel, time, dt, every, task, rec, st, buf, tmpl, wp, ref, baseline, speeds, pitches, v0s, Ks,
+              commands, As, Bs, c, n_bins)
         tumbled, n_path = L._before(ud, qpos, qvel, time, dt, task, rec, obs, opts, ground, path, path_every,
                                     n_path, tumble_rad, base)
         if tumbled:
             return
         if not L._after(mptr, dptr, off, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
             return
+
+
+@njit(cache=True)
+def residual_command(baseline, action, scale, lo, hi, target):
+    """The kinematics' target (``target``) of the designed controller's command ``baseline`` with a residual policy's
+    ``action`` (nine numbers in ``[-1, 1]``, one per control of
+    :data:`~lifelike_mj.butterfly.flight3d.averaged.CONTROLS`) times ``scale`` added to its controls, each control
+    kept within the controller's limits ``lo``, ``hi`` (the natural envelope); a zero action leaves the command
+    exactly as it is."""
+    cb = _controls_of(baseline)
+    change = np.zeros(len(cb))
+    for q in range(len(cb)):
+        if action[q] != 0.0:
+            change[q] = min(max(cb[q] + action[q] * scale[q], lo[q]), hi[q]) - cb[q]
+    p = _command_from_controls(baseline, change)
+    for j in range(N_PARAMS):
+        target[j] = p[j]
+
+
+@njit(cache=True)
+def decide_designed(mptr, dptr, off, nq, nv, n_max, dt, every, action, act, scale, task, rec, obs, tumble_rad, base,
+                    st, buf, tmpl, baseline, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins):
+    """:func:`~lifelike_mj.butterfly.flight3d.loop.to_decision` for the designed controller with a residual policy on
+    top: with ``act``, the designed command of this decision (``baseline``) plus the residual ``action``
+    (:func:`residual_command`, ``scale`` per control) becomes the kinematics' target; then the steps go on, as
+    :func:`fly_designed` flies them, to the controller's next command (whose observation is then in ``obs``, its
+    command in ``baseline``), the flight's end or ``n_max`` steps. Without ``act``: on to the first command (at the
+    start). With a zero action every step is :func:`fly_designed`'s, bit for bit. Returns whether the flight goes
+    on."""
+    ud, qpos, qvel, time = _views(dptr, off, nq, nv)
+    p, dp, ddp, ground, opts, wp, ref = _scratch()
+    none = np.empty((0, 7))
+    if rec[L.R_DIVERGED] >= 0 or rec[L.R_TUMBLED] >= 0:
+        return False
+    if act:
+        residual_command(baseline, action, scale, c[19:28], c[28:37], ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS])
+        if not L._after(mptr, dptr, off, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
+            return False
+    while True:
+        decision = _head(ud, qpos, qvel, time, dt, every, task, rec, st, buf, tmpl, wp, ref, baseline, speeds,
+                         pitches, v0s, Ks, commands, As, Bs, c, n_bins)
+        tumbled, _ = L._before(ud, qpos, qvel, time, dt, task, rec, obs, opts, ground, none, 0, 0, tumble_rad, base)
+        if tumbled:
+            return False
+        if decision or int(rec[L.R_STEPS]) >= n_max:
+            return True
+        if not L._after(mptr, dptr, off, ud, qpos, qvel, time, dt, rec, obs, p, dp, ddp, task):
+            return False
+
+
+@njit(cache=True, parallel=True)
+def decide_designed_batch(mptr, dptrs, off, nq, nv, n_max, dt, every, actions, act, scale, tasks, recs, obs,
+                          tumble_rad, base, sts, bufs, tmpls, baselines, speeds, pitches, v0s, Ks, commands, As, Bs, c,
+                          n_bins, going):
+    """:func:`decide_designed` for many butterflies at once (threads over the copies), each with its own state and
+    action row; copies with ``act[i]`` false only fly on to their next command."""
+    for i in prange(len(dptrs)):
+        going[i] = decide_designed(mptr, dptrs[i], off, nq, nv, n_max, dt, every, actions[i], act[i], scale, tasks[i],
+                                   recs[i], obs[i], tumble_rad, base, sts[i], bufs[i], tmpls[i], baselines[i], speeds,
+                                   pitches, v0s, Ks, commands, As, Bs, c, n_bins)
 
 
 @njit(cache=True, parallel=True)

@@ -393,9 +393,16 @@ class Flight3D(StepCounter):
         ``max_steps`` steps. ``action=None``: take no action, only observe (at the start). Returns the
         observation there (:data:`~lifelike_mj.butterfly.flight3d.controllers.OBS_NAMES`, SI units). A runaway
         raises :class:`~lifelike_mj.errors.Diverged`. This is the step of the Gymnasium environment
-        ``lifelike_mj/ButterflyFlight3D-v0``; :attr:`reward` sums the same rewards as the evolution's."""
-        if self.network is None:
-            raise UserError("decide needs a 3D controller (its base command, scales and rate); give one to Flight3D.")
+        ``lifelike_mj/ButterflyFlight3D-v0``; :attr:`reward` sums the same rewards as the evolution's.
+
+        With a designed controller (compiled) the nine actions are a **residual** policy's, one per control of
+        :data:`~lifelike_mj.butterfly.flight3d.averaged.CONTROLS`, times
+        :data:`~lifelike_mj.butterfly.flight3d.designed.RESIDUAL_SCALE`, added to the controller's own command at each
+        of its control steps (within its limits; no flutter): zeros fly the designed controller as :meth:`step` does,
+        bit for bit. Its command at the decision reached is :attr:`baseline_command`."""
+        if self.network is None and self.designed is None:
+            raise UserError("decide needs a 3D controller (a network's base command, scales and rate, or a designed "
+                            "controller under a residual policy); give one to Flight3D.")
         self._check_alive()
         if action is not None:
             from lifelike_mj.butterfly.flight3d.controllers import N_ACT
@@ -408,6 +415,12 @@ class Flight3D(StepCounter):
         self._batch.decide(action, limit)
         self._settle()
         return self._batch.observations[0].copy()
+
+    @property
+    def baseline_command(self) -> np.ndarray | None:
+        """The designed controller's own command (kinematics parameters, :class:`KinematicsCommand`'s order) at the
+        last decision (:meth:`decide`), before a residual policy's actions; ``None`` without a designed controller."""
+        return None if self.designed is None else self._batch.baselines[0].copy()
 
     # ---- landing, perching and take-off -----------------------------------------------------------
 

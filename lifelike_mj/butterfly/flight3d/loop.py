@@ -630,6 +630,8 @@ class Batch:
         if designed is not None:
             self.every = designed.every
             self.designed_states = designed.states(self.n)
+            #: Each flight's designed command at its last decision (:meth:`decide`; kinematics parameters).
+            self.baselines = np.zeros((self.n, N_PARAMS))
 
     def advance(self, n_steps: int, path: np.ndarray | None = None, path_every: int = 0) -> None:
         """Fly every butterfly ``n_steps`` steps (threads over the butterflies), with the model's compiled air
@@ -660,19 +662,24 @@ class Batch:
         """Fly every butterfly to its next decision (:func:`to_decision`) with ``actions`` (one row of ``N_ACT``
         numbers in ``[-1, 1]`` per butterfly, from outside, taken now) or, with ``None``, only observe the current
         step; ``act`` (a mask): which butterflies act (the others only observe). The observations are then in
-        :attr:`observations`; returns whether each flight goes on."""
+        :attr:`observations`; returns whether each flight goes on. With a designed controller the actions are a
+        residual policy's, added to its command at each of its control steps
+        (:meth:`~lifelike_mj.butterfly.flight3d.designed_kernel.CompiledDesigned.decide`; the commands in
+        :attr:`baselines`)."""
         from lifelike_mj.physics.callbacks import passive_callback
         from lifelike_mj.physics.stability import watching
 
-        if self.designed is not None:
-            from lifelike_mj.errors import UserError
-
-            raise UserError("a designed controller flies by itself: decide() takes a policy's actions in place of a "
-                            "network's, and this flight has none (fly it with step()).")
         m = self.model
         act = np.full(self.n, actions is not None) if act is None else np.asarray(act, dtype=np.bool_) & (
             actions is not None)
         a = np.zeros((self.n, N_ACT)) if actions is None else np.ascontiguousarray(actions, dtype=np.float64)
+        if self.designed is not None:  # a residual policy on the designed controller (designed_kernel.decide_designed)
+            from lifelike_mj._numba_cache import compile_notice
+
+            group = "flight3d-designed-decide" if self.n == 1 else "flight3d-designed-decisions"
+            with compile_notice(group, "the 3D flight", COMPILE_S), passive_callback(mj3d.COMPILED_PASSIVE), \
+                    watching():
+                return self.designed.decide(self, a, n_max, act)
         going = np.zeros(self.n, dtype=np.bool_)
         from lifelike_mj._numba_cache import compile_notice
 

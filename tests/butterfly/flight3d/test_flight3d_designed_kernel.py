@@ -80,4 +80,40 @@ def test_a_designed_controller_converts_for_the_compiled_loop(spec):
     from lifelike_mj.errors import UserError
 
     with pytest.raises(UserError, match="decide needs a 3D controller"):
-        f.decide(np.zeros(9))
+        Flight3D(task=turn(90.0, speed_m_s=1.2)).decide(np.zeros(9))
+
+
+def test_a_residual_of_zeros_flies_the_designed_controller_bit_for_bit(spec):
+    """Flight3D.decide with a designed controller: a residual policy's decisions at the controller's own control
+    steps (every 8 steps); zeros fly the same flight as step() to the last bit, a residual another flight."""
+    task = course(204).with_weather(wind_to_m_s=(1.0, 0.0, 0.0), gust_m_s=0.5, gust_vertical_m_s=0.5, seed=204)
+    ctl = DK.CompiledDesigned(spec)
+    alone = Flight3D(controller=ctl, task=task)
+    alone.step(2400)
+    zeros, pushed = Flight3D(controller=ctl, task=task), Flight3D(controller=ctl, task=task)
+    for f, a in ((zeros, np.zeros(9)), (pushed, np.full(9, 0.5))):
+        f.decide()
+        decisions = 0
+        while f.steps < 2400:
+            f.decide(a, max_steps=2400)
+            decisions += 1
+        assert decisions == 2400 // ctl.every
+    assert np.array_equal(zeros.data.qpos, alone.data.qpos) and zeros.reward == alone.reward
+    assert np.linalg.norm(pushed.data.qpos[:3] - alone.data.qpos[:3]) > 0.05
+    assert zeros.baseline_command.shape == (13,) and Flight3D(task=task).baseline_command is None
+
+
+def test_a_residual_is_added_to_each_control_within_the_limits():
+    from lifelike_mj.butterfly.flight3d import averaged as av
+
+    lo, hi = D.limits()
+    base = np.array([10.9, 0.1, 0.12, 1.0, 1.02, 0.2, 0.18, 0.6, 0.6, -1.571, -0.2, 0.244, 2.54])
+    action = np.array([1.0, -0.5, 0.25, 1.0, -1.0, 0.0, 0.5, -0.25, 1.0])
+    target = np.empty(13)
+    DK.residual_command(base, action, D.RESIDUAL_SCALE, lo, hi, target)
+    want = np.clip(av.controls_of(base) + action * D.RESIDUAL_SCALE, lo, hi)
+    np.testing.assert_allclose(av.controls_of(target), want, rtol=0.0, atol=1e-12)
+    assert target[0] == hi[0]  # 10.9 Hz + 0.5 Hz is held at the envelope's 11 Hz
+    # the feathering's difference moved by half its scale, split between the wings; its mean did not move
+    assert target[5] - target[6] == pytest.approx(base[5] - base[6] + 0.5 * 0.06, abs=1e-12)
+    assert target[5] + target[6] == pytest.approx(base[5] + base[6], abs=1e-12)
