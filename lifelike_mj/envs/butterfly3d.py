@@ -110,19 +110,24 @@ def check_actions3d(actions: Any, n: int | None = None) -> np.ndarray:
     return a
 
 
-def _designed(controller):
-    """``controller`` as a designed controller for the compiled loop (``designed_kernel.CompiledDesigned``) if it is
-    one (a designed controller's name, path or object), else ``None``."""
+def _controller(controller):
+    """``controller`` (a name, a path, an object or ``None``) as the environment flies it: a designed controller for
+    the compiled loop (``designed_kernel.CompiledDesigned``), a network (:class:`~lifelike_mj.butterfly.flight3d.
+    Controller3D`), or without one a still network (:func:`_still_controller`); a file is read once."""
     from pathlib import Path
 
     from lifelike_mj.butterfly.flight3d.designed import DesignedController, load_any
     from lifelike_mj.butterfly.flight3d.designed_kernel import CompiledDesigned
 
+    if controller is None:
+        return _still_controller()
     if isinstance(controller, (str, Path)):
         controller = load_any(controller)
     if isinstance(controller, DesignedController):
-        controller = CompiledDesigned.of(controller)
-    return controller if isinstance(controller, CompiledDesigned) else None
+        return CompiledDesigned.of(controller)
+    if isinstance(controller, (CompiledDesigned, flight3d.Controller3D)):
+        return controller
+    return flight3d.load_controller(controller)  # says in one sentence what a controller is
 
 
 def _still_controller() -> flight3d.Controller3D:
@@ -246,18 +251,14 @@ class ButterflyFlight3DEnv(Drawn, gym.Env):
         self.duration_s = checks.number("duration_s", duration_s, 0.0, 3600.0, lo_open=True, unit="s")
         self.n_steps = checks.work(f"an episode of {duration_s:g} s at {dt_s:g} s", checks.steps_of(duration_s, dt_s),
                                    checks.MAX_BODY_STEPS, "time steps")
-        ctl = _designed(controller)
+        ctl = _controller(controller)
         #: The designed controller flown under a residual policy (``designed_kernel.CompiledDesigned``), or ``None``.
-        self.designed = ctl
-        if ctl is not None:
+        self.designed = None if isinstance(ctl, flight3d.Controller3D) else ctl
+        if self.designed is not None:
             if every is not None or inputs is not None or (animal is not None and animal != ctl.animal):
                 raise UserError("a designed controller keeps its own rate, inputs and butterfly: every, inputs and "
                                 "animal are a network's (leave them out).")
-        else:
-            ctl = controller if isinstance(controller, flight3d.Controller3D) else (
-                flight3d.load_controller(controller) if controller is not None else
-                _still_controller())
-        if ctl is not self.designed and (every is not None or inputs is not None or animal is not None):
+        elif every is not None or inputs is not None or animal is not None:
             ctl = ctl.replace(every=ctl.every if every is None else every, inputs=inputs or ctl.inputs,
                               animal=animal or ctl.animal)
         self.controller = ctl
@@ -465,7 +466,7 @@ class ButterflyFlight3DVectorEnv(VectorEnv):
         it), else the network's base command."""
         if self.single.designed is None:
             return self.single.controller.base
-        return self.single.designed.start_command(task.rows[0][3] if task.kind == "schedule" else task.speed_m_s)
+        return self.single.designed.start_command(task.start_speed_m_s)
 
     # ---- internals ------------------------------------------------------------------------------
 
@@ -473,10 +474,8 @@ class ButterflyFlight3DVectorEnv(VectorEnv):
         from lifelike_mj.butterfly.flight3d import model as mj3d
 
         c = self.single.controller
-        if self.single.designed is not None:
-            return mj3d.setup_data(self._model, flight3d.Kinematics(self._start(task), None), animal=c.animal,
-                                   force_law=c.force_law)
-        return mj3d.setup_data(self._model, flight3d.Kinematics(c.base, c.omega_c_rad_s), animal=c.animal,
+        omega_c = None if self.single.designed is not None else c.omega_c_rad_s
+        return mj3d.setup_data(self._model, flight3d.Kinematics(self._start(task), omega_c), animal=c.animal,
                                force_law=c.force_law)
 
     def _reset_one(self, i: int) -> None:

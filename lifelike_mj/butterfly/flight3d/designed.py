@@ -231,9 +231,10 @@ def _interp(schedule: list[dict], speed: float, key: str) -> np.ndarray:
     return _lerp(np.array([s["speed_m_s"] for s in schedule]), np.array([s[key] for s in schedule], float), speed)
 
 
+@njit(cache=True)
 def _log(R: np.ndarray) -> np.ndarray:
-    """The rotation vector (rad) of the rotation matrix ``R``."""
-    c = max(-1.0, min(1.0, 0.5 * (np.trace(R) - 1.0)))
+    """The rotation vector (rad) of the rotation matrix ``R`` (compiled once for both forms of the controller)."""
+    c = max(-1.0, min(1.0, 0.5 * (R[0, 0] + R[1, 1] + R[2, 2] - 1.0)))
     t = math.acos(c)
     w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
     if t < 1e-9:

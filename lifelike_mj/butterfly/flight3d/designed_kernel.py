@@ -20,6 +20,7 @@ from numba import njit, prange
 from lifelike_mj.butterfly.flight3d import designed as D
 from lifelike_mj.butterfly.flight3d import loop as L
 from lifelike_mj.butterfly.flight3d import model as mj3d
+from lifelike_mj.butterfly.flight3d.designed import _log
 from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
 
 #: The scalars of a flight's state, in ``st``'s order.
@@ -68,16 +69,6 @@ def _exp(a):
     if t < 1e-12:
         return np.eye(3) + k
     return np.eye(3) + math.sin(t) / t * k + (1.0 - math.cos(t)) / t ** 2 * (k @ k)
-
-
-@njit(cache=True)
-def _log(R):
-    c = max(-1.0, min(1.0, 0.5 * (R[0, 0] + R[1, 1] + R[2, 2] - 1.0)))
-    t = math.acos(c)
-    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
-    if t < 1e-9:
-        return 0.5 * w
-    return t / (2.0 * math.sin(t)) * w
 
 
 @njit(cache=True)

@@ -190,7 +190,7 @@ class Flight3D(StepCounter):
         if designed:  # a designed controller: its animal and force law, its trim at the task's speed to start from
             animal = animal if animal is not None else controller.animal
             force_law = force_law if force_law is not None else controller.force_law
-            start = 1.5 if not isinstance(task, Task3D) else task.rows[0][3] if task.kind == "schedule" else task.speed_m_s
+            start = task.start_speed_m_s if isinstance(task, Task3D) else 1.5
             command = command or controller.start_command(start)
             if getattr(controller, "compiled", False):
                 self.designed, controller = controller, None

@@ -177,6 +177,11 @@ class Task3D:
                        seed=self.seed if seed is None else seed, gust_vertical_m_s=gust_vertical_m_s)
 
     @property
+    def start_speed_m_s(self) -> float:
+        """The speed asked first (m/s): a schedule's first row's, else the task's cruise speed."""
+        return float(self.rows[0][3]) if self.kind == "schedule" else self.speed_m_s
+
+    @property
     def vertical_gust_m_s(self) -> float:
         """The vertical gusts' standard deviation (m/s)."""
         return self.gust_m_s if self.gust_vertical_m_s is None else self.gust_vertical_m_s
