@@ -1,4 +1,4 @@
-"""The designed controller (issue 42, in progress) on courses, beside what the shipped ``monarch`` did.
+"""The designed controller (issue 42, in progress) on courses, and any 3D network controller on the same ones.
 
 Run: ``python benchmarks/designed_courses.py`` (about 5 minutes on 2 cores; the averaged model first, if
 ``benchmarks/results/monarch_model.json`` is missing: ``lifelike-mj butterfly model3d --out
@@ -12,7 +12,10 @@ at most 60 s:
 - in a 1 m/s wind toward +x with gusts of 0.5 m/s and vertical gusts at Dryden's ratio near the ground (0.25 m/s);
 - in the same wind with vertical gusts as strong as the horizontal ones (0.5 m/s);
 - in a steady 1.5 m/s wind from one of four sides (toward +x, +y, -x, -y by the seed's remainder by 4).
-The controller was tuned on seeds 100-107 (and calm courses 100-119); the default seeds, 200-209, were never flown
+With ``--controller NAME`` (a shipped 3D network, such as ``monarch``, or its file) the same flights are flown by that
+network, on its own wing law and animal, started from its own base gait, into
+``benchmarks/results/designed_courses_NAME.json``: the side-by-side table of ``docs/results.md``.
+The designed controller was tuned on seeds 100-107 (and calm courses 100-119); the default seeds, 200-209, were never flown
 while tuning.
 
 Also measured: level flight in calm air at 1, 1.5 and 2 m/s (``measures.level_measures``: 6 s after 5 s, with the
@@ -48,22 +51,32 @@ def _spec(model_path: str) -> dict:
     return D.design(json.loads(Path(model_path).read_text()))
 
 
-def fly(job: tuple[dict, int]) -> dict:
-    """One seed's four courses (module docstring)."""
+def _flight(spec) -> tuple[object, dict]:
+    """The controller to fly and the flight's keywords: ``spec`` a designed controller's schedule (the calibrated
+    monarch, started from the 1.5 m/s trim) or a network controller's name or file (its own animal, law and base)."""
     from lifelike_mj.butterfly.flight3d import designed as D
     from lifelike_mj.butterfly.flight3d import designed_kernel as DK
+    from lifelike_mj.butterfly.flight3d.controllers import load_controller
     from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
     from lifelike_mj.butterfly.flight3d.parts import Butterfly
+
+    if isinstance(spec, str):
+        return load_controller(spec), {}
+    return DK.CompiledDesigned(spec), {"command": KinematicsCommand(*D._interp(spec["schedule"], 1.5, "command")),
+                                       "butterfly": Butterfly("monarch", force_law="calibrated")}
+
+
+def fly(job: tuple[dict | str, int]) -> dict:
+    """One seed's four courses (module docstring)."""
     from lifelike_mj.butterfly.flight3d.validate import course_check
 
     spec, seed = job
-    start = KinematicsCommand(*D._interp(spec["schedule"], 1.5, "command"))
     dx, dy = DIRECTIONS[seed % 4]
     weather = dict(WEATHER, steady_1_5={"wind_to_m_s": [1.5 * dx, 1.5 * dy, 0.0]})
     out = {"seed": seed}
     for name, w in weather.items():
-        r = course_check(DK.CompiledDesigned(spec), seed, weather=w, command=start,
-                         butterfly=Butterfly("monarch", force_law="calibrated"))
+        ctl, kw = _flight(spec)
+        r = course_check(ctl, seed, weather=w, **kw)
         out[name] = {"passed": r["passed"], "time_s": r["time_s"]}
     return out
 
@@ -74,13 +87,13 @@ def calm(job: tuple[dict, int]) -> dict:
 
     import numpy as np
 
-    from lifelike_mj.butterfly.flight3d import designed_kernel as DK
     from lifelike_mj.butterfly.flight3d.flight import Flight3D, euler_from_quat
     from lifelike_mj.butterfly.flight3d.tasks import course
 
     spec, seed = job
     task = course(seed)
-    f = Flight3D(controller=DK.CompiledDesigned(spec), task=task)
+    ctl, kw = _flight(spec)
+    f = Flight3D(controller=ctl, task=task, **kw)
     lowest = min(r[2] for r in task.rows)
     worst, fell = 0.0, False
     while f.time < 40.0 and f.waypoints_passed < len(task.rows) and not fell:
@@ -95,13 +108,13 @@ def level(job: tuple[dict, float]) -> dict:
     """Level flight in calm air at one speed (module docstring)."""
     import numpy as np
 
-    from lifelike_mj.butterfly.flight3d import designed_kernel as DK
     from lifelike_mj.butterfly.flight3d import measures as M
     from lifelike_mj.butterfly.flight3d import tasks
     from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
     spec, speed = job
-    f = Flight3D(controller=DK.CompiledDesigned(spec), task=tasks.level(speed))
+    ctl, kw = _flight(spec)
+    f = Flight3D(controller=ctl, task=tasks.level(speed), **kw)
     f.step(int(round(5.0 / f.dt)))
     s = M.sample(f, 6.0)
     m = M.measures(s, **M.body_numbers(f))
@@ -148,7 +161,9 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--model", default=str(MODEL))
     ap.add_argument("--seeds", default="200-209", help="first-last")
-    ap.add_argument("--out", default=str(HERE / "results" / "designed_courses.json"))
+    ap.add_argument("--controller", default="designed", help="designed (from --model), or a 3D network's name or file")
+    ap.add_argument("--out", default=None, help="default: results/designed_courses.json, or "
+                    "results/designed_courses_NAME.json for a network")
     ap.add_argument("--picture", default=None, help="also draw one course in gusts (Dryden's ratio) here (.png)")
     ap.add_argument("--picture-seed", type=int, default=200)
     ap.add_argument("--calm", type=int, default=100, help="random calm courses from seed 1000 on (0: none)")
@@ -157,7 +172,10 @@ def main(argv=None) -> None:
         picture(args.model, args.picture_seed, args.picture)
     lo, hi = (int(v) for v in args.seeds.split("-"))
     start = time.perf_counter()
-    spec = _spec(args.model)
+    designed = args.controller == "designed"
+    spec = _spec(args.model) if designed else args.controller
+    out = args.out or str(HERE / "results" / ("designed_courses.json" if designed else
+                                              f"designed_courses_{Path(args.controller).stem}.json"))
     with Pool(2) as pool:
         rows = pool.map(fly, [(spec, s) for s in range(lo, hi + 1)])
         levels = pool.map(level, [(spec, v) for v in (1.0, 1.5, 2.0)])
@@ -165,7 +183,8 @@ def main(argv=None) -> None:
     summary = {name: {"completed": sum(r[name]["passed"] == 10 for r in rows), "of": len(rows),
                       "waypoints": [r[name]["passed"] for r in rows]}
                for name in ("calm", "gusts_dryden", "gusts_every_axis", "steady_1_5")}
-    write_json(args.out, {"provenance": provenance(benchmark="designed_courses", model=args.model, seeds=[lo, hi]),
+    write_json(out, {"provenance": provenance(benchmark="designed_courses", controller=args.controller,
+                                              model=args.model if designed else None, seeds=[lo, hi], calm=args.calm),
                           "machine": machine_info(), "wall_time_s": time.perf_counter() - start,
                           "summary": summary, "courses": rows, "level": levels,
                           "calm_courses": {"completed": sum(r["passed"] == 10 for r in calms),
