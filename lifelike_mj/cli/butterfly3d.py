@@ -571,7 +571,8 @@ def add_commands(bf) -> None:
     p.set_defaults(func=cmd_strobe3d)
     p = bf.add_parser("land3d", help="one butterfly visits flowers by landing on each in turn (touchdown speed, perch, "
                                      "take-off), with a picture of a landing and a take-off")
-    p.add_argument("--controller", default="monarch", help="a 3D controller evolved to land (default: monarch)")
+    p.add_argument("--controller", default="monarch", help="a 3D controller (default: monarch). No shipped "
+                   "controller lands yet; the report says so for each visit")
     p.add_argument("--flowers", type=count(2, 200), default=11, help="flowers, 2 to 200: perched on the first, it "
                    "visits each other once")
     add_seed(p)

@@ -36,7 +36,7 @@ def on_blossom(thorax_m, blossom_m) -> bool:
 
 def visit_flowers(controller, flowers, perch_s: float = 2.0, *, dt_s: float | None = None, record_every_s: float = 0.0,
                   ground_m: float | None = None) -> dict:
-    """Fly ``controller`` (a 3D controller evolved to land) from perched on ``flowers[0]`` to each next flower in
+    """Fly ``controller`` (a 3D controller; none shipped lands yet) from perched on ``flowers[0]`` to each next flower in
     turn (``(n, 3)`` blossom centres, m), landing on each and perching ``perch_s`` s. Returns ``visits`` (one per
     flower after the first: ``flower``, ``landed``, ``flight_s`` (take-off to touchdown), ``touchdown_speed_m_s``,
     ``within_bound`` (:data:`TOUCHDOWN_M_S`), ``perch_moved_m``, ``still`` (:data:`STILL_M`), ``stayed`` (still
