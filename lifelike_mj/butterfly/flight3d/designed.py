@@ -185,7 +185,8 @@ def _pade2(tau: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
 def lagged_poles(model: dict, spec: dict, lag_s: float | None = None, extra_s: float = 0.0) -> list[dict]:
     """The closed loop's poles at each level trim of ``spec`` (:func:`design` of ``model``) when the controller sees
     the body's motion late: by ``lag_s`` (s), or with ``None`` by half a beat (``0.5 / f``), as a moving mean of one
-    wing beat sees it; plus ``extra_s``. The lag is a second-order Pade form on the 9 model states and the altitude
+    wing beat sees it; plus ``extra_s`` (a total of 0: the loop as designed). The lag is a second-order Pade form on
+    the 9 model states and the altitude
     error; the controls as flown are the controller's own and seen at once. Per speed: the fastest growth or slowest
     decay (``growth_per_s``, 1/s: positive is unstable) and the least damped oscillation (``damping``, its
     ``frequency_hz``). The design itself assumes no lag: this is how much of its margin a lag takes."""
@@ -197,8 +198,9 @@ def lagged_poles(model: dict, spec: dict, lag_s: float | None = None, extra_s: f
         Aa, Ba = augment(np.array(p["A"]), np.array(p["B"]), s["body_angle_rad"], np.array(s["v0_body_m_s"]),
                          2.0 * math.pi * f)
         K = np.array(s["K"])
-        n, lagged = Aa.shape[0], range(N_PLANT - 3)  # the 9 model states and the altitude error
-        Ap, Bp, Cp, Dp = _pade2((0.5 / f if lag_s is None else lag_s) + extra_s)
+        tau = (0.5 / f if lag_s is None else lag_s) + extra_s
+        n, lagged = Aa.shape[0], (range(N_PLANT - 3) if tau > 0.0 else range(0))  # the 9 model states, altitude error
+        Ap, Bp, Cp, Dp = _pade2(tau) if tau > 0.0 else (None, None, None, 1.0)  # no lag: the design's own loop
         M = np.zeros((n + 2 * len(lagged), n + 2 * len(lagged)))
         M[:n, :n] = Aa
         Kfb = np.zeros((K.shape[0], M.shape[0]))  # u = -Kfb [x, z]: the lagged states through their filters

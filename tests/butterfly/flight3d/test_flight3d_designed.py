@@ -156,6 +156,9 @@ def test_the_lagged_loop_is_the_designed_one_without_lag_and_loses_its_margin_at
     near = {r["speed_m_s"]: r for r in D.lagged_poles(model, spec, lag_s=1e-4)}
     assert near[1.5]["growth_per_s"] == pytest.approx(-next(s for s in spec["schedule"] if s["speed_m_s"] == 1.5)
                                                       ["slowest_pole_per_s"], abs=1e-3)
+    none = D.lagged_poles(model, spec, lag_s=0.0)  # no lag at all is the loop as designed, exactly
+    assert [r["growth_per_s"] for r in none] == pytest.approx([-s["slowest_pole_per_s"] for s in spec["schedule"]],
+                                                              abs=1e-9)
     half_beat = {r["speed_m_s"]: r for r in D.lagged_poles(model, spec)}
     assert half_beat[0.75]["growth_per_s"] > 0.0 and half_beat[0.5]["growth_per_s"] > 0.0
     assert all(r["damping"] > 0.5 and r["growth_per_s"] < 0.0 for r in D.lagged_poles(model, spec, D.CONTROL_LAG_S))
