@@ -1,6 +1,6 @@
 """The designed controller (issue 42, in progress) on courses, and any 3D network controller on the same ones.
 
-Run: ``python benchmarks/designed_courses.py`` (about 5 minutes on 2 cores; the averaged model first, if
+Run: ``python benchmarks/designed_courses.py`` (45-55 s on 2 cores, measured 2026-11-28; the averaged model first, if
 ``benchmarks/results/monarch_model.json`` is missing: ``lifelike-mj butterfly model3d --out
 benchmarks/results/monarch_model.json``). Writes ``benchmarks/results/designed_courses.json``.
 
