@@ -25,7 +25,8 @@ from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
 
 #: The scalars of a flight's state, in ``st``'s order.
 ST_NAMES = ("k", "count", "head", "int_z", "int_v", "int_h", "v_hat_set", "v_hat_x", "v_hat_y", "v_hat_z", "w_hat_x",
-            "w_hat_y", "w_hat_z", "heading_set", "heading", "airspeed_set", "airspeed", "altitude_set", "altitude")
+            "w_hat_y", "w_hat_z", "heading_set", "heading", "airspeed_set", "airspeed", "altitude_set", "altitude",
+            "orbit_waypoint", "orbit_swept", "orbit_bearing", "orbit_bearing_set", "going_out", "out_heading")
 #: Rows of the sample ring: more than any wing beat holds at the coarsest time step and slowest frequency allowed.
 N_BUF = 512
 #: A sample's columns: position (3), velocity (3), rates (3), attitude matrix (9, row major), stroke phase (1).
@@ -232,6 +233,26 @@ def control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins
         to = waypoint[0:2] - pos[0:2]
         dist = math.sqrt(to[0] ** 2 + to[1] ** 2)
         d = to / dist if dist > 1e-9 else np.array([1.0, 0.0])
+        # circling a waypoint it cannot turn tightly enough to pass: out straight, then in again (the twin's _orbit)
+        if st[19] != reference[0]:  # a new waypoint
+            st[19], st[20], st[22], st[23] = reference[0], 0.0, 0.0, 0.0
+        if st[23] != 0.0:
+            if dist > D.ORBIT_OUT_M:
+                st[20], st[22], st[23] = 0.0, 0.0, 0.0
+            else:
+                d = np.array([math.cos(st[24]), math.sin(st[24])])
+        if st[23] == 0.0:
+            if dist < D.ORBIT_M:
+                b = math.atan2(to[1], to[0])
+                if st[22] != 0.0:
+                    st[20] = st[20] + abs(_wrap(b - st[21]))
+                st[21], st[22] = b, 1.0
+                if st[20] > D.ORBIT_TURNS_RAD:
+                    st[23] = 1.0
+                    st[24] = st[14] if st[13] != 0.0 else b
+                    d = np.array([math.cos(st[24]), math.sin(st[24])])
+            else:
+                st[20], st[22] = 0.0, 0.0
         gs = min(task_speed, app_min + app_per * dist)
         target, asked = _wind_triangle(d, gs, wind[0:2], vmin, vmax)
         altitude_asked = waypoint[2]
@@ -402,6 +423,7 @@ def _head(ud, qpos, qvel, time, dt, every, task, rec, st, buf, tmpl, wp, ref, ba
         i = min(int(rec[L.R_PASSED]), int(task[L.T_ROWS]) - 1)
         b = L.T_ROW0 + 4 * i
         wp[0], wp[1], wp[2] = task[b], task[b + 1], task[b + 2]
+        ref[0] = i
         k = 0
     elif kind == L.TASK_SCHEDULE:
         # the schedule's row at steps x dt, the time Flight3D.reference reads (the data's clock, a sum of steps, can

@@ -32,12 +32,25 @@ def _flight(controller, task, seconds: float) -> np.ndarray:
 
 @pytest.mark.parametrize("task,seconds", [
     (course(201).with_weather(wind_to_m_s=(1.0, 0.0, 0.0), gust_m_s=0.5, gust_vertical_m_s=0.5), 6.0),
-    (turn(90.0, speed_m_s=1.2), 4.0)], ids=["gusty course", "turn"])
+    (turn(90.0, speed_m_s=1.2), 4.0), (course(105), 8.0)], ids=["gusty course", "turn", "a circled waypoint"])
 def test_the_compiled_controller_flies_as_its_python_twin(spec, task, seconds):
     python = _flight(D.DesignedController(spec), task, seconds)
     compiled = _flight(DK.CompiledDesigned(spec), task, seconds)
     assert np.ptp(python[:, 0]) > 1.0  # it flew somewhere
     np.testing.assert_allclose(compiled, python, rtol=0.0, atol=1e-9)
+
+
+def test_a_waypoint_circled_is_left_and_met_again_from_straight_ahead(spec):
+    """Calm course 105 turns so sharply at its second waypoint that the butterfly, at its slowest airspeed and fastest
+    turn, circled it for the rest of a minute (1 of 10 waypoints before ``designed.ORBIT_M``); having swept one and a
+    half turns of bearing near it, it now flies out and comes back in (5.9 s in: the twin's path above crosses it), and
+    completes the course in 18.4 s."""
+    f = Flight3D(controller=DK.CompiledDesigned(spec), task=course(105))
+    went_out = False
+    while f.time < 40.0 and f.waypoints_passed < 10:
+        f.step(40)
+        went_out |= bool(f._batch.designed_states[0][0][DK.ST_NAMES.index("going_out")])
+    assert went_out and f.waypoints_passed == 10
 
 
 def test_the_ring_keeps_the_last_beat_as_the_twins_deque_does():
