@@ -74,8 +74,8 @@ def fly(job: tuple[dict | str, int]) -> dict:
     dx, dy = DIRECTIONS[seed % 4]
     weather = dict(WEATHER, steady_1_5={"wind_to_m_s": [1.5 * dx, 1.5 * dy, 0.0]})
     out = {"seed": seed}
+    ctl, kw = _flight(spec)  # read once: a controller keeps no state between flights
     for name, w in weather.items():
-        ctl, kw = _flight(spec)
         r = course_check(ctl, seed, weather=w, **kw)
         out[name] = {"passed": r["passed"], "time_s": r["time_s"]}
     return out

@@ -33,7 +33,7 @@ waypoint's, reached by a climb or descent at :data:`MAX_CLIMB_M_S` at most (the 
 heading asked turns at :data:`MAX_TURN_RATE_RAD_S` at most; errors beyond :data:`MAX_ALTITUDE_ERROR_M` and
 :data:`MAX_HEADING_ERROR_RAD` are clipped, so that a far target asks a steady climb or turn, not a saturated one. A
 waypoint circled without being passed (:data:`ORBIT_TURNS_RAD` of bearing swept near it: the slowest turn is wider than
-a course's radius) is left straight ahead and met again from further out (:meth:`DesignedController._orbit`).
+a course's radius) is left straight ahead and met again from further out (:func:`orbit_direction`).
 
 **Saturation.** Every control is clipped to the natural envelope (:data:`~lifelike_mj.butterfly.flight3d.averaged.ENVELOPE`
 for the symmetric ones, :data:`DIFFERENCE_LIMITS` for left against right); the integrals are bounded
@@ -194,10 +194,10 @@ def lagged_poles(model: dict, spec: dict, lag_s: float | None = None, extra_s: f
     """The closed loop's poles at each level trim of ``spec`` (:func:`design` of ``model``) when the controller sees
     the body's motion late: by ``lag_s`` (s), or with ``None`` by half a beat (``0.5 / f``), as a moving mean of one
     wing beat sees it; plus ``extra_s`` (a total of 0: the loop as designed). The lag is a second-order Pade form on
-    the 9 model states and the altitude
-    error; the controls as flown are the controller's own and seen at once. Per speed: the fastest growth or slowest
-    decay (``growth_per_s``, 1/s: positive is unstable) and the least damped oscillation (``damping``, its
-    ``frequency_hz``). The design itself assumes no lag: this is how much of its margin a lag takes."""
+    the 9 model states and the altitude error; the controls as flown are the controller's own and seen at once. Per
+    speed: the fastest growth or slowest decay (``growth_per_s``, 1/s: positive is unstable) and the least damped
+    oscillation (``damping``, its ``frequency_hz``). The design itself assumes no lag: this is how much of its margin a
+    lag takes."""
     points = {p["speed_m_s"]: p for p in model["points"] if p["climb_m_s"] == 0.0}
     out = []
     for s in spec["schedule"]:
@@ -207,8 +207,10 @@ def lagged_poles(model: dict, spec: dict, lag_s: float | None = None, extra_s: f
                          2.0 * math.pi * f)
         K = np.array(s["K"])
         tau = (0.5 / f if lag_s is None else lag_s) + extra_s
-        n, lagged = Aa.shape[0], (range(N_PLANT - 3) if tau > 0.0 else range(0))  # the 9 model states, altitude error
-        Ap, Bp, Cp, Dp = _pade2(tau) if tau > 0.0 else (None, None, None, 1.0)  # no lag: the design's own loop
+        # the 9 model states and the altitude error, seen late (none with no lag: the design's own loop)
+        n, lagged = Aa.shape[0], (range(N_PLANT - 3) if tau > 0.0 else range(0))
+        if tau > 0.0:
+            Ap, Bp, Cp, Dp = _pade2(tau)
         M = np.zeros((n + 2 * len(lagged), n + 2 * len(lagged)))
         M[:n, :n] = Aa
         Kfb = np.zeros((K.shape[0], M.shape[0]))  # u = -Kfb [x, z]: the lagged states through their filters
@@ -275,6 +277,36 @@ def quat2mat(q):
     return R
 
 
+@njit(cache=True)
+def orbit_direction(o, waypoint, to, dist, d, heading, has_heading):
+    """The direction to fly (unit vector) when homing on waypoint number ``waypoint`` along ``d`` (``to`` it, ``dist`` m
+    away), compiled once for both forms of the controller: having swept :data:`ORBIT_TURNS_RAD` of bearing within
+    :data:`ORBIT_M` of it without passing (circling, as a turn too wide for its radius does), it flies straight out on
+    the heading asked (``heading``, if ``has_heading``, else the bearing) until :data:`ORBIT_OUT_M` away, then homes
+    again, now from straight ahead. ``o`` (6, changed in place): the waypoint, the bearing swept, the last bearing and
+    whether set, whether going out and its heading."""
+    if o[0] != waypoint:
+        o[0], o[1], o[3], o[4] = waypoint, 0.0, 0.0, 0.0
+    if o[4] != 0.0:
+        if dist > ORBIT_OUT_M:
+            o[1], o[3], o[4] = 0.0, 0.0, 0.0
+        else:
+            d = np.array([math.cos(o[5]), math.sin(o[5])])
+    if o[4] == 0.0:
+        if dist < ORBIT_M:
+            b = math.atan2(to[1], to[0])
+            if o[3] != 0.0:
+                o[1] = o[1] + abs((b - o[2] + math.pi) % (2.0 * math.pi) - math.pi)
+            o[2], o[3] = b, 1.0
+            if o[1] > ORBIT_TURNS_RAD:
+                o[4] = 1.0
+                o[5] = heading if has_heading else b
+                d = np.array([math.cos(o[5]), math.sin(o[5])])
+        else:
+            o[1], o[3] = 0.0, 0.0
+    return d
+
+
 def _wrap(a: float) -> float:
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
@@ -323,9 +355,8 @@ class DesignedController:
         self.w_hat = np.zeros(3)
         self.k = 0
         self.heading = None
-        #: circling a waypoint (:meth:`_orbit`): the waypoint, the bearing swept, the last bearing and whether set,
-        #: whether going out and its heading
-        self.orbit = [-1.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+        #: circling a waypoint (:func:`orbit_direction`)
+        self.orbit = np.array([-1.0, 0.0, 0.0, 0.0, 0.0, 0.0])
         self.airspeed = None
         self.altitude = None
         self.template = np.zeros((N_BINS, 9))
@@ -389,40 +420,13 @@ class DesignedController:
             to = wp[:2] - pos[:2]
             dist = float(np.linalg.norm(to))
             d = to / dist if dist > 1e-9 else np.array([1.0, 0.0])
-            d = self._orbit(float(i), to, dist, d)
+            d = orbit_direction(self.orbit, float(i), to, dist, d, self.heading or 0.0, self.heading is not None)
             # slower as it closes, so that its turns are tighter than the waypoint's radius
             speed = min(task.speed_m_s, APPROACH_MIN_M_S + APPROACH_PER_S * dist)
             heading, airspeed = self.wind_triangle(d, speed, wind[:2])
             return heading, float(wp[2]), airspeed
         heading, altitude, speed = flight.reference  # a schedule asks for a heading and an airspeed
         return float(heading), float(altitude), float(np.clip(speed, MIN_AIRSPEED_M_S, MAX_AIRSPEED_M_S))
-
-    def _orbit(self, waypoint: float, to: np.ndarray, dist: float, d: np.ndarray) -> np.ndarray:
-        """The direction to fly (unit vector) when homing on waypoint number ``waypoint`` along ``d`` (``to`` it,
-        ``dist`` m away): having swept :data:`ORBIT_TURNS_RAD` of bearing within :data:`ORBIT_M` of it without passing
-        (circling, as a turn too wide for its radius does), it flies straight out on the heading asked until
-        :data:`ORBIT_OUT_M` away, then homes again, now from straight ahead."""
-        o = self.orbit
-        if o[0] != waypoint:
-            o[0], o[1], o[3], o[4] = waypoint, 0.0, 0.0, 0.0
-        if o[4] != 0.0:
-            if dist > ORBIT_OUT_M:
-                o[1], o[3], o[4] = 0.0, 0.0, 0.0
-            else:
-                d = np.array([math.cos(o[5]), math.sin(o[5])])
-        if o[4] == 0.0:
-            if dist < ORBIT_M:
-                b = math.atan2(to[1], to[0])
-                if o[3] != 0.0:
-                    o[1] = o[1] + abs(_wrap(b - o[2]))
-                o[2], o[3] = b, 1.0
-                if o[1] > ORBIT_TURNS_RAD:
-                    o[4] = 1.0
-                    o[5] = self.heading if self.heading is not None else b
-                    d = np.array([math.cos(o[5]), math.sin(o[5])])
-            else:
-                o[1], o[3] = 0.0, 0.0
-        return d
 
     @staticmethod
     def wind_triangle(d: np.ndarray, ground_speed: float, wind_xy: np.ndarray) -> tuple[float, float]:

@@ -233,26 +233,7 @@ def control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins
         to = waypoint[0:2] - pos[0:2]
         dist = math.sqrt(to[0] ** 2 + to[1] ** 2)
         d = to / dist if dist > 1e-9 else np.array([1.0, 0.0])
-        # circling a waypoint it cannot turn tightly enough to pass: out straight, then in again (the twin's _orbit)
-        if st[19] != reference[0]:  # a new waypoint
-            st[19], st[20], st[22], st[23] = reference[0], 0.0, 0.0, 0.0
-        if st[23] != 0.0:
-            if dist > D.ORBIT_OUT_M:
-                st[20], st[22], st[23] = 0.0, 0.0, 0.0
-            else:
-                d = np.array([math.cos(st[24]), math.sin(st[24])])
-        if st[23] == 0.0:
-            if dist < D.ORBIT_M:
-                b = math.atan2(to[1], to[0])
-                if st[22] != 0.0:
-                    st[20] = st[20] + abs(_wrap(b - st[21]))
-                st[21], st[22] = b, 1.0
-                if st[20] > D.ORBIT_TURNS_RAD:
-                    st[23] = 1.0
-                    st[24] = st[14] if st[13] != 0.0 else b
-                    d = np.array([math.cos(st[24]), math.sin(st[24])])
-            else:
-                st[20], st[22] = 0.0, 0.0
+        d = D.orbit_direction(st[19:25], reference[0], to, dist, d, st[14], st[13] != 0.0)  # circling
         gs = min(task_speed, app_min + app_per * dist)
         target, asked = _wind_triangle(d, gs, wind[0:2], vmin, vmax)
         altitude_asked = waypoint[2]
