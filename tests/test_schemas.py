@@ -37,7 +37,8 @@ def test_every_shipped_file_validates(creature):
     jsonschema = pytest.importorskip("jsonschema")
     for path in sorted((controllers_dir() / creature).glob("*.json")):
         data = json.loads(path.read_text())
-        name = "boids-grid" if data["format"].endswith("grid") else KINDS[creature]
+        name = ("boids-grid" if data["format"].endswith("grid") else "butterfly3d-designed"
+                if data.get("kind") == "designed" else KINDS[creature])
         jsonschema.validate(data, json.loads((DOCS / f"{name}.schema.json").read_text()))
 
 

@@ -31,11 +31,36 @@ LEVEL_SETTLE_S = 5.0
 MAX_COURSES = 1000
 #: The --controller option's help: the shipped 3D controllers' names.
 CONTROLLER_HELP = f"a shipped 3D controller's name ({', '.join(shipped_names('butterfly3d'))}) or a file"
+#: The 3D controller flown unless another is named: the one designed from the averaged model (``design3d``); the
+#: commands that fly networks only (``garden``, ``land3d``, ``view3d``, ``evolve3d``) keep the evolved ``monarch``.
+DEFAULT_CONTROLLER = "designed"
+
+
+def _flown(name: str):
+    """The 3D controller ``name`` (a shipped name or a file) as it flies: a network, or a designed controller made
+    ready for the compiled loop (the same flight as its Python twin)."""
+    from lifelike_mj.butterfly.flight3d.designed import DesignedController, load_any
+
+    ctrl = load_any(name)
+    if isinstance(ctrl, DesignedController):
+        from lifelike_mj.butterfly.flight3d.designed_kernel import CompiledDesigned
+
+        ctrl = CompiledDesigned.of(ctrl)
+    return ctrl
+
+
+def _fastest_beat_hz(ctrl) -> float:
+    """The fastest wing beat (Hz) ``ctrl`` flies at first: a network's base gait's, a designed controller's top of
+    the natural envelope (the time step must resolve it)."""
+    from lifelike_mj.butterfly.flight3d.averaged import ENVELOPE
+
+    base = getattr(ctrl, "base", None)
+    return float(base.frequency_hz) if base is not None else float(ENVELOPE["frequency_hz"][1])
 
 
 def _add_level_flight(p: argparse.ArgumentParser, settle_s: float, settle_help: str) -> None:
     """The options of a level flight that is flown, then looked at: the controller, its speed, the settling time."""
-    p.add_argument("--controller", default="monarch", help=CONTROLLER_HELP)
+    p.add_argument("--controller", default=DEFAULT_CONTROLLER, help=CONTROLLER_HELP + f" (default: {DEFAULT_CONTROLLER})")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s")
     p.add_argument("--settle", type=num(0, 600, unit="s"), default=settle_s, help=settle_help)
 
@@ -66,15 +91,10 @@ def _task(args):
 def cmd_fly3d(args) -> None:
     import numpy as np
 
-    from lifelike_mj.butterfly.flight3d.designed import DesignedController, load_any
     from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
-    ctrl = load_any(args.controller)
+    ctrl = _flown(args.controller)
     check_outputs(args, folders={"--out": FLY3D_FILES})
-    if isinstance(ctrl, DesignedController):  # it flies in the compiled loop, the same flight
-        from lifelike_mj.butterfly.flight3d.designed_kernel import CompiledDesigned
-
-        ctrl = CompiledDesigned.of(ctrl)
     flight = Flight3D(controller=ctrl, task=_task(args), dt_s=args.dt)
     with stage(f"3D flight, {args.duration:g} s"):
         rec = flight.record(duration_s=args.duration, every=max(1, round(0.01 / args.dt)))  # every 10 ms
@@ -134,14 +154,13 @@ def cmd_evolve3d(args) -> None:
 
 
 def cmd_assess3d(args) -> None:
-    from lifelike_mj.butterfly.flight3d.controllers import load_controller
     from lifelike_mj.butterfly.flight3d.flight import check_time_step
     from lifelike_mj.butterfly.flight3d.validate import check_window, course_check, level_check, turn_check
 
     check_window("the level flight (--duration)", args.duration, LEVEL_SETTLE_S, 1.0,
                  "it measures the speed each second after settling")
-    ctrl = load_controller(args.controller)
-    check_time_step(args.dt, ctrl.base.frequency_hz, "--dt")
+    ctrl = _flown(args.controller)
+    check_time_step(args.dt, _fastest_beat_hz(ctrl), "--dt")
     with stage("level flight, turns of 90 and 180 deg, courses"):
         level = level_check(ctrl, args.speed, args.duration, LEVEL_SETTLE_S, dt_s=args.dt)
         turns = [turn_check(ctrl, a, speed_m_s=args.speed, dt_s=args.dt) for a in (90.0, -90.0, 180.0)]
@@ -160,13 +179,12 @@ def cmd_assess3d(args) -> None:
 
 
 def cmd_measure3d(args) -> None:
-    from lifelike_mj.butterfly.flight3d.controllers import load_controller
     from lifelike_mj.butterfly.flight3d.flight import check_time_step
     from lifelike_mj.butterfly.flight3d.measures import check_window, level_measures
 
     check_window("the measures", args.settle + args.window, args.settle, 0.5, "they measure whole wing beats")
-    ctrl = load_controller(args.controller)
-    check_time_step(args.dt, ctrl.base.frequency_hz, "--dt")
+    ctrl = _flown(args.controller)
+    check_time_step(args.dt, _fastest_beat_hz(ctrl), "--dt")
     with stage(f"level flight at {args.speed:g} m/s, {args.settle + args.window:g} s"):
         m = level_measures(ctrl, args.speed, args.settle, args.window, dt_s=args.dt)
     d = {"controller": ctrl.name or args.controller, **m}
@@ -280,13 +298,12 @@ def _climbs(text: str) -> list[float]:
 
 def cmd_strobe3d(args) -> None:
     from lifelike_mj.butterfly import flight3d
-    from lifelike_mj.butterfly.flight3d.controllers import load_controller
     from lifelike_mj.butterfly.flight3d.strobe import strobe
     from lifelike_mj.render.video import check_size, write_png
 
     check_outputs(args, files={"--out": (".png",)})
     check_size(args.width, args.height, "panel")
-    ctrl = load_controller(args.controller)
+    ctrl = _flown(args.controller)
     f = flight3d.Flight3D(controller=ctrl, task=flight3d.level(args.speed), dt_s=args.dt)
     with stage(f"level flight at {args.speed:g} m/s, {args.settle:g} s, then one beat"):
         f.step(int(round(args.settle / f.dt)))
@@ -428,7 +445,8 @@ def _hidden(text: str) -> list[int]:
 def add_commands(bf) -> None:
     """``fly3d``, ``evolve3d`` and ``assess3d`` under ``lifelike-mj butterfly``."""
     p = bf.add_parser("fly3d", help="fly the 3D butterfly with a 3D controller")
-    p.add_argument("--controller", default="monarch", help=CONTROLLER_HELP + ", a network or one designed (design3d)")
+    p.add_argument("--controller", default=DEFAULT_CONTROLLER,
+                   help=CONTROLLER_HELP + f", a network or one designed (design3d; default: {DEFAULT_CONTROLLER})")
     p.add_argument("--task", default="level", choices=("level", "turn", "course"),
                    help="level flight, a turn (--angle) or a course of 10 waypoints drawn by --seed")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
@@ -517,7 +535,7 @@ def add_commands(bf) -> None:
     add_json(p)
     p.set_defaults(func=cmd_garden)
     p = bf.add_parser("assess3d", help="a 3D controller's acceptance numbers: level flight, turns, courses")
-    p.add_argument("--controller", default="monarch", help=CONTROLLER_HELP)
+    p.add_argument("--controller", default=DEFAULT_CONTROLLER, help=CONTROLLER_HELP + f" (default: {DEFAULT_CONTROLLER})")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s")
     p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=60.0,
                    help="seconds of level flight")

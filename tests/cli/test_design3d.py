@@ -83,3 +83,25 @@ def test_a_bad_designed_controller_file_is_one_sentence(designed_file, change, n
     with pytest.raises(UserError, match=needle) as e:
         controller_from_dict(d, "bad")
     assert "\n" not in str(e.value)
+
+
+def test_the_shipped_designed_controller_is_what_design3d_makes_from_the_shipped_model(designed_file):
+    """``controllers/butterfly3d/designed.json`` is remade by its recorded command: the same schedule, to the bit."""
+    from lifelike_mj.paths import controllers_dir
+
+    shipped = json.loads((controllers_dir() / "butterfly3d" / "designed.json").read_text())
+    assert shipped["provenance"]["command"] == ("lifelike-mj butterfly design3d --model "
+                                                "benchmarks/results/monarch_model.json --out "
+                                                "controllers/butterfly3d/designed.json")
+    assert shipped["schedule"] == json.loads(designed_file.read_text())["schedule"]
+
+
+def test_the_level_flight_commands_fly_the_designed_controller_by_default(capsys):
+    """``measure3d`` with no ``--controller`` flies the shipped designed controller, inside the natural envelope
+    (issue 42: 9.5-11 Hz, dorsal gap 35-50 deg, strokes of 110-130 deg; the evolved monarch flies 8.7-9.0 Hz, 77-80 deg)."""
+    capsys.readouterr()
+    assert main(["butterfly", "measure3d", "--settle", "3", "--window", "2", "--json"]) == 0
+    m = json.loads(capsys.readouterr().out)
+    assert m["controller"] == "designed" and m["animal"] == "monarch"
+    assert 9.5 <= m["flap_frequency_hz"] <= 11.0 and 35.0 <= m["dorsal_gap_deg"] <= 50.0
+    assert 110.0 <= m["stroke_left_deg"] <= 130.0 and abs(m["roll_mean_deg"]) <= 3.0

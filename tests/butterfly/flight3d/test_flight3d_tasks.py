@@ -14,9 +14,15 @@ SHIPPED = shipped_names("butterfly3d")
 
 
 def test_the_controllers_are_shipped_with_their_provenance():
-    assert "monarch" in SHIPPED and not set(flight3d.WITHDRAWN) & set(SHIPPED)  # they tumbled: withdrawn
+    from lifelike_mj.butterfly.flight3d.designed import DesignedController, load_any
+
+    assert {"monarch", "designed"} <= set(SHIPPED) and not set(flight3d.WITHDRAWN) & set(SHIPPED)  # withdrawn: tumbled
     for name in SHIPPED:
-        prov = flight3d.load_controller(name).provenance
+        ctrl = load_any(name)
+        prov = ctrl.provenance
+        if isinstance(ctrl, DesignedController):  # designed from the averaged model, the command recorded
+            assert prov["command"].startswith("lifelike-mj butterfly design3d") and prov["parameters"]["model_provenance"]
+            continue
         assert prov["evolution_wall_time_s"] > 0 and prov["generations_done"] > 0
         assert prov["problem"]["problem"] == "butterfly3d-flight" and "machine" in prov
 

@@ -183,8 +183,10 @@ FAST = {"c.json": ctrl(base={**MONARCH["base"], "frequency_hz": 50.0})}
 
 
 @pytest.mark.parametrize("argv, needle, files", [
-    (["butterfly", "measure3d", "--dt", "0.0125", "--settle", "0", "--window", "0.5"],
+    (["butterfly", "measure3d", "--controller", "monarch", "--dt", "0.0125", "--settle", "0", "--window", "0.5"],
      "--dt 0.0125 s does not resolve the 0.0980392 s wing beat: it must be at most 1/8 of it", {}),
+    (["butterfly", "measure3d", "--dt", "0.0125", "--settle", "0", "--window", "0.5"],  # designed: up to 11 Hz
+     "--dt 0.0125 s does not resolve the 0.0909091 s wing beat: it must be at most 1/8 of it", {}),
     (["butterfly", "assess3d", "--dt", "0.0125", "--duration", "7", "--courses", "1"], "--dt 0.0125 s does not resolve", {}),
     (["butterfly", "garden", "--dt", "0.0125", "--n", "1", "--duration", "0.1"], "--dt 0.0125 s does not resolve", {}),
     (["butterfly", "evolve3d", "--dt", "0.0125", *TINY, "--out", "e.json"], "argument --dt: must be a number in [1e-05, "
