@@ -37,16 +37,10 @@ DEFAULT_CONTROLLER = "designed"
 
 
 def _flown(name: str):
-    """The 3D controller ``name`` (a shipped name or a file) as it flies: a network, or a designed controller made
-    ready for the compiled loop (the same flight as its Python twin)."""
-    from lifelike_mj.butterfly.flight3d.designed import DesignedController, load_any
+    """The 3D controller ``name`` (a shipped name or a file) as it flies (``designed_kernel.load_compiled``)."""
+    from lifelike_mj.butterfly.flight3d.designed_kernel import load_compiled
 
-    ctrl = load_any(name)
-    if isinstance(ctrl, DesignedController):
-        from lifelike_mj.butterfly.flight3d.designed_kernel import CompiledDesigned
-
-        ctrl = CompiledDesigned.of(ctrl)
-    return ctrl
+    return load_compiled(name)
 
 
 def _fastest_beat_hz(ctrl) -> float:

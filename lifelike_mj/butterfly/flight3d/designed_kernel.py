@@ -297,6 +297,15 @@ def control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins
     return _command_from_controls(trim_cmd, change)
 
 
+def load_compiled(name_or_path):
+    """Any 3D controller by name (``"designed"``, ``"monarch"``: the shipped files) or path, ready to fly in the
+    compiled loop: a network (:class:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D`) as it is read, a
+    designed controller as a :class:`CompiledDesigned` (the same flight as its Python twin). For
+    ``Flight3D(controller=load_compiled(name))`` and the commands' ``--controller``."""
+    ctrl = D.load_any(name_or_path)
+    return CompiledDesigned.of(ctrl) if isinstance(ctrl, D.DesignedController) else ctrl
+
+
 class CompiledDesigned:
     """A designed controller (:func:`~lifelike_mj.butterfly.flight3d.designed.design`'s answer or a controller file's
     content) for the compiled loop: ``Flight3D(controller=CompiledDesigned(spec))`` flies it inside
