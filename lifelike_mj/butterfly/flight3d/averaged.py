@@ -36,6 +36,18 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
+from lifelike_mj.butterfly.flight3d.controls import (  # noqa: F401  (here too: the model's names)
+    CONTROLS,
+    ENVELOPE,
+    LATERAL,
+    LONGITUDINAL,
+    STATES,
+    TOP_RANGE,
+    command_from_controls,
+    controls_of,
+    rotation,
+)
+from lifelike_mj.butterfly.flight3d.controls import exp_rotation as _exp
 from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
 from lifelike_mj.butterfly.flight3d.parts import Butterfly
 
@@ -43,25 +55,6 @@ from lifelike_mj.butterfly.flight3d.parts import Butterfly
 DAMPING_STEP_RAD_S = 0.5
 #: Phases of a wing beat the wrench is averaged over.
 N_PHASES = 48
-#: State names (module docstring).
-STATES = ("u", "v", "w", "p", "q", "r", "a_x", "a_y", "a_z")
-#: Longitudinal and lateral states (indices into :data:`STATES`).
-LONGITUDINAL, LATERAL = (0, 2, 4, 7), (1, 3, 5, 6, 8)
-#: Controls (module docstring; Hz or rad).
-CONTROLS = ("frequency_hz", "offset", "amplitude", "offset_difference", "amplitude_difference", "feather_mean",
-            "feather_mean_difference", "feather_amplitude", "abdomen_mean")
-#: The symmetric controls trim may move, and how far from :data:`NATURAL` each is allowed (the natural envelope:
-#: 9.5-11 Hz, strokes of 110-130 deg, the top of the stroke where the wing tips stop 35-50 deg apart, feathering within
-#: 45 deg, the abdomen within its filmed swing around its filmed mean).
-ENVELOPE = {"frequency_hz": (9.5, 11.0), "offset": (math.radians(2.0), math.radians(17.0)),
-            "amplitude": (math.radians(55.0), math.radians(65.0)), "feather_mean": (math.radians(-20.0), math.radians(20.0)),
-            "feather_amplitude": (math.radians(25.0), math.radians(45.0)),
-            "abdomen_mean": (math.radians(-31.0), math.radians(-3.0))}
-#: The top of the stroke (offset plus amplitude, rad) inside the natural envelope: the wing tips stop 35-50 deg apart
-#: above the body (the filmed gait's top at 68 deg leaves them 48.5 deg apart, and each degree higher about 1.7 deg
-#: less, measured in the simulator, :func:`flown`): the range the designed controller's stroke offset may move the top
-#: in (its lowest at the largest amplitude); trims keep above :func:`top_floor`.
-TOP_RANGE = (math.radians(69.0), math.radians(75.0))
 #: The lowest top of the stroke a trim may take (deg) at forward speeds (m/s), linear between and held beyond. Where a
 #: wing's tip stops depends on its feathering as well as on the top, and the slow trims feather more (15 deg at 1 m/s,
 #: 7.5 at 1.5), so the same top leaves the tips further apart in slow flight (flown at a top of 69 deg: 50.2 deg at
@@ -84,31 +77,6 @@ def natural_command():
     from lifelike_mj.butterfly.flight3d.controllers import default_base
 
     return default_base("monarch")
-
-
-def command_from_controls(base, u) -> np.ndarray:
-    """The kinematics parameters (``KinematicsCommand.as_array`` order) of ``base`` changed by the controls ``u``
-    (:data:`CONTROLS`, additions to the base's values; differences split half to each wing)."""
-    p = base.as_array().copy() if hasattr(base, "as_array") else np.array(base, float)
-    f, off, amp, doff, damp, fm, dfm, fa, ab = (float(x) for x in u)
-    p[0] += f
-    p[1] += off + 0.5 * doff
-    p[2] += off - 0.5 * doff
-    p[3] += amp + 0.5 * damp
-    p[4] += amp - 0.5 * damp
-    p[5] += fm + 0.5 * dfm
-    p[6] += fm - 0.5 * dfm
-    p[7] += fa
-    p[8] += fa
-    p[10] += ab
-    return p
-
-
-def controls_of(p: np.ndarray) -> np.ndarray:
-    """The controls' values (:data:`CONTROLS`) of the kinematics ``p``: the two wings' means and their differences
-    (left less right); :func:`command_from_controls` adds changes of them back."""
-    return np.array([p[0], 0.5 * (p[1] + p[2]), 0.5 * (p[3] + p[4]), p[1] - p[2], p[3] - p[4], 0.5 * (p[5] + p[6]),
-                     p[5] - p[6], 0.5 * (p[7] + p[8]), p[10]])
 
 
 @dataclass
@@ -316,26 +284,6 @@ class Averager:
         #: over the beat, of the last call (untilted axes)
         self.tilt, self.spin, self.shake = tilt, spin, shake
         return forces.mean(axis=0), moments.mean(axis=0)
-
-
-def rotation(roll: float, pitch: float, yaw: float) -> np.ndarray:
-    """The body's axes in the world (columns) for ``roll`` (right wing down > 0), ``pitch`` (nose up > 0) and ``yaw``
-    (left > 0), composed yaw, pitch, roll (:func:`~lifelike_mj.butterfly.flight3d.flight.euler_from_quat`)."""
-    cr, sr, cp, sp, cy, sy = (math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch), math.cos(yaw),
-                              math.sin(yaw))
-    rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
-    ry = np.array([[cp, 0.0, -sp], [0.0, 1.0, 0.0], [sp, 0.0, cp]])  # nose up about -y
-    rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
-    return rz @ ry @ rx
-
-
-def _exp(a: np.ndarray) -> np.ndarray:
-    """The rotation matrix of the rotation vector ``a`` (rad)."""
-    t = float(np.linalg.norm(a))
-    k = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
-    if t < 1e-12:
-        return np.eye(3) + k
-    return np.eye(3) + math.sin(t) / t * k + (1.0 - math.cos(t)) / t ** 2 * (k @ k)
 
 
 @dataclass

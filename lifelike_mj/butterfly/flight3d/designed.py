@@ -35,7 +35,7 @@ heading asked turns at :data:`MAX_TURN_RATE_RAD_S` at most; errors beyond :data:
 waypoint circled without being passed (:data:`ORBIT_TURNS_RAD` of bearing swept near it: the slowest turn is wider than
 a course's radius) is left straight ahead and met again from further out (:func:`orbit_direction`).
 
-**Saturation.** Every control is clipped to the natural envelope (:data:`~lifelike_mj.butterfly.flight3d.averaged.ENVELOPE`
+**Saturation.** Every control is clipped to the natural envelope (:data:`~lifelike_mj.butterfly.flight3d.controls.ENVELOPE`
 for the symmetric ones, :data:`DIFFERENCE_LIMITS` for left against right); the integrals are bounded
 (:data:`INTEGRAL_LIMITS`), so they do not wind up.
 """
@@ -48,21 +48,21 @@ from collections import deque
 import numpy as np
 from numba import njit
 
-from lifelike_mj.butterfly.flight3d import averaged as av
+from lifelike_mj.butterfly.flight3d import controls as ct
 from lifelike_mj.butterfly.flight3d import model as mj3d
 from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
 
 #: Bryson's scales of the augmented state: 9 model states (m/s, rad/s, rad), then the altitude error (m), its integral
 #: (m s), the airspeed error's integral (m) and the heading error's integral (rad s).
 Q_SCALES = np.array([0.9, 0.9, 0.9, 3.0, 3.0, 3.0, 0.45, 0.45, 0.3, 0.15, 0.15, 0.45, 0.3])
-#: Bryson's scales of the controls (Hz, rad), :data:`~lifelike_mj.butterfly.flight3d.averaged.CONTROLS` order. The
+#: Bryson's scales of the controls (Hz, rad), :data:`~lifelike_mj.butterfly.flight3d.controls.CONTROLS` order. The
 #: left-right differences are kept small (0.06 rad). Seen through the moving mean alone (half a beat late), the lateral
 #: loop needed 0.03: at 0.1 rad for the feathering difference it fell into a 2 Hz roll-and-yaw cycle of +-60 deg with
 #: that control slamming between its limits (seeds 100-119: 2 of 20 calm courses tumbled; at 0.2 rad, 14 of 20).
 #: Without that lag (:meth:`DesignedController._unlagged`) it carries 0.06, and the rates' weights three times more.
 R_SCALES = np.array([0.5, 0.06, 0.06, 0.06, 0.06, 0.1, 0.06, 0.1, 0.15])
 #: A residual policy's reach (:mod:`~lifelike_mj.envs.butterfly3d`: the designed controller as a baseline, a policy's
-#: nine actions in [-1, 1] times these added to its controls, in :data:`~lifelike_mj.butterfly.flight3d.averaged.CONTROLS`
+#: nine actions in [-1, 1] times these added to its controls, in :data:`~lifelike_mj.butterfly.flight3d.controls.CONTROLS`
 #: order; Hz, rad): the controls' Bryson scales, the change the design itself counts as large.
 RESIDUAL_SCALE = R_SCALES.copy()
 #: Limits of the antisymmetric controls (rad): offset, amplitude and feathering differences left less right.
@@ -115,7 +115,7 @@ def _outputs(trim_pitch: float, v0_body: np.ndarray) -> np.ndarray:
     """Rows of the world's vertical speed, forward speed and heading (yaw) as linear functions of the 9 model states at
     a trim of body angle ``trim_pitch`` moving at ``v0_body`` (body axes): the world velocity is ``R0 (dv + a x v0)``,
     the heading the world vertical component of ``R0 a``."""
-    R0 = av.rotation(0.0, trim_pitch, 0.0)
+    R0 = ct.rotation(0.0, trim_pitch, 0.0)
     C = np.zeros((3, 9))
     cross = np.array([[0.0, v0_body[2], -v0_body[1]], [-v0_body[2], 0.0, v0_body[0]], [v0_body[1], -v0_body[0], 0.0]])
     # a x v0 = -v0 x a = cross @ a
@@ -171,7 +171,7 @@ def design(model: dict, q_scales=Q_SCALES, r_scales=R_SCALES) -> dict:
     for p in rows:
         A, B = np.array(p["A"]), np.array(p["B"])
         pitch = math.radians(p["body_angle_deg"])
-        v0 = av.rotation(0.0, pitch, 0.0).T @ np.array([p["speed_m_s"], 0.0, 0.0])
+        v0 = ct.rotation(0.0, pitch, 0.0).T @ np.array([p["speed_m_s"], 0.0, 0.0])
         omega_c = 2.0 * math.pi * p["command"]["frequency_hz"]  # the kinematics follow a command in one beat
         Aa, Ba = augment(A, B, pitch, v0, omega_c)
         K = lqr(Aa, Ba, q_scales, r_scales)
@@ -312,16 +312,16 @@ def _wrap(a: float) -> float:
 
 
 def limits() -> tuple[np.ndarray, np.ndarray]:
-    """The lowest and highest value of each control (:data:`~lifelike_mj.butterfly.flight3d.averaged.CONTROLS`) as
+    """The lowest and highest value of each control (:data:`~lifelike_mj.butterfly.flight3d.controls.CONTROLS`) as
     an absolute value: the symmetric ones' natural envelope, the differences' :data:`DIFFERENCE_LIMITS`."""
-    lo, hi = np.empty(len(av.CONTROLS)), np.empty(len(av.CONTROLS))
-    for i, name in enumerate(av.CONTROLS):
+    lo, hi = np.empty(len(ct.CONTROLS)), np.empty(len(ct.CONTROLS))
+    for i, name in enumerate(ct.CONTROLS):
         if name in DIFFERENCE_LIMITS:
             lo[i], hi[i] = -DIFFERENCE_LIMITS[name], DIFFERENCE_LIMITS[name]
         elif name == "offset":
-            lo[i], hi[i] = av.TOP_RANGE[0] - av.ENVELOPE["amplitude"][1], av.TOP_RANGE[1] - av.ENVELOPE["amplitude"][0]
+            lo[i], hi[i] = ct.TOP_RANGE[0] - ct.ENVELOPE["amplitude"][1], ct.TOP_RANGE[1] - ct.ENVELOPE["amplitude"][0]
         else:
-            lo[i], hi[i] = av.ENVELOPE[name]
+            lo[i], hi[i] = ct.ENVELOPE[name]
     return lo, hi
 
 
@@ -381,7 +381,7 @@ class DesignedController:
         if self.learnt[j] < TEMPLATE_MIN:
             return vel, rates, Rm
         t = self.template[j]
-        return now[1] - now[3] @ t[0:3], now[2] - t[3:6], now[3] @ av._exp(-t[6:9])
+        return now[1] - now[3] @ t[0:3], now[2] - t[3:6], now[3] @ ct.exp_rotation(-t[6:9])
 
     def start_command(self, speed_m_s: float = 1.5):
         """The trim's kinematics at the airspeed ``speed_m_s`` (m/s, held within the schedule's speeds): where a
@@ -470,7 +470,7 @@ class DesignedController:
         Rm = self.buffer[-1][3]
         # a mean attitude: the beat's rotations averaged about the latest (small swings)
         a_mean = np.mean([_log(Rm.T @ b[3]) for b in self.buffer], axis=0)
-        Rm = Rm @ av._exp(a_mean)
+        Rm = Rm @ ct.exp_rotation(a_mean)
         if len(self.buffer) == n_beat:
             vel, rates, Rm = self._unlagged(vel, rates, Rm)
         t_ctrl = self.every * dt
@@ -497,12 +497,12 @@ class DesignedController:
         v0 = self._at(airspeed, "v0_body_m_s")
         K = self._at(airspeed, "K")
         trim_cmd = self._at(airspeed, "command")
-        trim_u = av.controls_of(trim_cmd)
+        trim_u = ct.controls_of(trim_cmd)
         yaw = math.atan2(Rm[1, 0], Rm[0, 0])
         herr = float(np.clip(_wrap(yaw - heading), -MAX_HEADING_ERROR_RAD, MAX_HEADING_ERROR_RAD))
         # the trim attitude at the heading asked (the error clipped), banked into the turn asked: tan(bank) = v r / g
         bank = -math.atan(airspeed * turn_rate / 9.81)
-        R0 = av.rotation(bank, pitch0, yaw - herr)
+        R0 = ct.rotation(bank, pitch0, yaw - herr)
         a = _log(R0.T @ Rm)
         v_air = Rm.T @ (vel - wind - np.array([0.0, 0.0, climb_rate]))  # the air velocity less the climb asked
         x = np.zeros(N_AUG)
@@ -510,9 +510,9 @@ class DesignedController:
         x[3:6] = np.clip(rates - R0.T @ np.array([0.0, 0.0, turn_rate]), -MAX_RATE_RAD_S, MAX_RATE_RAD_S)
         x[6:9] = np.clip(a, -MAX_ATTITUDE_ERROR_RAD, MAX_ATTITUDE_ERROR_RAD)
         ud = d.userdata
-        nu = len(av.CONTROLS)
-        x[N_PLANT : N_PLANT + nu] = av.controls_of(ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS]) - trim_u
-        x[N_PLANT + nu :] = av.controls_of(ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS])  # the controls' rates as flown
+        nu = len(ct.CONTROLS)
+        x[N_PLANT : N_PLANT + nu] = ct.controls_of(ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS]) - trim_u
+        x[N_PLANT + nu :] = ct.controls_of(ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS])  # the controls' rates as flown
         zerr = float(np.clip(pos[2] - altitude, -MAX_ALTITUDE_ERROR_M, MAX_ALTITUDE_ERROR_M))
         x[9] = zerr
         x[10:13] = self.integral
@@ -523,7 +523,7 @@ class DesignedController:
                                 INTEGRAL_LIMITS)
         self.last = {"t": flight.time, "wind": wind.copy(), "heading": heading, "airspeed": airspeed,
                      "altitude": altitude, "pos": pos.copy(), "x": x, "u": change}
-        return KinematicsCommand(*av.command_from_controls(trim_cmd, change))
+        return KinematicsCommand(*ct.command_from_controls(trim_cmd, change))
 
     def wind(self, vel: np.ndarray, Rm: np.ndarray, rates: np.ndarray, flown: np.ndarray, dt: float) -> np.ndarray:
         """The wind estimate (world, m/s): one step of the observer (module docstring). The model's acceleration is
@@ -544,8 +544,8 @@ class DesignedController:
         pitch0 = float(self._at(speed, "body_angle_rad"))
         trim_cmd = self._at(speed, "command")
         yaw = math.atan2(Rm[1, 0], Rm[0, 0])
-        a = _log(av.rotation(0.0, pitch0, yaw).T @ Rm)
-        u = av.controls_of(flown) - av.controls_of(trim_cmd)
+        a = _log(ct.rotation(0.0, pitch0, yaw).T @ Rm)
+        u = ct.controls_of(flown) - ct.controls_of(trim_cmd)
         v_b = Rm.T @ (self.v_hat - self.w_hat)
         acc = Rm @ (A[0:3, 0:3] @ (v_b - v0) + A[0:3, 3:6] @ rates + A[0:3, 6:9] @ a + B[0:3] @ u)
         Avv = Rm @ A[0:3, 0:3] @ Rm.T
@@ -578,7 +578,7 @@ def json_schema() -> dict:
     def matrix(rows: int, cols: int, what: str) -> dict:
         return {"type": "array", "minItems": rows, "maxItems": rows, "items": vector(cols), "description": what}
 
-    nx, nu, nc = len(av.STATES), len(av.CONTROLS), len(KinematicsCommand.names())
+    nx, nu, nc = len(ct.STATES), len(ct.CONTROLS), len(KinematicsCommand.names())
     point = {"type": "object", "additionalProperties": False,
              "required": ["speed_m_s", "body_angle_rad", "command", "v0_body_m_s", "A", "B", "K"],
              "properties": {
@@ -637,7 +637,7 @@ def model_schema() -> dict:
     from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
     from lifelike_mj.schema import number
 
-    nx, nu = len(av.STATES), len(av.CONTROLS)
+    nx, nu = len(ct.STATES), len(ct.CONTROLS)
     row = {"type": "array", "items": number("", -MAX_VALUE, MAX_VALUE)}
     point = {"type": "object", "required": ["speed_m_s", "climb_m_s", "body_angle_deg", "command", "A", "B"],
              "properties": {

@@ -460,7 +460,7 @@ def fly_designed(mptr, dptr, off, nq, nv, n_steps, dt, every, task, rec, path, p
 def residual_command(baseline, action, scale, lo, hi, target):
     """The kinematics' target (``target``) of the designed controller's command ``baseline`` with a residual policy's
     ``action`` (nine numbers in ``[-1, 1]``, one per control of
-    :data:`~lifelike_mj.butterfly.flight3d.averaged.CONTROLS`) times ``scale`` added to its controls, each control
+    :data:`~lifelike_mj.butterfly.flight3d.controls.CONTROLS`) times ``scale`` added to its controls, each control
     kept within the controller's limits ``lo``, ``hi`` (the natural envelope); a zero action leaves the command
     exactly as it is."""
     cb = _controls_of(baseline)

@@ -34,7 +34,8 @@ import numpy as np
 
 from lifelike_mj import checks
 from lifelike_mj.butterfly.flight3d import model as mj3d
-from lifelike_mj.butterfly.flight3d.controllers import Controller3D, load_controller
+from lifelike_mj.butterfly.flight3d.controllers import Controller3D
+from lifelike_mj.butterfly.flight3d.designed_kernel import load_compiled
 from lifelike_mj.butterfly.flight3d.kinematics import JOINTS, N_PARAMS, Kinematics, KinematicsCommand, joint_refs
 from lifelike_mj.butterfly.flight3d.loop import TUMBLE_RAD, Batch
 from lifelike_mj.butterfly.flight3d.parts import BUTTERFLY_KEYWORDS, WORLD_KEYWORDS, Butterfly, World
@@ -144,9 +145,9 @@ class Flight3D(StepCounter):
       task's, whose gusts and flutter go on; legs that touch the ground, flowers, the ground's height);
     * the flight: ``command``, the kinematics at the start (default: the controller's base command or trim, else the
       paper's 10 Hz flap over [-60, 75] deg, no feathering); ``controller``, a 3D controller
-      (:class:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D` or a network file's name or path; a
-      designed controller as :func:`~lifelike_mj.butterfly.flight3d.designed_kernel.load_compiled` gives it:
-      ``load_compiled("designed")``),
+      (:class:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D`, a designed controller, or the name or path
+      of a controller file of either kind: ``"designed"``, ``"monarch"``;
+      :func:`~lifelike_mj.butterfly.flight3d.designed_kernel.load_compiled`),
       flown in the compiled loop towards ``task``'s references (:class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`;
       default level flight at 1.5 m/s), or any callable ``controller(flight) -> KinematicsCommand | None`` run from
       Python before every ``control_every``-th step; ``start_m``, the thorax's start position; ``dt_s``, the time step.
@@ -186,8 +187,8 @@ class Flight3D(StepCounter):
         self.network = None
         #: A designed controller flown in the compiled loop (``designed_kernel.CompiledDesigned``), or ``None``.
         self.designed = None
-        if isinstance(controller, (str, Path)):
-            controller = load_controller(controller)
+        if isinstance(controller, (str, Path)):  # a name or a file of either kind, a designed one ready to fly compiled
+            controller = load_compiled(controller)
         designed = getattr(controller, "start_command", None) is not None and not isinstance(controller, Controller3D)
         if designed:  # a designed controller: its animal and force law, its trim at the task's speed to start from
             animal = animal if animal is not None else controller.animal

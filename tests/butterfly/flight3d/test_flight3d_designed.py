@@ -183,20 +183,17 @@ def test_the_controller_sees_a_kick_at_once_and_the_beat_s_ripple_not_at_all(spe
 
 
 def test_a_designed_controller_by_name_flies_in_the_compiled_loop():
-    """``load_compiled("designed")`` (the shipped file) flies in the compiled loop, the flight of the same controller
-    made by hand; a network comes back as read; ``Flight3D`` given a designed file's name says what to do instead."""
+    """``Flight3D(controller="designed")`` (the shipped file, through ``load_compiled``) flies in the compiled loop, the
+    flight of the same controller made by hand; a network comes back from ``load_compiled`` as read."""
     from lifelike_mj.butterfly.flight3d import Flight3D, level, load_compiled
     from lifelike_mj.butterfly.flight3d.controllers import Controller3D
     from lifelike_mj.butterfly.flight3d.designed import load_any
     from lifelike_mj.butterfly.flight3d.designed_kernel import CompiledDesigned
-    from lifelike_mj.errors import UserError
 
-    by_name = Flight3D(controller=load_compiled("designed"), task=level(1.5))
+    by_name = Flight3D(controller="designed", task=level(1.5))
     by_object = Flight3D(controller=CompiledDesigned.of(load_any("designed")), task=level(1.5))
     assert by_name.designed is not None and by_name.animal == "monarch"
     by_name.step(400)
     by_object.step(400)
     assert np.array_equal(by_name.data.qpos, by_object.data.qpos)
     assert isinstance(load_compiled("monarch"), Controller3D)
-    with pytest.raises(UserError, match=r"load_compiled"):
-        Flight3D(controller="designed")
