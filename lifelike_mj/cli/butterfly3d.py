@@ -353,7 +353,6 @@ def cmd_garden(args) -> None:
     import numpy as np
 
     from lifelike_mj import checks
-    from lifelike_mj.butterfly.flight3d.controllers import load_controller
     from lifelike_mj.butterfly.flight3d.flight import check_time_step
     from lifelike_mj.butterfly.flight3d.garden import Garden, film_garden
 
@@ -362,8 +361,8 @@ def cmd_garden(args) -> None:
     if args.out:
         checks.work(f"a video of {args.duration:g} s at {args.fps} frames/s", checks.steps_of(args.duration, 1 / args.fps),
                     checks.MAX_FRAMES, "frames", "a shorter garden or fewer frames per second")
-    ctrl = load_controller(args.controller)
-    check_time_step(args.dt, ctrl.base.frequency_hz, "--dt")
+    ctrl = _flown(args.controller)
+    check_time_step(args.dt, _fastest_beat_hz(ctrl), "--dt")
     check_outputs(args, files={"--out": (".mp4", ".gif"), "--paths": (".png",)})
     garden = Garden(args.n, ctrl, seed=args.seed, flutter=args.flutter, gust_m_s=args.gusts, wind_to_m_s=args.wind,
                     gust_vertical_m_s=args.vertical_gusts, dt_s=args.dt)
@@ -513,7 +512,8 @@ def add_commands(bf) -> None:
     p.set_defaults(func=cmd_evolve3d)
     p = bf.add_parser("garden", help="a garden of 3D butterflies visiting flowers, filmed")
     p.add_argument("--n", type=count(1, 500), default=20, help="butterflies, 1 to 500")
-    p.add_argument("--controller", default="monarch", help=CONTROLLER_HELP)
+    p.add_argument("--controller", default=DEFAULT_CONTROLLER, help=CONTROLLER_HELP + f" (default: {DEFAULT_CONTROLLER}; "
+                   "a network that lands lands on the flowers, the others pass them by)")
     add_seed(p)
     p.add_argument("--flutter", type=num(0, 1), default=0.1, help="each butterfly's flutter, 0 to 1")
     _add_weather(p, "", "each butterfly's seed")
@@ -615,7 +615,8 @@ def view_keys() -> str:
 def add_export_args(p: argparse.ArgumentParser) -> None:
     from lifelike_mj.cli.export import add_window
 
-    p.add_argument("--controller", default="monarch", help=CONTROLLER_HELP)
+    p.add_argument("--controller", default="monarch", help=CONTROLLER_HELP + " (default: monarch, whose exports the "
+                   "animation tests hold; designed flies too)")
     p.add_argument("--task", default="course", choices=("level", "turn", "course"),
                    help="level flight, a turn (--angle) or a course of 10 waypoints drawn by --seed")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
@@ -632,11 +633,10 @@ def add_export_args(p: argparse.ArgumentParser) -> None:
 def export_window(args):
     """The run to export, built and checked, not yet simulated (:class:`~lifelike_mj.cli.export.Window`), and the
     parameters that make it."""
-    from lifelike_mj.butterfly.flight3d.controllers import load_controller
     from lifelike_mj.cli.export import Window, check_window, parameters_of
 
     check_window(args.start, args.duration, args.fps, args.dt, bodies=args.garden or 1, drawn=4 * (args.garden or 1))
-    ctrl = load_controller(args.controller)
+    ctrl = _flown(args.controller)
     if args.garden:
         from lifelike_mj.butterfly.flight3d.garden import Garden
 

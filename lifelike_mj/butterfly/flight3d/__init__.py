@@ -11,7 +11,7 @@ Fly one::
 
 A garden of butterflies visiting flowers::
 
-    garden = flight3d.Garden(20, "monarch", seed=1)
+    garden = flight3d.Garden(20, "designed", seed=1)
     garden.step(800)                                 # one second
 
 Evolve a controller of your own (``lifelike-mj butterfly evolve3d`` does the same)::

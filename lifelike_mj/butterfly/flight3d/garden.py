@@ -22,7 +22,8 @@ import numpy as np
 from lifelike_mj import checks
 from lifelike_mj.butterfly.flight3d import model as mj3d
 from lifelike_mj.butterfly.flight3d import tasks as t3
-from lifelike_mj.butterfly.flight3d.controllers import Controller3D, load_controller
+from lifelike_mj.butterfly.flight3d.controllers import Controller3D
+from lifelike_mj.butterfly.flight3d.designed_kernel import CompiledDesigned, load_compiled
 from lifelike_mj.butterfly.flight3d.flight import DT_S
 from lifelike_mj.butterfly.flight3d.flowers import add_flowers, check_room, landing_surface, place_flowers
 from lifelike_mj.butterfly.flight3d.kinematics import Kinematics
@@ -112,21 +113,27 @@ def scene_model(n: int, blossoms: np.ndarray, size_m: float = 8.0, animal: str =
 class Garden(StepCounter):
     """``n`` 3D butterflies in a garden of ``n_flowers`` flowers drawn by ``seed`` (module docstring).
 
-    ``controller``: a 3D controller (name, path or :class:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D`);
+    ``controller``: a 3D controller of either kind (a name, default the shipped ``designed``; a path; a
+    :class:`~lifelike_mj.butterfly.flight3d.controllers.Controller3D` or a
+    :class:`~lifelike_mj.butterfly.flight3d.designed_kernel.CompiledDesigned`);
     ``flutter``, ``gust_m_s``, ``gust_vertical_m_s``, ``wind_to_m_s`` (or ``wind_from_m_s``; ``wind_m_s``, the
     older spelling of ``wind_to_m_s``): each butterfly's flutter and the weather
     (:class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`); ``speed_m_s``: the cruise speed; ``dt_s`` the time step.
     ``land``: the butterflies land on the flowers (module docstring); default: a controller that lands (:func:`lands`:
-    one with a ``land`` network, or evolved on the ``garden`` task set) lands, the others pass the flowers by.
+    one with a ``land`` network, or evolved on the ``garden`` task set) lands, the others pass the flowers by (a
+    designed controller does not land yet, and ``land=True`` with one is refused).
     """
 
     @checks.known_keywords
-    def __init__(self, n: int = 20, controller="monarch", *, seed: int = 0, n_flowers: int = 10, size_m: float = 6.0,
+    def __init__(self, n: int = 20, controller="designed", *, seed: int = 0, n_flowers: int = 10, size_m: float = 6.0,
                  speed_m_s: float = 1.5, flutter: float = 0.1, gust_m_s: float = 0.0, wind_to_m_s=None,
                  gust_vertical_m_s: float | None = None, dt_s: float = DT_S, n_strips: int = 8, n_chord: int = 2,
                  force_law: str | None = None, wind_from_m_s=None, wind_m_s=None, land: bool | None = None) -> None:
         self.n = checks.whole("the number of butterflies", n, 1, 500)
-        self.controller = controller if isinstance(controller, Controller3D) else load_controller(controller)
+        self.controller = (controller if isinstance(controller, (Controller3D, CompiledDesigned))
+                           else load_compiled(controller))
+        #: Whether a designed controller flies the garden (else a network).
+        self.designed = isinstance(self.controller, CompiledDesigned)
         self.seed = checks.whole("seed", seed, 0, 2**32 - 1)
         self.size_m = checks.number("garden size", size_m, 2.0, 100.0, unit="m")
         n_flowers = checks.whole("n_flowers", n_flowers, 2, 200)
@@ -135,8 +142,11 @@ class Garden(StepCounter):
         self.dt = checks.positive("time step dt_s", dt_s, "s")
         #: Whether the butterflies land on the flowers (else they pass them by).
         self.land = lands(self.controller) if land is None else checks.flag("land", land)
+        if self.land and self.designed:
+            raise UserError("a designed controller does not land yet: its garden passes the flowers by (land=False), "
+                            "or fly a network that lands.")
         wind = checks.one_wind("Garden", wind_to_m_s, wind_from_m_s, wind_m_s, "to") or (0.0, 0.0, 0.0)
-        speed_m_s = checks.positive("speed_m_s", speed_m_s, "m/s")
+        self._speed = speed_m_s = checks.positive("speed_m_s", speed_m_s, "m/s")
         weather = {"wind_to_m_s": wind, "gust_m_s": gust_m_s, "gust_vertical_m_s": gust_vertical_m_s,
                    "flutter": flutter}
         self._orders = [visiting_order(len(self.blossoms), self.seed * 1000 + i) for i in range(self.n)]
@@ -179,9 +189,11 @@ class Garden(StepCounter):
         self._k = 0
         rng = np.random.default_rng([self.seed, 3])
         ctl = self.controller
+        # a designed controller starts from its trim at the cruise speed, its kinematics following in one beat
+        command, omega_c = (ctl.start_command(self._speed), None) if self.designed else (ctl.base, ctl.omega_c_rad_s)
         self._datas = []
         for task in self.tasks:
-            d = mj3d.setup_data(self._phys, Kinematics(ctl.base, ctl.omega_c_rad_s), force_law=self._force_law,
+            d = mj3d.setup_data(self._phys, Kinematics(command, omega_c), force_law=self._force_law,
                                 n_strips=self._n_strips, n_chord=self._n_chord, animal=ctl.animal)
             a = rng.uniform(0, 2 * math.pi)
             start = np.array([0.6 * self.size_m * math.cos(a), 0.6 * self.size_m * math.sin(a), rng.uniform(-0.2, 0.2)])
@@ -190,8 +202,9 @@ class Garden(StepCounter):
             d.qpos[0:3] = start
             d.qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
             self._datas.append(d)
-        self._batch = Batch(self._phys, self._datas, self._task_arr.copy(), ctl, dt_s=self.dt,  # a landing changes it
-                            records=new_record(self.n, self._rows))
+        self._batch = Batch(self._phys, self._datas, self._task_arr.copy(),  # a landing changes the task arrays
+                            None if self.designed else ctl, dt_s=self.dt, records=new_record(self.n, self._rows),
+                            base=command.as_array() if self.designed else None, designed=ctl if self.designed else None)
         self._recs = self._batch.records
         # each butterfly's visits: (flower, touchdown time s, touchdown speed m/s, take-off time s or None), and
         # where it is in its order, since when it aims at its flower, how long it perches there
@@ -284,9 +297,11 @@ class Garden(StepCounter):
                 "perched": self._batch.tasks[:, t3.T_KIND] == t3.TASK_PERCH}
 
 
-def lands(controller: Controller3D) -> bool:
-    """Whether ``controller`` lands: it has a ``land`` behaviour network, or was evolved on the ``garden`` task set (or
-    started from one that was)."""
+def lands(controller) -> bool:
+    """Whether ``controller`` lands: a network with a ``land`` behaviour network, or evolved on the ``garden`` task set
+    (or started from one that was). A designed controller does not land yet."""
+    if not isinstance(controller, Controller3D):
+        return False
     if "land" in controller.modes:
         return True
     prov = controller.provenance or {}

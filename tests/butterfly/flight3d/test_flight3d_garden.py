@@ -37,6 +37,25 @@ def test_each_garden_butterfly_flies_what_its_own_flight_flies():
         np.testing.assert_allclose(g.data.xpos[body], state["position_m"][i], atol=1e-12)
 
 
+def test_a_garden_of_the_designed_controller_flies_each_butterfly_as_its_own_flight():
+    """The default garden flies the shipped designed controller (threaded, fly_designed_batch): each butterfly the
+    flight a Flight3D of the same controller gives it on its own task, and they pass flowers; it does not land."""
+    g = Garden(3, seed=2, flutter=0.1, gust_m_s=0.3)
+    assert g.designed and g.controller.name == "designed" and not g.land
+    starts = [d.qpos[:7].copy() for d in g._datas]
+    g.step(800)
+    state = g.state()
+    for i in range(3):
+        f = Flight3D(controller="designed", task=g.tasks[i])
+        f.data.qpos[:7] = starts[i]
+        f.step(800)
+        np.testing.assert_array_equal(f.state()["position_m"], state["position_m"][i])
+    g.step(int(round(9.0 / g.dt)))
+    assert g.state()["waypoints_passed"].min() >= 2  # ten seconds among flowers 1.2 m or more apart
+    with pytest.raises(UserError, match="does not land yet"):
+        Garden(2, land=True)
+
+
 def test_bad_garden_arguments_are_one_sentence():
     with pytest.raises(UserError, match="number of butterflies"):
         Garden(0, flight3d.Controller3D([10, 9], flight3d.pd_prior([10, 9])))
