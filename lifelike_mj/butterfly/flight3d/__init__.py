@@ -41,7 +41,8 @@ What is here, one layer on the next:
 * :mod:`~lifelike_mj.butterfly.flight3d.evolution`: :class:`FlightProblem3D`, :data:`TASK_SETS`, :func:`evolve`;
 * :mod:`~lifelike_mj.butterfly.flight3d.calibrate`: the calibrated wing law, fitted to a filmed monarch;
   :mod:`~lifelike_mj.butterfly.flight3d.averaged`: the butterfly averaged over its wing beat, trims, linear models and
-  modes; :mod:`~lifelike_mj.butterfly.flight3d.designed`: a controller designed from them (shipped as ``designed``, the
+  modes (:mod:`~lifelike_mj.butterfly.flight3d.controls`: its states, controls and natural envelope);
+  :mod:`~lifelike_mj.butterfly.flight3d.designed`: a controller designed from them (shipped as ``designed``, the
   default; :func:`load_compiled` reads a controller of either kind ready to fly);
 * :mod:`~lifelike_mj.butterfly.flight3d.parts`: :class:`Butterfly` and :class:`World`, what a :class:`Flight3D` is
   made of besides its controller and task;
@@ -69,7 +70,8 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "animals": ".", "measures": ".", "Animal": "animals", "ANIMALS": "animals", "animal": "animals",
     "level_measures": "measures", "default_base": "controllers", "strobe": ".",
     "flowers": ".", "landing": ".", "land": "tasks", "visit_flowers": "landing", "place_flowers": "flowers",
-    "calibrate": ".", "averaged": ".", "designed": ".", "designed_kernel": ".", "load_compiled": "designed_kernel",
+    "calibrate": ".", "averaged": ".", "controls": ".", "designed": ".", "designed_kernel": ".",
+    "load_compiled": "designed_kernel",
     "parts": ".", "Butterfly": "parts",
     "World": "parts",
 }, globals())
