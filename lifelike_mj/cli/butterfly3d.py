@@ -32,7 +32,8 @@ MAX_COURSES = 1000
 #: The --controller option's help: the shipped 3D controllers' names.
 CONTROLLER_HELP = f"a shipped 3D controller's name ({', '.join(shipped_names('butterfly3d'))}) or a file"
 #: The 3D controller flown unless another is named: the one designed from the averaged model (``design3d``); the
-#: commands that fly networks only (``garden``, ``land3d``, ``view3d``, ``evolve3d``) keep the evolved ``monarch``.
+#: commands that fly networks only (``land3d``, ``evolve3d``) and ``export`` (whose animation tests hold its flights)
+#: keep the evolved ``monarch``.
 DEFAULT_CONTROLLER = "designed"
 
 
@@ -662,16 +663,15 @@ def export_rigs(poses) -> list:
 
 
 def add_view_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--controller", default="monarch", help=CONTROLLER_HELP)
+    p.add_argument("--controller", default=DEFAULT_CONTROLLER, help=CONTROLLER_HELP + f" (default: {DEFAULT_CONTROLLER})")
     p.add_argument("--speed", type=num(0.1, 5.0, unit="m/s"), default=1.5, help="commanded speed, m/s, 0.1 to 5")
     p.add_argument("--duration", type=num(0, None, lo_open=True, unit="s"), default=None,
                    help="stop after this many seconds (default: run until the window is closed)")
 
 
 def view(args) -> None:
-    from lifelike_mj.butterfly.flight3d.controllers import load_controller
     from lifelike_mj.butterfly.flight3d.view import view_flight3d
     from lifelike_mj.cli import web_options
 
     web = web_options(args)
-    view_flight3d(load_controller(args.controller), args.speed, args.duration, web=web)
+    view_flight3d(_flown(args.controller), args.speed, args.duration, web=web)

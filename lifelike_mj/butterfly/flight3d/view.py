@@ -45,11 +45,11 @@ def flight3d_controls(flight) -> list:
     return [Control(key, label, act) for (key, label), act in zip(FLIGHT3D_KEYS, acts, strict=True)]
 
 
-def view_flight3d(controller="monarch", speed_m_s: float = 1.5, duration_s: float | None = None, flight=None,
+def view_flight3d(controller="designed", speed_m_s: float = 1.5, duration_s: float | None = None, flight=None,
                   web=None) -> None:
     """Fly a 3D butterfly in the MuJoCo viewer in about real time, level at ``speed_m_s``, the camera following
     it, with the keys of :func:`flight3d_controls` (steer it, change the wind).
-    ``controller``: a 3D controller (default ``monarch``);
+    ``controller``: a 3D controller of either kind, or its name or file (default ``designed``);
     ``flight``: a :class:`~lifelike_mj.butterfly.flight3d.flight.Flight3D` of your own instead; ``web``:
     :class:`~lifelike_mj.render.web.WebOptions` to serve MuJoCo's web viewer (no display needed)."""
     if web is None:

@@ -35,6 +35,25 @@ def test_a_new_altitude_course_and_wind_are_flown_to():
     assert 0.8 < s["velocity_m_s"][0] < 1.2  # carried along by the cross wind, through which it flies its course
 
 
+def test_the_default_designed_controller_follows_the_viewers_keys():
+    """``view butterfly3d`` flies the designed controller: a new altitude is climbed to at its guidance's 0.3 m/s and
+    held, a new course turned to, a cross wind carries it along while it keeps its heading through the air."""
+    f = Flight3D(controller="designed", task=flight3d.level(1.5))
+    _fly(f, 3.0)
+    f.set_reference(altitude_m=1.0)
+    assert abs(_fly(f, 3.0)["position_m"][2] - 1.0) > 0.05  # a climb at 0.3 m/s, not a jump
+    assert abs(_fly(f, 2.5)["position_m"][2] - 1.0) < 0.1
+    alts = [_fly(f, 0.5)["position_m"][2] for _ in range(4)]
+    assert max(abs(a - 1.0) for a in alts) < 0.05  # and holds it
+    f.set_reference(heading_rad=math.pi / 2)
+    s = _fly(f, 2.0)
+    assert abs(math.degrees(s["attitude_rad"][2]) - 90.0) < 10.0  # turned left within 2 s
+    f.set_wind((1.0, 0.0, 0.0))
+    s = _fly(f, 3.0)
+    assert abs(math.degrees(s["attitude_rad"][2]) - 90.0) < 10.0 and abs(s["position_m"][2] - 1.0) < 0.15
+    assert 0.8 < s["velocity_m_s"][0] < 1.2
+
+
 def test_bad_references_are_refused():
     f = Flight3D(controller=flight3d.withdrawn_file("wind"))
     with pytest.raises(UserError, match="altitude_m"):
