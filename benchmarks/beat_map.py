@@ -1,7 +1,7 @@
 """The butterfly's beat-to-beat map against its averaged model (issue 42): one wing beat of the simulator, linearised
 about level flight, beside the averaged linear model over the same beat.
 
-Run: ``python benchmarks/beat_map.py`` (about 20 s). Writes ``benchmarks/results/beat_map.json``.
+Run: ``python benchmarks/beat_map.py`` (about 7 s). Writes ``benchmarks/results/beat_map.json``.
 
 At 1, 1.5 and 2 m/s the butterfly is settled in level flight by the shipped designed controller (4 s), flown on to
 the start of a wing beat (phase 0), its kinematics set to the trim's, and from there flown open loop for one beat.
@@ -23,10 +23,14 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
 import scipy.linalg as sl
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _beat import beat_means, open_loop, schedule_row, settled  # noqa: E402  (shared with lateral_kick, beat_regulator)
 
 from lifelike_mj.io import write_json
 from lifelike_mj.machine import machine_info
@@ -45,25 +49,11 @@ def beat_map(speed: float, row: dict) -> dict:
 
     from lifelike_mj.butterfly.flight3d import controls as ct
     from lifelike_mj.butterfly.flight3d import model as mj3d
-    from lifelike_mj.butterfly.flight3d import tasks
     from lifelike_mj.butterfly.flight3d.designed import _log, quat2mat
-    from lifelike_mj.butterfly.flight3d.flight import Flight3D
-    from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS, KinematicsCommand
-    from lifelike_mj.butterfly.flight3d.parts import Butterfly
+    from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
 
     trim = np.array(row["command"], float)
-    f = Flight3D(controller="designed", task=tasks.level(speed))
-    f.step(int(round(4.0 / f.dt)))
-    prev = float(f.data.userdata[mj3d.U_PSI0]) % (2 * math.pi)
-    while True:  # on to phase 0
-        f.step(1)
-        now = float(f.data.userdata[mj3d.U_PSI0]) % (2 * math.pi)
-        if now < prev:
-            break
-        prev = now
-    s0 = {n: getattr(f.data, n).copy() for n in ("qpos", "qvel", "act", "userdata")}
-    s0["userdata"][mj3d.U_P0 : mj3d.U_P0 + N_PARAMS] = trim
-    s0["userdata"][mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS] = 0.0
+    s0 = settled(speed, phase_zero=True, trim=trim)
     r_ref = quat2mat(np.ascontiguousarray(s0["qpos"][3:7]))
     period = 1.0 / trim[0]
 
@@ -73,12 +63,8 @@ def beat_map(speed: float, row: dict) -> dict:
 
     def one_beat(dx: np.ndarray, du: np.ndarray) -> tuple[np.ndarray, float]:
         cmd = ct.command_from_controls(trim, du)
-        g = Flight3D(KinematicsCommand(*cmd), butterfly=Butterfly("monarch", force_law="calibrated"),
-                     task=tasks.level(speed))
-        for n in ("qpos", "qvel", "act", "userdata"):
-            getattr(g.data, n)[:] = s0[n]
+        g = open_loop(speed, cmd, s0)
         g.data.userdata[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS] = cmd
-        g.data.time = f.data.time
         r = r_ref @ ct.exp_rotation(dx[6:9])
         q = np.zeros(4)
         mujoco.mju_mat2Quat(q, r.reshape(-1))
@@ -112,35 +98,21 @@ def mean_control_effects(speed: float, row: dict, step: float = 0.02, beats: int
     the beat from settled flight, against the averaged model's (module docstring)."""
     from lifelike_mj.butterfly.flight3d import controls as ct
     from lifelike_mj.butterfly.flight3d import model as mj3d
-    from lifelike_mj.butterfly.flight3d import tasks
-    from lifelike_mj.butterfly.flight3d.flight import Flight3D
-    from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS, KinematicsCommand
-    from lifelike_mj.butterfly.flight3d.parts import Butterfly
+    from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
 
     trim = np.array(row["command"], float)
     period = 1.0 / trim[0]
+    snaps = {ph: settled(speed, ph * period) for ph in PHASES}  # one settled flight per phase, for every step
 
-    def flown(j: int, delta: float, extra_s: float) -> np.ndarray:
-        f = Flight3D(controller="designed", task=tasks.level(speed))
-        f.step(int(round((4.0 + extra_s) / f.dt)))
+    def flown(j: int, delta: float, ph: float) -> np.ndarray:
         u = np.zeros(9)
         u[j] = delta
         cmd = ct.command_from_controls(trim, u)
-        g = Flight3D(KinematicsCommand(*cmd), butterfly=Butterfly("monarch", force_law="calibrated"),
-                     task=tasks.level(speed))
-        for n in ("qpos", "qvel", "act", "userdata"):
-            getattr(g.data, n)[:] = getattr(f.data, n)
+        g = open_loop(speed, cmd, snaps[ph])
         g.data.userdata[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS] = trim
         g.data.userdata[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS] = 0.0
         g.data.userdata[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS] = cmd
-        g.data.time = f.data.time
-        n = int(round(period / g.dt))
-        rates = []
-        for _ in range(beats * n):
-            g.step(1)
-            rates.append(g.data.qvel[3:6].copy())
-        rates = np.array(rates)
-        return np.array([rates[k * n : (k + 1) * n].mean(axis=0) for k in range(beats)])
+        return beat_means(g, int(round(period / g.dt)), beats)[1]
 
     a, b = np.array(row["A"]), np.array(row["B"])
     wc = 2.0 * math.pi * trim[0]
@@ -152,7 +124,7 @@ def mean_control_effects(speed: float, row: dict, step: float = 0.02, beats: int
     for name, j in LATERAL.items():
         xs = np.array([sl.expm(z * t)[3:6, 27 + j] for t in ts])
         model = [xs[(ts >= k * period) & (ts < (k + 1) * period)].mean(axis=0).tolist() for k in range(beats)]
-        sim = {str(ph): ((flown(j, step, ph * period) - flown(j, -step, ph * period)) / (2.0 * step)).tolist()
+        sim = {str(ph): ((flown(j, step, ph) - flown(j, -step, ph)) / (2.0 * step)).tolist()
                for ph in PHASES}
         out[name] = {"averaged_beats_p_q_r": model, "simulator_beats_p_q_r_by_phase": sim}
     return out
@@ -167,7 +139,7 @@ def main(argv=None) -> None:
     spec = D.design(D.check_model(json.loads(MODEL.read_text()), str(MODEL)))
     rows = []
     for v in (1.0, 1.5, 2.0):
-        row = next(p for p in spec["schedule"] if abs(p["speed_m_s"] - v) < 1e-9)
+        row = schedule_row(spec, v)
         rows.append({**beat_map(v, row), "lateral_controls_beat_means": mean_control_effects(v, row)})
     write_json(args.out, {"provenance": provenance(benchmark="beat_map", model=str(MODEL),
                                                    state_steps=STATE_STEPS.tolist(), phases=list(PHASES)),

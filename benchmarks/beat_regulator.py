@@ -22,10 +22,14 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
 import scipy.linalg as sl
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _beat import PARTS, open_loop, schedule_row, settled  # noqa: E402  (shared with lateral_kick, beat_map)
 
 from lifelike_mj.io import write_json
 from lifelike_mj.machine import machine_info
@@ -51,27 +55,11 @@ class Plant:
     """The reference at phase 0, the identified map and the regulator (module docstring)."""
 
     def __init__(self, spec: dict) -> None:
-        from lifelike_mj.butterfly.flight3d import model as mj3d
-        from lifelike_mj.butterfly.flight3d import tasks
         from lifelike_mj.butterfly.flight3d.designed import quat2mat
-        from lifelike_mj.butterfly.flight3d.flight import Flight3D
-        from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
 
-        row = next(p for p in spec["schedule"] if abs(p["speed_m_s"] - SPEED) < 1e-9)
-        self.trim = np.array(row["command"], float)
+        self.trim = np.array(schedule_row(spec, SPEED)["command"], float)
         self.period = 1.0 / self.trim[0]
-        f = Flight3D(controller="designed", task=tasks.level(SPEED))
-        f.step(int(round(4.0 / f.dt)))
-        prev = float(f.data.userdata[mj3d.U_PSI0]) % (2 * math.pi)
-        while True:
-            f.step(1)
-            now = float(f.data.userdata[mj3d.U_PSI0]) % (2 * math.pi)
-            if now < prev:
-                break
-            prev = now
-        self.s0 = {n: getattr(f.data, n).copy() for n in ("qpos", "qvel", "act", "userdata")}
-        self.s0["userdata"][mj3d.U_P0 : mj3d.U_P0 + N_PARAMS] = self.trim
-        self.s0["userdata"][mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS] = 0.0
+        self.s0 = settled(SPEED, phase_zero=True, trim=self.trim)
         r0 = quat2mat(np.ascontiguousarray(self.s0["qpos"][3:7]))
         self.r_att = _rz(-_yaw(r0)) @ r0
         self.v_ref, self.w_ref = r0.T @ self.s0["qvel"][0:3], self.s0["qvel"][3:6].copy()
@@ -94,7 +82,7 @@ class Plant:
         from lifelike_mj.butterfly.flight3d import controls as ct
 
         dx = np.zeros(10) if dx is None else dx
-        for n in ("qpos", "qvel", "act", "userdata"):
+        for n in PARTS:  # the reference's state, on the flight's own clock
             getattr(g.data, n)[:] = self.s0[n]
         r = self.r_att @ ct.exp_rotation(dx[6:9])
         q = np.zeros(4)
@@ -105,13 +93,7 @@ class Plant:
         g.data.qvel[3:6] = self.w_ref + dx[3:6]
 
     def flight(self, command, task=None, controller=None):
-        from lifelike_mj.butterfly.flight3d import tasks
-        from lifelike_mj.butterfly.flight3d.flight import Flight3D
-        from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
-        from lifelike_mj.butterfly.flight3d.parts import Butterfly
-
-        return Flight3D(KinematicsCommand(*command), butterfly=Butterfly("monarch", force_law="calibrated"),
-                        task=task or tasks.level(SPEED), controller=controller)
+        return open_loop(SPEED, command, task=task, controller=controller)
 
     def one_beat(self, dx: np.ndarray, du: np.ndarray) -> np.ndarray:
         from lifelike_mj.butterfly.flight3d import controls as ct

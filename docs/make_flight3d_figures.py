@@ -19,17 +19,16 @@ OUT = Path(__file__).resolve().parent / "figures"
 CONTROLLER = "designed"
 
 
-def _fly(task, duration_s: float) -> tuple[dict, flight3d.Flight3D]:
+def _fly(task, duration_s: float) -> dict:
     """``task`` flown by the default controller for ``duration_s``, its path every 10 ms."""
     f = flight3d.Flight3D(controller=CONTROLLER, task=task)
-    rec = f.record(duration_s=duration_s, every=max(1, round(0.01 / f.dt)))
-    return rec, f
+    return f.record(duration_s=duration_s, every=max(1, round(0.01 / f.dt)))
 
 
 def turns() -> None:
     recs, labels = [], []
     for angle, label in ((90.0, "turn 90 deg left"), (-90.0, "turn 90 deg right"), (180.0, "turn 180 deg")):
-        rec, _ = _fly(flight3d.turn(angle, 2.0, 1.5), 8.0)
+        rec = _fly(flight3d.turn(angle, 2.0, 1.5), 8.0)
         recs.append(rec)
         labels.append(label)
         late = rec["t_s"] > 6.0
