@@ -26,7 +26,8 @@ from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
 #: The scalars of a flight's state, in ``st``'s order.
 ST_NAMES = ("k", "count", "head", "int_z", "int_v", "int_h", "v_hat_set", "v_hat_x", "v_hat_y", "v_hat_z", "w_hat_x",
             "w_hat_y", "w_hat_z", "heading_set", "heading", "airspeed_set", "airspeed", "altitude_set", "altitude",
-            "orbit_waypoint", "orbit_swept", "orbit_bearing", "orbit_bearing_set", "going_out", "out_heading")
+            "orbit_waypoint", "orbit_swept", "orbit_bearing", "orbit_bearing_set", "going_out", "out_heading",
+            "moment_set", "rates_before_x", "rates_before_y", "rates_before_z", "moment_x", "moment_y", "moment_z")
 #: Rows of the sample ring: more than any wing beat holds at the coarsest time step and slowest frequency allowed.
 N_BUF = 512
 #: A sample's columns: position (3), velocity (3), rates (3), attitude matrix (9, row major), stroke phase (1).
@@ -55,7 +56,7 @@ def constants() -> np.ndarray:
                             D.MAX_ATTITUDE_ERROR_RAD, D.MAX_CLIMB_M_S, D.TEMPLATE_RATE, D.TEMPLATE_MIN,
                             D.OBSERVER_HZ, D.OBSERVER_ZETA, D.APPROACH_MIN_M_S, D.APPROACH_PER_S, D.MIN_AIRSPEED_M_S,
                             D.MAX_AIRSPEED_M_S, D.MAX_SPEED_CHANGE_M_S2, D.MAX_TURN_RATE_RAD_S],
-                           D.INTEGRAL_LIMITS, lo, hi])
+                           D.INTEGRAL_LIMITS, lo, hi, [D.MOMENT_TAU_S], D.MOMENT_WEIGHTS])
 
 
 @njit(cache=True)
@@ -287,6 +288,24 @@ def control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins
     x[9] = zerr
     x[10:13] = st[3:6]
     u = -(K @ x)
+    # the moment observer (DesignedController.moment)
+    A = (1.0 - t) * As[i] + t * As[i + 1]
+    B = (1.0 - t) * Bs[i] + t * Bs[i + 1]
+    Aw = np.ascontiguousarray(A[3:6, 0:9])
+    Bw = np.ascontiguousarray(B[3:6])
+    if st[25] == 0.0:
+        st[25] = 1.0
+        st[26:29] = rates
+    else:
+        measured = (rates - st[26:29]) / t_ctrl
+        st[26:29] = rates
+        predicted = Aw @ np.ascontiguousarray(x[0:9]) + Bw @ np.ascontiguousarray(x[13 : 13 + nu])
+        st[29:32] = st[29:32] + min(1.0, t_ctrl / c[37]) * (measured - predicted - st[29:32])
+    W = np.diag(c[38:47] ** 2)
+    BwT = np.ascontiguousarray(Bw.T)
+    lateral = st[29:32].copy()
+    lateral[1] = 0.0  # the roll and yaw only
+    u = u - W @ BwT @ np.linalg.solve(Bw @ W @ BwT, lateral)
     change = np.empty(nu)
     for q in range(nu):
         change[q] = min(max(trim_u[q] + u[q], lo[q]), hi[q]) - trim_u[q]
