@@ -42,9 +42,10 @@ predicts from the state and the controls as flown, low-passed over :data:`MOMENT
 the body gets from elsewhere, and the controls are changed by the least change (weighed by :data:`MOMENT_WEIGHTS`)
 that the model says cancels its roll and yaw and leaves the pitch alone. (The pitch is left to the regulator: in level
 flight the model's pitch prediction is off by a steady 50 rad/s^2 or so, which the altitude and airspeed integrals
-already take up; cancelled as well, it slowed the recovery from a 30 deg nose-down upset from 2.4 beats to 11.) This is the disturbance estimation and cancellation with which Chirarattananon et al.
-(2017) halved a flapping robot's position error in wind, on the rotation; with the measured acceleration it is the
-incremental dynamic inversion of Smeur, de Croon and Chu (2016), which needs of the model only the controls' effect.
+already take up; cancelled as well, it slowed the recovery from a 30 deg nose-down upset from 2.4 beats to 11.) This
+is the disturbance estimation and cancellation with which Chirarattananon et al. (2017) halved a flapping robot's
+position error in wind, on the rotation; with the measured acceleration it is the incremental dynamic inversion of
+Smeur, de Croon and Chu (2016), which needs of the model only the controls' effect.
 
 **Saturation.** Every control is clipped to the natural envelope (:data:`~lifelike_mj.butterfly.flight3d.controls.ENVELOPE`
 for the symmetric ones, :data:`DIFFERENCE_LIMITS` for left against right); the integrals are bounded
