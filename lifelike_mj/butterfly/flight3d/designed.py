@@ -112,8 +112,11 @@ APPROACH_MIN_M_S, APPROACH_PER_S = 1.0, 1.0
 #: divergence was too fast for the loop (:func:`lagged_poles`: unstable at 0.5 and 0.75 m/s; flown, a 20 deg roll upset
 #: at 0.75 m/s left a roll cycle of +-36 deg); seen without that lag the loop holds them, but those trims are the model's
 #: least accurate (they speed up by 0.3 m/s in free flight) and a floor of 0.8 m/s completed fewer courses (19 of 20
-#: calm, seeds 100-119). Above 2 m/s the trims fly at the top of the frequency's range and leave nothing to climb with.
-MIN_AIRSPEED_M_S, MAX_AIRSPEED_M_S = 1.0, 2.0
+#: calm, seeds 100-119). The top is 2.25 m/s, the maximum-range speed measured for *Heliconius sara* (Srygley et al.
+#: 2023), where the level trim beats at 10.7 Hz: in a 1 m/s wind with gusts of 0.5 m/s on every axis (tuning seeds
+#: 100-139) a top of 1.75, 2, 2.25 and 2.5 m/s completed 1 of 16 (seeds 100-115), 19, 25 and 19 of 40 courses; faster
+#: than 2.25 the trims beat at the frequency's top and cannot climb.
+MIN_AIRSPEED_M_S, MAX_AIRSPEED_M_S = 1.0, 2.25
 #: The most the airspeed asked changes (m/s^2): a wind triangle that flips as a waypoint passes does not jerk the
 #: speed loop.
 MAX_SPEED_CHANGE_M_S2 = 1.0
@@ -127,8 +130,8 @@ MAX_TURN_RATE_RAD_S = 2.0
 #: the slowest airspeed and fastest turn rate has a radius of 0.5 m, wider than a course's 0.3 m), the butterfly flies
 #: straight out until ``ORBIT_OUT_M`` away (m), then homes on it again. Measured before: calm course 105 circled its
 #: second waypoint for 58 s; then completed in 18.4 s. A single turn swept was too eager in gusts (one of the ten
-#: held-out courses at Dryden's ratio lost); one and a half changed none of them. ``ORBIT_M`` is the diameter of the
-#: turn at the top airspeed (2 m/s at 2 rad/s): at 1 m, a waypoint 0.7 m to the side of the track at 1.5 m/s was
+#: held-out courses at Dryden's ratio lost); one and a half changed none of them. ``ORBIT_M`` is about the diameter of
+#: the widest turns (2 m at 2 m/s and 2 rad/s): at 1 m, a waypoint 0.7 m to the side of the track at 1.5 m/s was
 #: circled at 0.8-1.1 m for a minute, each pass beyond 1 m starting the count again.
 ORBIT_M, ORBIT_OUT_M, ORBIT_TURNS_RAD = 2.0, 2.5, 3.0 * math.pi
 
