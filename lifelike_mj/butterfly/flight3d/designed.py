@@ -44,8 +44,9 @@ that the model says cancels its roll and yaw and leaves the pitch alone. (The pi
 flight the model's pitch prediction is off by a steady 50 rad/s^2 or so, which the altitude and airspeed integrals
 already take up; cancelled as well, it slowed the recovery from a 30 deg nose-down upset from 2.4 beats to 11.) This
 is the disturbance estimation and cancellation with which Chirarattananon et al. (2017) halved a flapping robot's
-position error in wind, on the rotation; with the measured acceleration it is the incremental dynamic inversion of
-Smeur, de Croon and Chu (2016), which needs of the model only the controls' effect.
+position error in wind, here on the rotation: a disturbance observer on the model's angular acceleration, akin to the
+incremental dynamic inversion of Smeur, de Croon and Chu (2016), which measures the acceleration too but leans on the
+controls' effect alone.
 
 **Saturation.** Every control is clipped to the natural envelope (:data:`~lifelike_mj.butterfly.flight3d.controls.ENVELOPE`
 for the symmetric ones, :data:`DIFFERENCE_LIMITS` for left against right); the integrals are bounded
@@ -103,7 +104,8 @@ OBSERVER_HZ, OBSERVER_ZETA = 0.5, 1.0
 #: controls' sizes, Hz and rad, :data:`~lifelike_mj.butterfly.flight3d.controls.CONTROLS` order) by which its
 #: cancellation is shared among the controls (the least-squares change of the controls, each divided by its weight,
 #: that gives the opposite angular acceleration through the model's ``B``). Chosen on the tuning courses 100-119 among
-#: 0.05, 0.15 and 0.3 s: at 0.05 s Dryden's gusts completed 5 of 8, at 0.3 s 20 of 20.
+#: 0.05, 0.15 and 0.3 s: at 0.05 s Dryden's gusts completed 5 of 8, at 0.3 s 20 of 20; checked again with the 2.25 m/s
+#: top speed in gusts on every axis (seeds 100-139): 0.15, 0.3 and 0.6 s completed 23, 25 and 16 of 40.
 MOMENT_TAU_S = 0.3
 MOMENT_WEIGHTS = R_SCALES.copy()
 #: Near a waypoint the ground speed asked is at most ``APPROACH_MIN_M_S + APPROACH_PER_S * distance`` (m/s, 1/s).
@@ -131,8 +133,8 @@ MAX_TURN_RATE_RAD_S = 2.0
 #: straight out until ``ORBIT_OUT_M`` away (m), then homes on it again. Measured before: calm course 105 circled its
 #: second waypoint for 58 s; then completed in 18.4 s. A single turn swept was too eager in gusts (one of the ten
 #: held-out courses at Dryden's ratio lost); one and a half changed none of them. ``ORBIT_M`` is about the diameter of
-#: the widest turns (2 m at 2 m/s and 2 rad/s): at 1 m, a waypoint 0.7 m to the side of the track at 1.5 m/s was
-#: circled at 0.8-1.1 m for a minute, each pass beyond 1 m starting the count again.
+#: the widest turns (2 m at 2 m/s and 2 rad/s, 2.25 m at the top speed): at 1 m, a waypoint 0.7 m to the side of the
+#: track at 1.5 m/s was circled at 0.8-1.1 m for a minute, each pass beyond 1 m starting the count again.
 ORBIT_M, ORBIT_OUT_M, ORBIT_TURNS_RAD = 2.0, 2.5, 3.0 * math.pi
 
 

@@ -1,8 +1,8 @@
 """The designed controller (:mod:`~lifelike_mj.butterfly.flight3d.designed`) compiled: the same measurement, wind
-observer, guidance and gain-scheduled regulator as :class:`~lifelike_mj.butterfly.flight3d.designed.DesignedController`,
-step by step, in numba, on arrays a compiled loop can hold per flight (issue 42, point 2). The Python class is its
-twin and the reference: ``tests/butterfly/flight3d/test_flight3d_designed_kernel.py`` flies both and finds the same
-flight.
+observer, moment observer, guidance and gain-scheduled regulator as
+:class:`~lifelike_mj.butterfly.flight3d.designed.DesignedController`, step by step, in numba, on arrays a compiled
+loop can hold per flight (issue 42, point 2). The Python class is its twin and the reference:
+``tests/butterfly/flight3d/test_flight3d_designed_kernel.py`` flies both and finds the same flight.
 
 A flight's controller state is three arrays (:func:`new_state`): ``st`` (the scalars, :data:`ST_NAMES`), ``buf`` (the
 last wing beat's samples, a ring of :data:`N_BUF` rows: position, velocity, rates, attitude matrix, stroke phase) and
