@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from lifelike_mj.butterfly.flight3d import controls as ct
 from lifelike_mj.butterfly.flight3d import designed as D
 from lifelike_mj.butterfly.flight3d import designed_kernel as DK
 from lifelike_mj.butterfly.flight3d.flight import Flight3D
@@ -136,34 +137,55 @@ def test_a_residual_is_added_to_each_control_within_the_limits():
     assert target[5] + target[6] == pytest.approx(base[5] + base[6], abs=1e-12)
 
 
-def _yawed(spec, torque_n_m: float, tau_s: float, monkeypatch) -> tuple[float, float]:
-    """Level flight at 1.5 m/s, a steady yaw torque on the thorax from 2 s on: the mean |yaw| (deg) over the last 2 s
-    of 5, and the moment observer's yaw estimate (rad/s^2) at the end."""
+def _torqued(spec, axis: int, torque_n_m: float, tau_s: float, monkeypatch) -> tuple[float, float]:
+    """Level flight at 1.5 m/s, a steady torque about the world's ``axis`` (0: x, the roll at heading 0; 2: the
+    vertical, the yaw) on the thorax from 2 s on: the mean |roll| or |yaw| (deg) over the last 2 s of 5, and the moment
+    observer's estimate about the body's same axis (rad/s^2) at the end."""
     from lifelike_mj.butterfly.flight3d.flight import euler_from_quat
     from lifelike_mj.butterfly.flight3d.tasks import level
 
     monkeypatch.setattr(D, "MOMENT_TAU_S", tau_s)
     f = Flight3D(controller=DK.CompiledDesigned(spec), task=level(1.5))  # the constants are read here
     f.step(int(round(2.0 / f.dt)))
-    f.data.xfrc_applied[f.model.body("butterfly").id, 3:6] = (0.0, 0.0, torque_n_m)
-    yaws = []
+    f.data.xfrc_applied[f.model.body("butterfly").id, 3 + axis] = torque_n_m
+    angles = []
     while f.time < 5.0 - 1e-9:
         f.step(8)
-        yaws.append(euler_from_quat(f.data.qpos[3:7])[2])
-    yaws = np.degrees(np.unwrap(yaws))
-    return float(np.abs(yaws[len(yaws) // 3 :]).mean()), float(f._batch.designed_states[0][0][DK.ST_NAMES.index("moment_z")])
+        angles.append(euler_from_quat(f.data.qpos[3:7])[axis])
+    angles = np.degrees(np.unwrap(angles))
+    estimate = f._batch.designed_states[0][0][DK.ST_NAMES.index("moment_" + "xyz"[axis])]
+    return float(np.abs(angles[len(angles) // 3 :]).mean()), float(estimate)
 
 
-def test_the_moment_observer_finds_a_steady_torque_and_cancels_it(spec, monkeypatch):
-    """A yaw torque of 3e-7 N m (4.7 rad/s^2 on the averaged model's yaw inertia at 1.5 m/s) that the model does not
-    know: the observer's yaw estimate moves by about that much (measured 1.3 times: the torque is about the world's
-    vertical, the body pitched 23 deg), and the heading holds four times closer than with the observer held at zero
-    (measured 0.08 deg against 0.36 deg). Its sign is what this checks; which axes are cancelled, the upset tests."""
-    inertia = json.loads(MODEL.read_text())["points"]
-    izz = next(p["inertia_kg_m2"][2][2] for p in inertia if p["speed_m_s"] == 1.5 and p["climb_m_s"] == 0.0)
+@pytest.mark.parametrize("axis", [0, 2], ids=["roll", "yaw"])
+def test_the_moment_observer_finds_a_steady_torque_and_cancels_it(spec, axis, monkeypatch):
+    """A torque of 3e-7 N m that the model does not know, about the roll axis (5.0 rad/s^2 on the averaged model's
+    roll inertia at 1.5 m/s) or the vertical (4.7 rad/s^2 on its yaw inertia): the observer's estimate about that axis
+    moves by about torque / inertia (measured 0.78 times in roll, 1.3 in yaw: the torque is about the world's axes,
+    the body pitched 23 deg), and the roll or heading holds more than twice as close as with the observer held at zero
+    (measured 0.14 against 0.35 deg in roll, 0.08 against 0.36 deg in yaw). Its sign is what this checks; which axes
+    are cancelled, the upset tests and the test below."""
+    points = json.loads(MODEL.read_text())["points"]
+    inertia = next(p["inertia_kg_m2"][axis][axis] for p in points if p["speed_m_s"] == 1.5 and p["climb_m_s"] == 0.0)
     torque, tau = 3e-7, D.MOMENT_TAU_S
-    off_yaw, _ = _yawed(spec, torque, 1e12, monkeypatch)
-    on_yaw, on_est = _yawed(spec, torque, tau, monkeypatch)
-    _, calm_est = _yawed(spec, 0.0, tau, monkeypatch)
-    assert 0.5 < (on_est - calm_est) / (torque / izz) < 2.0
-    assert on_yaw < 0.5 * off_yaw
+    off_angle, _ = _torqued(spec, axis, torque, 1e12, monkeypatch)
+    on_angle, on_est = _torqued(spec, axis, torque, tau, monkeypatch)
+    _, calm_est = _torqued(spec, axis, 0.0, tau, monkeypatch)
+    assert 0.5 < (on_est - calm_est) / (torque / inertia) < 2.0
+    assert on_angle < 0.5 * off_angle
+
+
+def test_the_moment_observers_correction_cancels_roll_and_yaw_and_leaves_the_symmetric_controls(spec):
+    """The correction (``DesignedController.moment``) is the least change of the controls whose angular acceleration
+    through the model's ``B`` is the estimate's roll and yaw, negated, and none in pitch; the model's roll and yaw rows
+    hold only the left-right differences (its symmetry), so the symmetric controls (frequency, offset, amplitude,
+    feathering mean and amplitude, abdomen) stay where they are, to a rounding of the model's near-zero entries."""
+    ctl = D.DesignedController(spec)
+    A, B = ctl._at(1.5, "A"), ctl._at(1.5, "B")
+    ctl.moment_hat = np.array([2.0, -3.0, 1.5])  # rad/s^2: the estimate as the observer holds it
+    u = ctl.moment(np.zeros(3), np.zeros(D.N_AUG), A, B, 0.01)  # its first call sets the rates, keeps the estimate
+    np.testing.assert_allclose(B[3:6] @ u, [-2.0, 0.0, -1.5], rtol=0.0, atol=1e-9)
+    differences = [i for i, n in enumerate(ct.CONTROLS) if n.endswith("_difference")]
+    symmetric = [i for i in range(len(ct.CONTROLS)) if i not in differences]
+    assert np.abs(u[differences]).max() > 1e-4
+    assert np.abs(u[symmetric]).max() < 1e-5 * np.abs(u[differences]).max()
