@@ -367,6 +367,9 @@ class DesignedController:
         self.force_law = spec.get("force_law", "calibrated")
         self.q_scales, self.r_scales = spec.get("q_scales"), spec.get("r_scales")
         self.schedule = spec["schedule"]
+        #: The landing's manoeuvres (:mod:`~lifelike_mj.butterfly.flight3d.perching`), flown by the compiled loop only;
+        #: ``None`` without.
+        self.landing = spec.get("landing")
         # the schedule as arrays, made once: what each control step interpolates
         self._speeds = np.array([s["speed_m_s"] for s in self.schedule])
         self._table = {k: np.array([s[k] for s in self.schedule], float)
@@ -430,6 +433,8 @@ class DesignedController:
                "schedule": self.schedule}
         if self.q_scales is not None:
             out["q_scales"], out["r_scales"] = list(self.q_scales), list(self.r_scales)
+        if self.landing is not None:
+            out["landing"] = self.landing
         if self.name:
             out["name"] = self.name
         out["provenance"] = self.provenance
@@ -649,6 +654,19 @@ def json_schema() -> dict:
                      "description": "per level trim, by rising airspeed: the trim, its linear model and the gain"},
         "q_scales": vector(N_PLANT, "Bryson's scales of the states it was designed with"),
         "r_scales": vector(nu, "Bryson's scales of the controls it was designed with"),
+        "landing": {"type": "object", "required": ["manoeuvres"], "description":
+                    "the landing: manoeuvres shot per phase of the wing beat and their tracking (flight3d.perching)",
+                    "properties": {"manoeuvres": {"type": "array", "maxItems": 64, "items": {
+                        "type": "object", "required": ["phase_rad", "start_m", "states", "commands", "gains"],
+                        "properties": {
+                            "phase_rad": number("rad: the wing beat's phase at the start", 0.0, 2 * math.pi),
+                            "start_m": number("m: the start's distance before the flower's axis", 0.0, 10.0),
+                            "states": {"type": "array", "maxItems": 2001,
+                                       "description": "the nominal's state at each control step and its end"},
+                            "commands": {"type": "array", "maxItems": 2000,
+                                         "description": "its kinematics at each control step"},
+                            "gains": {"type": "array", "maxItems": 2000,
+                                      "description": "the tracking's gain at each control step"}}}}}},
         "provenance": {"type": "object"},
     }
     return document_schema(FORMAT, "lifelike-mj 3D butterfly controller, designed", props,
@@ -676,6 +694,10 @@ def controller_from_dict(data: object, name: str = "") -> DesignedController:
         raise UserError(f"{where}: the schedule's airspeeds must rise from one trim to the next, got {speeds}.")
     for p in d["schedule"]:
         KinematicsCommand(*p["command"])  # its own sentence for a command out of bounds
+    if "landing" in d:
+        from lifelike_mj.butterfly.flight3d.perching import check_landing
+
+        check_landing(d["landing"], where)
     return DesignedController(d, name=name, provenance=d.get("provenance"))
 
 

@@ -20,6 +20,7 @@ from numba import njit, prange
 from lifelike_mj.butterfly.flight3d import designed as D
 from lifelike_mj.butterfly.flight3d import loop as L
 from lifelike_mj.butterfly.flight3d import model as mj3d
+from lifelike_mj.butterfly.flight3d import perching as PE
 from lifelike_mj.butterfly.flight3d.designed import _log
 from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
 
@@ -27,7 +28,11 @@ from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
 ST_NAMES = ("k", "count", "head", "int_z", "int_v", "int_h", "v_hat_set", "v_hat_x", "v_hat_y", "v_hat_z", "w_hat_x",
             "w_hat_y", "w_hat_z", "heading_set", "heading", "airspeed_set", "airspeed", "altitude_set", "altitude",
             "orbit_waypoint", "orbit_swept", "orbit_bearing", "orbit_bearing_set", "going_out", "out_heading",
-            "moment_set", "rates_before_x", "rates_before_y", "rates_before_z", "moment_x", "moment_y", "moment_z")
+            "moment_set", "rates_before_x", "rates_before_y", "rates_before_z", "moment_x", "moment_y", "moment_z",
+            "land_on", "land_bin", "land_k", "land_yaw", "land_x", "land_y", "land_z", "final_set", "final_yaw",
+            "outbound")
+#: Where the landing's scalars start in ``st`` (:data:`ST_NAMES`).
+ST_LAND = ST_NAMES.index("land_on")
 #: Rows of the sample ring: more than any wing beat holds at the coarsest time step and slowest frequency allowed.
 N_BUF = 512
 #: A sample's columns: position (3), velocity (3), rates (3), attitude matrix (9, row major), stroke phase (1).
@@ -57,6 +62,140 @@ def constants() -> np.ndarray:
                             D.OBSERVER_HZ, D.OBSERVER_ZETA, D.APPROACH_MIN_M_S, D.APPROACH_PER_S, D.MIN_AIRSPEED_M_S,
                             D.MAX_AIRSPEED_M_S, D.MAX_SPEED_CHANGE_M_S2, D.MAX_TURN_RATE_RAD_S],
                            D.INTEGRAL_LIMITS, lo, hi, [D.MOMENT_TAU_S], D.MOMENT_WEIGHTS])
+
+
+def landing_tables(landing: dict | None) -> tuple[np.ndarray, ...]:
+    """A designed controller's landing (its file's ``landing``: :func:`~lifelike_mj.butterfly.flight3d.perching.
+    design_landing`) as the arrays the compiled loop reads: per manoeuvre its start distance (m), length (control
+    steps) and phase (rad) (``lm``), its nominal states (``ls``, :func:`~lifelike_mj.butterfly.flight3d.perching.
+    state_vector`), commands (``lu``) and gains (``lk``), padded to the longest; and the landing's constants
+    (``lc``). Without a landing, zero manoeuvres."""
+    lc = np.array([PE.RISE_M, PE.APPROACH_M_S, PE.START_WINDOW_M, PE.START_SIDE_M, PE.START_HEIGHT_M,
+                   PE.MAX_GLIDE_S / (PE.EVERY * 1.0 / 800.0), PE.BELOW_M, *PE.CONTROL_SCALE, PE.CONTROL_LIMIT,
+                   PE.FINAL_LOOKAHEAD_M, PE.FINAL_MIN_M, PE.FINAL_OUT_M])
+    bins = (landing or {}).get("manoeuvres") or []
+    n = len(bins)
+    t_max = max([len(b["commands"]) for b in bins] + [1])
+    lm, ls = np.zeros((n, 3)), np.zeros((n, t_max + 1, PE.N_STATE + 1))
+    lu, lk = np.zeros((n, t_max, N_PARAMS)), np.zeros((n, t_max, PE.N_CONTROL, PE.N_STATE))
+    for i, b in enumerate(bins):
+        t = len(b["commands"])
+        lm[i] = (b["start_m"], t, b["phase_rad"])
+        ls[i, : t + 1] = b["states"]
+        lu[i, :t] = b["commands"]
+        lk[i, :t] = b["gains"]
+    return lm, ls, lu, lk, lc
+
+
+@njit(cache=True)
+def trigger(st, task, qpos, qvel, psi, lm, lc):
+    """Whether a landing's manoeuvre starts now (then marked in ``st``): the one for the eighth of the beat the phase
+    ``psi`` is nearest, if the thorax is between its start distance and :data:`~lifelike_mj.butterfly.flight3d.
+    perching.START_WINDOW_M` nearer the flower's axis, flying toward it within ``START_SIDE_M`` and at the
+    approach's height within ``START_HEIGHT_M``. The manoeuvre's frame: the flower's standing point, its ``x`` the
+    bearing to the axis now."""
+    b = L.T_ROW0
+    sx, sy, sz = task[b], task[b + 1], task[b + 2] + task[b + 3]
+    tx, ty = sx - qpos[0], sy - qpos[1]
+    dist = math.sqrt(tx * tx + ty * ty)
+    nb = lm.shape[0]
+    two_pi = 2.0 * math.pi
+    j = int(math.floor((psi % two_pi) / (two_pi / nb) + 0.5)) % nb
+    if dist > lm[j, 0] or dist < lm[j, 0] - lc[2]:
+        return False
+    sp = math.sqrt(qvel[0] * qvel[0] + qvel[1] * qvel[1])
+    if sp < 0.5 or abs(qvel[0] * ty - qvel[1] * tx) / sp > lc[3] or abs(qpos[2] - sz - lc[0]) > lc[4]:
+        return False
+    s0 = ST_LAND
+    st[s0], st[s0 + 1], st[s0 + 2], st[s0 + 3] = 1.0, j, 0.0, math.atan2(ty, tx)
+    st[s0 + 4], st[s0 + 5], st[s0 + 6] = sx, sy, sz
+    return True
+
+
+@njit(cache=True)
+def approach(st, task, qpos, lm, lc, wp):
+    """The landing's approach (its waypoint into ``wp``): a straight final toward the flower's axis at the approach's
+    height (:data:`~lifelike_mj.butterfly.flight3d.perching.RISE_M` above the standing point), followed by aiming
+    ``FINAL_LOOKAHEAD_M`` ahead of the body's foot on it. The final's line is the bearing to the axis at the landing's
+    start; begun nearer than ``FINAL_MIN_M``, the butterfly first flies out along it, away from the flower, to
+    ``FINAL_OUT_M``, and turns back. A final that passes every manoeuvre's start without one starting goes around:
+    out beyond the flower, then back along the line the other way."""
+    b = L.T_ROW0
+    sx, sy, sz = task[b], task[b + 1], task[b + 2] + task[b + 3]
+    f0 = ST_LAND + 7
+    if st[f0] == 0.0:
+        st[f0], st[f0 + 1] = 1.0, math.atan2(sy - qpos[1], sx - qpos[0])
+        st[f0 + 2] = 1.0 if math.hypot(sx - qpos[0], sy - qpos[1]) < lc[15] else 0.0
+    c, s = math.cos(st[f0 + 1]), math.sin(st[f0 + 1])
+    along = (sx - qpos[0]) * c + (sy - qpos[1]) * s
+    if st[f0 + 2] != 0.0:
+        if along >= lc[16] - 0.2:
+            st[f0 + 2] = 0.0
+        else:
+            wp[0], wp[1], wp[2] = sx - lc[16] * c, sy - lc[16] * s, sz + lc[0]
+            return
+    if along < lm[:, 0].min() - lc[2] - 0.05:  # every start passed: around again, the other way
+        st[f0 + 1] = st[f0 + 1] + math.pi
+        st[f0 + 2] = 1.0
+        wp[0], wp[1], wp[2] = sx + lc[16] * c, sy + lc[16] * s, sz + lc[0]
+        return
+    ahead = max(along - lc[14], 0.0)
+    wp[0], wp[1], wp[2] = sx - ahead * c, sy - ahead * s, sz + lc[0]
+
+
+@njit(cache=True)
+def tracked(st, ud, qpos, qvel, lm, ls, lu, lk, lc, out):
+    """The command (into ``out``) of a landing's manoeuvre under way (``st``'s landing scalars): its nominal's
+    command at this control step less its gain times the state's error from the nominal
+    (:func:`~lifelike_mj.butterfly.flight3d.perching.state_error`, the state taken in the manoeuvre's frame), each
+    control within :data:`~lifelike_mj.butterfly.flight3d.perching.CONTROL_LIMIT` of its scales; after the nominal's
+    end, its last command. A manoeuvre that has glided on ``MAX_GLIDE_S`` or sunk ``BELOW_M`` under the standing point
+    without touching down is given up (the approach flies again)."""
+    s0 = ST_LAND
+    j, k = int(st[s0 + 1]), int(st[s0 + 2])
+    t = int(lm[j, 1])
+    if k >= t + lc[5] or qpos[2] < st[s0 + 6] - lc[6]:
+        st[s0] = 0.0
+        return
+    st[s0 + 2] = k + 1
+    if k >= t:
+        for i in range(N_PARAMS):
+            out[i] = lu[j, t - 1, i]
+        return
+    cy, sy = math.cos(st[s0 + 3]), math.sin(st[s0 + 3])
+    rx, ry, rz = qpos[0] - st[s0 + 4], qpos[1] - st[s0 + 5], qpos[2] - st[s0 + 6]
+    nom = ls[j, k]
+    e = np.empty(PE.N_STATE)
+    e[0] = cy * rx + sy * ry - nom[0]
+    e[1] = -sy * rx + cy * ry - nom[1]
+    e[2] = rz - lc[0] - nom[2]
+    e[3] = cy * qvel[0] + sy * qvel[1] - nom[3]
+    e[4] = -sy * qvel[0] + cy * qvel[1] - nom[4]
+    e[5] = qvel[2] - nom[5]
+    # the attitude in the manoeuvre's frame: the yaw taken off, then the rotation from the nominal's
+    h = -0.5 * st[s0 + 3]
+    qz = np.array([math.cos(h), 0.0, 0.0, math.sin(h)])
+    q = qpos[3:7]
+    ql = np.array([qz[0] * q[0] - qz[3] * q[3], qz[0] * q[1] - qz[3] * q[2], qz[0] * q[2] + qz[3] * q[1],
+                   qz[0] * q[3] + qz[3] * q[0]])
+    e[6:9] = _log(D.quat2mat(nom[6:10]).T @ D.quat2mat(ql))
+    for i in range(3):
+        e[9 + i] = qvel[3 + i] - nom[10 + i]
+    for i in range(5):
+        e[12 + i] = qpos[int(ud[mj3d.U_DRIVEN_Q + i])] - nom[13 + i]
+        e[17 + i] = qvel[int(ud[mj3d.U_DRIVEN_D + i])] - nom[18 + i]
+    e[22] = (ud[mj3d.U_PSI0] - nom[23] + math.pi) % (2.0 * math.pi) - math.pi
+    for i in range(N_PARAMS):
+        e[23 + i] = ud[mj3d.U_P0 + i] - nom[24 + i]
+        e[23 + N_PARAMS + i] = ud[mj3d.U_DP0 + i] - nom[24 + N_PARAMS + i]
+    u = -(np.ascontiguousarray(lk[j, k]) @ e)
+    full = np.zeros(9)
+    for i in range(PE.N_CONTROL):
+        lim = lc[13] * lc[7 + i]
+        full[PE.TRACKED_CONTROLS[i]] = min(max(u[i], -lim), lim)
+    p = _command_from_controls(np.ascontiguousarray(lu[j, k]), full)
+    for i in range(N_PARAMS):
+        out[i] = p[i]
 
 
 @njit(cache=True)
@@ -230,12 +369,13 @@ def control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins
         st[10:13] = st[10:13] + t_ctrl * dw
         wind = st[10:13].copy()
     # guidance (DesignedController.references)
-    if kind == 0:
+    if kind == 0 or kind == 2:  # a waypoint (2: at the task's speed to the end, a landing's approach)
         to = waypoint[0:2] - pos[0:2]
         dist = math.sqrt(to[0] ** 2 + to[1] ** 2)
         d = to / dist if dist > 1e-9 else np.array([1.0, 0.0])
-        d = D.orbit_direction(st[19:25], reference[0], to, dist, d, st[14], st[13] != 0.0)  # circling
-        gs = min(task_speed, app_min + app_per * dist)
+        if kind == 0:
+            d = D.orbit_direction(st[19:25], reference[0], to, dist, d, st[14], st[13] != 0.0)  # circling
+        gs = task_speed if kind == 2 else min(task_speed, app_min + app_per * dist)
         target, asked = _wind_triangle(d, gs, wind[0:2], vmin, vmax)
         altitude_asked = waypoint[2]
     else:
@@ -340,6 +480,9 @@ class CompiledDesigned:
         self.animal = spec.get("animal", "monarch")
         self.force_law = spec.get("force_law", "calibrated")
         self.tables, self.constants = tables(spec), constants()
+        #: The landing's manoeuvres as arrays (:func:`landing_tables`; none: zero of them, no landing).
+        self.landing = landing_tables(spec.get("landing"))
+        self.spec_landing = spec.get("landing")
 
     def start_command(self, speed_m_s: float = 1.5):
         """The trim's kinematics at ``speed_m_s`` (``DesignedController.start_command``)."""
@@ -350,7 +493,8 @@ class CompiledDesigned:
     @classmethod
     def of(cls, controller: D.DesignedController) -> CompiledDesigned:
         """The same controller as ``controller`` (its schedule, rate, name and provenance), for the compiled loop."""
-        spec = {"animal": controller.animal, "force_law": controller.force_law, "schedule": controller.schedule}
+        spec = {"animal": controller.animal, "force_law": controller.force_law, "schedule": controller.schedule,
+                "landing": getattr(controller, "landing", None)}
         return cls(spec, controller.every, controller.name, controller.provenance)
 
     def advance(self, batch, n_steps: int, path: np.ndarray, path_every: int) -> None:
@@ -361,7 +505,7 @@ class CompiledDesigned:
 
         m = batch.model
         sts, bufs, tmpls = batch.designed_states
-        args = (*self.tables, self.constants, D.N_BINS)
+        args = (*self.tables, self.constants, D.N_BINS, *self.landing)
         if batch.n == 1:
             fly_designed(m._address, int(batch.ptrs[0]), mjabi.offsets_tuple(), m.nq, m.nv, n_steps, batch.dt,
                          self.every, batch.tasks[0], batch.records[0], path, path_every, batch.tumble_rad, batch.base,
@@ -381,7 +525,7 @@ class CompiledDesigned:
 
         m = batch.model
         sts, bufs, tmpls = batch.designed_states
-        args = (*self.tables, self.constants, D.N_BINS)
+        args = (*self.tables, self.constants, D.N_BINS, *self.landing)
         scale = D.RESIDUAL_SCALE
         going = np.zeros(batch.n, dtype=np.bool_)
         if batch.n == 1:
@@ -418,7 +562,7 @@ def _scratch():
 
 @njit(cache=True)
 def _head(ud, qpos, qvel, time, dt, every, task, rec, st, buf, tmpl, wp, ref, baseline, speeds, pitches, v0s, Ks,
-          commands, As, Bs, c, n_bins):
+          commands, As, Bs, c, n_bins, lm, ls, lu, lk, lc):
     """A step's first part for the designed controller: its sample (:func:`sample`) and, every ``every`` samples, its
     command (:func:`control`, the waypoint or the schedule's references the task gives) into ``baseline`` and the
     kinematics' target. Returns whether a new command was set (a control step: a residual policy's decision)."""
@@ -428,6 +572,25 @@ def _head(ud, qpos, qvel, time, dt, every, task, rec, st, buf, tmpl, wp, ref, ba
     if (int(st[0]) - 1) % every != 0:
         return False
     kind = int(task[L.T_KIND])
+    if kind == L.TASK_PERCH:  # perched: the perch's kinematics stay (loop.perch_command)
+        return False
+    if kind == L.TASK_LAND and lm.shape[0] > 0:
+        if st[ST_LAND] == 0.0:
+            trigger(st, task, qpos, qvel, ud[mj3d.U_PSI0], lm, lc)
+        if st[ST_LAND] != 0.0:
+            tracked(st, ud, qpos, qvel, lm, ls, lu, lk, lc, baseline)
+            if st[ST_LAND] != 0.0:
+                for j in range(N_PARAMS):
+                    ud[mj3d.U_TARGET + j] = baseline[j]
+                return True
+        approach(st, task, qpos, lm, lc, wp)
+        cmd = control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins,
+                      ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS].copy(), ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS].copy(), dt,
+                      every, 2, wp, lc[1], ref, n_beat)
+        for j in range(N_PARAMS):
+            baseline[j] = cmd[j]
+            ud[mj3d.U_TARGET + j] = cmd[j]
+        return True
     if kind == L.TASK_WAYPOINTS:
         i = min(int(rec[L.R_PASSED]), int(task[L.T_ROWS]) - 1)
         b = L.T_ROW0 + 4 * i
@@ -453,7 +616,7 @@ def _head(ud, qpos, qvel, time, dt, every, task, rec, st, buf, tmpl, wp, ref, ba
 
 @njit(cache=True)
 def fly_designed(mptr, dptr, off, nq, nv, n_steps, dt, every, task, rec, path, path_every, tumble_rad, base, st, buf,
-                 tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins):
+                 tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins, lm, ls, lu, lk, lc):
     """:func:`~lifelike_mj.butterfly.flight3d.loop.fly_steps` with the designed controller in place of the network:
     each step :func:`_head` (the sample, and every ``every`` steps a new command), then the loop's step as for every
     controller (gusts, air, references, one ``mj_step``, the kinematics advanced)."""
@@ -466,7 +629,7 @@ def fly_designed(mptr, dptr, off, nq, nv, n_steps, dt, every, task, rec, path, p
         if rec[L.R_DIVERGED] >= 0 or rec[L.R_TUMBLED] >= 0:
             return
         _head(ud, qpos, qvel, time, dt, every, task, rec, st, buf, tmpl, wp, ref, baseline, speeds, pitches, v0s, Ks,
-              commands, As, Bs, c, n_bins)
+              commands, As, Bs, c, n_bins, lm, ls, lu, lk, lc)
         tumbled, n_path = L._before(ud, qpos, qvel, time, dt, task, rec, obs, opts, ground, path, path_every,
                                     n_path, tumble_rad, base)
         if tumbled:
@@ -494,7 +657,7 @@ def residual_command(baseline, action, scale, lo, hi, target):
 
 @njit(cache=True)
 def decide_designed(mptr, dptr, off, nq, nv, n_max, dt, every, action, act, scale, task, rec, obs, tumble_rad, base,
-                    st, buf, tmpl, baseline, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins):
+                    st, buf, tmpl, baseline, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins, lm, ls, lu, lk, lc):
     """:func:`~lifelike_mj.butterfly.flight3d.loop.to_decision` for the designed controller with a residual policy on
     top: with ``act``, the designed command of this decision (``baseline``) plus the residual ``action``
     (:func:`residual_command`, ``scale`` per control) becomes the kinematics' target; then the steps go on, as
@@ -513,7 +676,7 @@ def decide_designed(mptr, dptr, off, nq, nv, n_max, dt, every, action, act, scal
             return False
     while True:
         decision = _head(ud, qpos, qvel, time, dt, every, task, rec, st, buf, tmpl, wp, ref, baseline, speeds,
-                         pitches, v0s, Ks, commands, As, Bs, c, n_bins)
+                         pitches, v0s, Ks, commands, As, Bs, c, n_bins, lm, ls, lu, lk, lc)
         tumbled, _ = L._before(ud, qpos, qvel, time, dt, task, rec, obs, opts, ground, none, 0, 0, tumble_rad, base)
         if tumbled:
             return False
@@ -526,20 +689,20 @@ def decide_designed(mptr, dptr, off, nq, nv, n_max, dt, every, action, act, scal
 @njit(cache=True, parallel=True)
 def decide_designed_batch(mptr, dptrs, off, nq, nv, n_max, dt, every, actions, act, scale, tasks, recs, obs,
                           tumble_rad, base, sts, bufs, tmpls, baselines, speeds, pitches, v0s, Ks, commands, As, Bs, c,
-                          n_bins, going):
+                          n_bins, lm, ls, lu, lk, lc, going):
     """:func:`decide_designed` for many butterflies at once (threads over the copies), each with its own state and
     action row; copies with ``act[i]`` false only fly on to their next command."""
     for i in prange(len(dptrs)):
         going[i] = decide_designed(mptr, dptrs[i], off, nq, nv, n_max, dt, every, actions[i], act[i], scale, tasks[i],
                                    recs[i], obs[i], tumble_rad, base, sts[i], bufs[i], tmpls[i], baselines[i], speeds,
-                                   pitches, v0s, Ks, commands, As, Bs, c, n_bins)
+                                   pitches, v0s, Ks, commands, As, Bs, c, n_bins, lm, ls, lu, lk, lc)
 
 
 @njit(cache=True, parallel=True)
 def fly_designed_batch(mptr, dptrs, off, nq, nv, n_steps, dt, every, tasks, recs, tumble_rad, base, sts, bufs, tmpls,
-                       speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins):
+                       speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins, lm, ls, lu, lk, lc):
     """:func:`fly_designed` for many butterflies at once (threads over the copies), each with its own state."""
     none = np.empty((0, 7))
     for i in prange(len(dptrs)):
         fly_designed(mptr, dptrs[i], off, nq, nv, n_steps, dt, every, tasks[i], recs[i], none, 0, tumble_rad, base,
-                     sts[i], bufs[i], tmpls[i], speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins)
+                     sts[i], bufs[i], tmpls[i], speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins, lm, ls, lu, lk, lc)

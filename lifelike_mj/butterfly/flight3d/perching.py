@@ -1,0 +1,429 @@
+"""Landing on a flower by a manoeuvre shot in advance and tracked in closed loop (issue 42, point 3): the designed
+controller's landing.
+
+The approach (:mod:`~lifelike_mj.butterfly.flight3d.designed_kernel`) flies level at :data:`APPROACH_M_S` toward the
+flower's axis, :data:`RISE_M` above the butterfly's standing point on the blossom. Nearing it, at a distance that
+depends on where the wing beat then is, a **manoeuvre** starts: a short open-loop sequence of kinematics (two held
+symmetric commands, then the wings spread and held) that brings the body down onto the blossom slowly and nose up, as
+Cory and Tedrake's perching glider brings itself onto its perch (Cory & Tedrake 2008, AIAA 2008-7256). One manoeuvre
+(a *nominal*) is shot per eighth of the wing beat at which it may start (:data:`N_BINS`), each by CMA-ES
+(Hansen 2016) from settled level flight at that phase (:func:`shoot`).
+
+Open loop, a manoeuvre lands only from the entry it was shot from; flown from the entries the approach delivers it
+is **tracked** by a time-varying LQR (Tedrake 2009; Moore, Cory & Tedrake 2014, *Bioinspir. Biomim.* 9:025013):
+along the nominal the simulator's map over one control step (10 ms) is linearised by central differences, in
+:data:`N_STATE` states (the thorax's position and velocity relative to the flower, its attitude and rates, the five
+driven joints and their rates, the stroke's phase, and the kinematics' parameters and rates) and
+:data:`N_CONTROL` controls (frequency, stroke offset and amplitude, the offset's and amplitude's and feathering's
+left-right differences), and a backward Riccati recursion gives a gain for each step (:func:`track`).
+
+Units: m, s, rad, Hz.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import mujoco
+import numpy as np
+
+from lifelike_mj.butterfly.flight3d import controls as ct
+from lifelike_mj.butterfly.flight3d import model as mj3d
+from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
+
+#: The approach's speed over the ground (m/s): the designed controller's level trim the manoeuvres start from.
+APPROACH_M_S = 1.5
+#: How far above the butterfly's standing point on the blossom the approach flies (m); every manoeuvre ends that much
+#: lower than it starts.
+RISE_M = 0.28
+#: Manoeuvres per wing beat: one for each eighth of the beat at which it may start.
+N_BINS = 8
+#: Physics steps per control step of the manoeuvre (the designed controller's rate, 10 ms at 800 Hz).
+EVERY = 8
+#: The tracked state's and controls' sizes (module docstring).
+N_STATE, N_CONTROL = 12 + 10 + 1 + 2 * N_PARAMS, 6
+#: The controls the tracking moves (indices into :data:`~lifelike_mj.butterfly.flight3d.controls.CONTROLS`).
+TRACKED_CONTROLS = (0, 1, 2, 3, 4, 6)
+#: The manoeuvre's decision variables (:func:`command_of`): for each of its two held commands the changes of
+#: frequency (Hz), stroke offset, amplitude, feathering mean and abdomen (rad) from the approach's trim and how long it
+#: is held (s); the spread wings' flap angle and feathering (rad); the start's distance before the flower's axis (m).
+N_DECISION = 2 * 6 + 2 + 1
+#: Where the decisions start (a gentle flare: slower, a higher stroke, the wings spread from 0.5 s) and their scales.
+DECISION_START = np.array([-1.0, 0.1, 0.0, 0.0, 0.0, 0.15, -1.0, 0.2, -0.1, 0.0, 0.0, 0.15, 0.3, 0.0, 0.55])
+DECISION_SCALE = np.array([1.0, 0.3, 0.3, 0.3, 0.3, 0.1, 1.0, 0.3, 0.3, 0.3, 0.3, 0.1, 0.5, 0.3, 0.1])
+#: The bounds the decisions are kept in.
+DECISION_LO = np.array([-3.0, -0.6, -0.9, -0.6, -0.6, 0.02, -3.0, -0.6, -0.9, -0.6, -0.6, 0.02, -0.8, -0.8, 0.3])
+DECISION_HI = np.array([2.0, 0.8, 0.4, 0.6, 0.6, 0.4, 2.0, 0.8, 0.4, 0.6, 0.6, 0.4, 1.2, 0.8, 0.9])
+#: The longest a manoeuvre may fly after its held commands before it counts as missed (s).
+MAX_GLIDE_S = 0.8
+
+
+def standing_point(animal: str = "monarch") -> np.ndarray:
+    """The thorax's point when standing on the manoeuvres' flower (m): the approach flies at height 0, the flower's
+    blossom stands :data:`RISE_M` below, on the axis ``x = y = 0``."""
+    return np.array([0.0, 0.0, -RISE_M])
+
+
+def blossom_centre(animal: str = "monarch") -> np.ndarray:
+    """The centre of the blossom the manoeuvres land on (m): under :func:`standing_point` by the animal's standing
+    height and the blossom's half height."""
+    from lifelike_mj.butterfly.flight3d.flowers import blossom_under
+
+    return blossom_under(standing_point(animal) - np.array([0.0, 0.0, mj3d.standing_height_m(animal)]))
+
+
+def commands_of(trim: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, float]:
+    """The manoeuvre of decisions ``z`` (:data:`N_DECISION`) flown from the trim kinematics ``trim``: its first and
+    second held commands and the spread wings' command (kinematics parameters), how long the first and second are
+    held (s)."""
+    out = []
+    for j in range(2):
+        f, off, amp, fm, ab, _ = z[6 * j : 6 * j + 6]
+        out.append(ct.command_from_controls(trim, [f, off, amp, 0.0, 0.0, fm, 0.0, 0.0, ab]))
+    spread = np.array(trim, float).copy()
+    spread[1] = spread[2] = z[12]
+    spread[3] = spread[4] = 0.0
+    spread[5] = spread[6] = z[13]
+    spread[7] = spread[8] = 0.0
+    return out[0], out[1], spread, float(z[5]), float(z[11])
+
+
+class Plant:
+    """The simulator the manoeuvres are shot and linearised on: one flower (:func:`blossom_centre`) with its landing
+    task, no controller (each step's kinematics target is set from outside), and the settled approach at each phase
+    (:meth:`settled`)."""
+
+    def __init__(self, spec: dict) -> None:
+        from lifelike_mj.butterfly.flight3d.designed_kernel import CompiledDesigned
+        from lifelike_mj.butterfly.flight3d.flight import Flight3D
+        from lifelike_mj.butterfly.flight3d.flowers import landing_surface
+        from lifelike_mj.butterfly.flight3d.parts import Butterfly, World
+        from lifelike_mj.butterfly.flight3d.tasks import land, level
+
+        self.spec, self.ctrl = spec, CompiledDesigned(spec)
+        animal, law = self.ctrl.animal, self.ctrl.force_law
+        self.trim = self.ctrl.start_command(APPROACH_M_S).as_array()
+        blossom = blossom_centre(animal)
+        world = World(flowers=[blossom])
+        self.butterfly = Butterfly(animal=animal, force_law=law)
+        self.approach = Flight3D(controller=self.ctrl, butterfly=self.butterfly, world=world, task=level(APPROACH_M_S),
+                                 start_m=(-6.0, 0.0, 0.0))
+        self.task = land(landing_surface(blossom), mj3d.standing_height_m(animal))
+        self.f = Flight3D(command=self.ctrl.start_command(APPROACH_M_S), butterfly=self.butterfly, world=world,
+                          task=self.task, _model=self.approach.model)
+        self.m, self.d = self.f.model, self.f.data
+        self.rec0 = self.f._rec.copy()
+        self.task0 = self.f._task.copy()
+        self.dt = self.f.dt
+
+    def settled(self, phase: float, settle_s: float = 3.0) -> mujoco.MjData:
+        """The approach's state (a copy of its ``MjData``) at the first step, after ``settle_s`` s of level flight at
+        :data:`APPROACH_M_S`, at which the stroke's phase passes ``phase`` (rad), moved to height 0 and ``y = 0``."""
+        a = self.approach
+        a.reset()
+        a.step(int(round(settle_s / a.dt)))
+        two_pi = 2.0 * math.pi
+        last = a.data.userdata[mj3d.U_PSI0] % two_pi
+        for _ in range(int(2.0 / a.dt)):
+            a.step(1)
+            now = a.data.userdata[mj3d.U_PSI0] % two_pi
+            if (now - phase) % two_pi < (last - phase) % two_pi:  # passed it
+                break
+            last = now
+        snap = copy.copy(a.data)
+        snap.qpos[1:3] = 0.0
+        return snap
+
+    def load(self, snap: mujoco.MjData, start_x: float) -> None:
+        """Start a run from ``snap`` with the thorax ``start_x`` m along the approach's line (``x``), the landing
+        task afresh."""
+        mujoco.mj_copyData(self.d, self.m, snap)
+        self.d.qpos[0] = start_x
+        self.f._rec[:] = self.rec0
+        self.f._task[:] = self.task0
+        self.f._diverged = ""
+
+    def fly(self, target: np.ndarray, n: int) -> None:
+        """``n`` steps with the kinematics' target ``target`` (stops stepping once perched: the perch's own)."""
+        from lifelike_mj.butterfly.flight3d.tasks import TASK_PERCH
+
+        ud = self.d.userdata
+        if int(self.f._task[0]) != TASK_PERCH:
+            ud[mj3d.U_TARGET : mj3d.U_TARGET + N_PARAMS] = target
+        self.f._batch.advance(n)
+
+    @property
+    def perched(self) -> bool:
+        return self.f.perched
+
+
+def up(d: mujoco.MjData) -> float:
+    """How upright the thorax is: its dorsal axis's vertical component (1 upright, -1 on its back)."""
+    w, x, y, _z = d.qpos[3:7]
+    return 1.0 - 2.0 * (x * x + y * y)
+
+
+#: How long after its touchdown a manoeuvre's perch is judged (s): a body going over backwards has done so by then.
+JUDGE_S = 0.5
+#: The perturbed entries a manoeuvre is scored from: (along, height) offsets of its start (m).
+SHOT_OFFSETS = ((0.0, 0.0), (0.015, 0.0), (-0.015, 0.0), (0.0, 0.004), (0.0, -0.004))
+
+
+def run(plant: Plant, snap: mujoco.MjData, z: np.ndarray, along_m: float = 0.0, height_m: float = 0.0,
+        record: bool = False) -> dict:
+    """Fly the manoeuvre of decisions ``z`` open loop from ``snap`` (:meth:`Plant.settled`), its start moved
+    ``along_m`` toward the flower and ``height_m`` up. Returns ``touched`` (bool), ``speed_m_s`` at touchdown,
+    ``up`` (:func:`up`) :data:`JUDGE_S` after it, ``miss_m`` (the closest the thorax came to its standing point), and
+    with ``record`` the ``states`` (``MjData`` copies) and ``commands`` at each control step up to the touchdown."""
+    from lifelike_mj.butterfly.flight3d.tasks import R_TOUCH_SPEED
+
+    c1, c2, spread, t1, t2 = commands_of(plant.trim, z)
+    plant.load(snap, -float(z[14]) + along_m)
+    plant.d.qpos[2] += height_m
+    goal = standing_point()
+    n1, n2 = int(round(t1 / (EVERY * plant.dt))), int(round(t2 / (EVERY * plant.dt)))
+    n_max = n1 + n2 + int(round(MAX_GLIDE_S / (EVERY * plant.dt)))
+    miss, states, commands = math.inf, [], []
+    for k in range(n_max):
+        cmd = c1 if k < n1 else (c2 if k < n1 + n2 else spread)
+        if record:
+            states.append(copy.copy(plant.d))
+            commands.append(cmd)
+        plant.fly(cmd, EVERY)
+        miss = min(miss, float(np.linalg.norm(plant.d.qpos[0:3] - goal)))
+        if plant.perched or plant.d.qpos[2] < goal[2] - 0.1 or plant.d.qpos[0] > 0.15:
+            break
+    out = {"touched": plant.perched, "miss_m": miss, "speed_m_s": math.inf, "up": -1.0}
+    if plant.perched:
+        out["speed_m_s"] = float(plant.f._rec[R_TOUCH_SPEED])
+        if record:
+            states.append(copy.copy(plant.d))
+        plant.fly(spread, int(round(JUDGE_S / plant.dt)))
+        out["up"] = up(plant.d) if plant.perched else -1.0
+    if record:
+        out.update(states=states, commands=np.array(commands))
+    return out
+
+
+def cost(outcome: dict) -> float:
+    """A run's cost (lower is better): a miss costs its closest approach beyond 5; a touchdown its speed above
+    0.2 m/s (4 per m/s) and how far from upright the perch stands :data:`JUDGE_S` later (2 when on its side)."""
+    if not outcome["touched"]:
+        return 5.0 + 10.0 * outcome["miss_m"]
+    return 4.0 * max(0.0, outcome["speed_m_s"] - 0.2) + 2.0 * (1.0 - outcome["up"])
+
+
+def score(plant: Plant, snap: mujoco.MjData, z: np.ndarray) -> float:
+    """The mean :func:`cost` of the manoeuvre ``z`` over :data:`SHOT_OFFSETS`."""
+    z = np.clip(z, DECISION_LO, DECISION_HI)
+    return float(np.mean([cost(run(plant, snap, z, a, h)) for a, h in SHOT_OFFSETS]))
+
+
+def shoot(plant: Plant, phase: float, seed: int, generations: int = 150, population: int = 12, sigma: float = 0.4,
+          start: np.ndarray | None = None, log=None) -> tuple[np.ndarray, float]:
+    """A manoeuvre for starts at the wing beat's ``phase`` (rad): CMA-ES (``seed``) over the decisions, scaled by
+    :data:`DECISION_SCALE`, from ``start`` (default :data:`DECISION_START`), minimising :func:`score`. Returns the
+    decisions and their score."""
+    import cma
+
+    snap = plant.settled(phase)
+    x0 = DECISION_START if start is None else np.asarray(start, float)
+    lo, hi = (DECISION_LO - x0) / DECISION_SCALE, (DECISION_HI - x0) / DECISION_SCALE
+    es = cma.CMAEvolutionStrategy(np.zeros(N_DECISION), sigma, {"seed": seed, "popsize": population,
+                                                                  "bounds": [list(lo), list(hi)], "verbose": -9,
+                                                                  "maxiter": generations})
+    best, best_f = x0, score(plant, snap, x0)
+    while not es.stop():
+        xs = es.ask()
+        fs = [score(plant, snap, x0 + DECISION_SCALE * x) for x in xs]
+        es.tell(xs, fs)
+        i = int(np.argmin(fs))
+        if fs[i] < best_f:
+            best, best_f = x0 + DECISION_SCALE * xs[i], fs[i]
+        if log is not None:
+            log(es.countiter, best_f)
+    return np.clip(best, DECISION_LO, DECISION_HI), float(best_f)
+
+
+def _quat_log_diff(qn: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """The rotation vector (rad, in the body's frame) taking the attitude ``qn`` to ``q`` (unit quaternions)."""
+    from lifelike_mj.butterfly.flight3d.designed import _log, quat2mat
+
+    return _log(quat2mat(qn).T @ quat2mat(q))
+
+
+def state_vector(d: mujoco.MjData, q_joints: np.ndarray, d_joints: np.ndarray) -> np.ndarray:
+    """The state the tracking reads from ``d`` (:data:`N_STATE` + 1 numbers, the attitude as a quaternion): position
+    and velocity of the thorax (m, m/s; the nominal's frame), its quaternion and body rates (rad/s), the driven joints
+    and their rates, the stroke's phase (rad), the kinematics' parameters and their rates."""
+    ud = d.userdata
+    return np.concatenate([d.qpos[0:3], d.qvel[0:3], d.qpos[3:7], d.qvel[3:6], d.qpos[q_joints], d.qvel[d_joints],
+                           [ud[mj3d.U_PSI0]], ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS], ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS]])
+
+
+def state_error(s: np.ndarray, s_nom: np.ndarray) -> np.ndarray:
+    """``s`` less the nominal's ``s_nom`` (both :func:`state_vector`), :data:`N_STATE` numbers: the attitude as the
+    body-frame rotation from the nominal's, the phase wrapped to ``[-pi, pi)``."""
+    e = np.empty(N_STATE)
+    e[0:6] = s[0:6] - s_nom[0:6]
+    e[6:9] = _quat_log_diff(s_nom[6:10], s[6:10])
+    e[9:22] = s[10:23] - s_nom[10:23]
+    e[22] = (s[23] - s_nom[23] + math.pi) % (2.0 * math.pi) - math.pi
+    e[23:] = s[24:] - s_nom[24:]
+    return e
+
+
+def _perturb(d: mujoco.MjData, i: int, h: float, q_joints: np.ndarray, d_joints: np.ndarray) -> None:
+    """Move ``d``'s state by ``h`` along the tracked state's ``i``-th coordinate (:func:`state_error`'s order)."""
+    ud = d.userdata
+    if i < 3:
+        d.qpos[i] += h
+    elif i < 6:
+        d.qvel[i - 3] += h
+    elif i < 9:
+        a = np.zeros(3)
+        a[i - 6] = h
+        dq = np.empty(4)
+        mujoco.mju_axisAngle2Quat(dq, a / h if h != 0 else np.array([1.0, 0, 0]), h)
+        q = np.empty(4)
+        mujoco.mju_mulQuat(q, d.qpos[3:7].copy(), dq)
+        d.qpos[3:7] = q
+    elif i < 12:
+        d.qvel[3 + i - 9] += h
+    elif i < 17:
+        d.qpos[q_joints[i - 12]] += h
+    elif i < 22:
+        d.qvel[d_joints[i - 17]] += h
+    elif i == 22:
+        ud[mj3d.U_PSI0] += h
+    elif i < 23 + N_PARAMS:
+        ud[mj3d.U_P0 + i - 23] += h
+    else:
+        ud[mj3d.U_DP0 + i - 23 - N_PARAMS] += h
+
+
+#: The finite-difference steps per tracked state coordinate (:func:`state_error`'s order) and control.
+STATE_STEP = np.concatenate([np.full(3, 1e-3), np.full(3, 1e-2), np.full(3, 1e-3), np.full(3, 1e-2), np.full(5, 1e-3),
+                             np.full(5, 1e-1), [1e-3], np.full(N_PARAMS, 1e-3), np.full(N_PARAMS, 1e-2)])
+CONTROL_STEP = np.array([0.05, 0.005, 0.005, 0.005, 0.005, 0.005])
+#: Bryson's scales of the tracking: controls (Hz, rad; the largest change it may make is three of these), the running
+#: state (position, velocity, attitude; the rest unweighted) and the touchdown's (along, aside, height; velocity,
+#: attitude, rates).
+CONTROL_SCALE = np.array([1.0, 0.1, 0.1, 0.1, 0.1, 0.1])
+RUN_SCALE = (0.05, 0.3, 0.2)
+END_SCALE = ((0.005, 0.01, 0.003), 0.1, 0.05, 1.0)
+
+
+def controls_to_command(command: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """The kinematics ``command`` changed by the tracking's controls ``u`` (:data:`TRACKED_CONTROLS`)."""
+    full = np.zeros(len(ct.CONTROLS))
+    full[list(TRACKED_CONTROLS)] = u
+    return ct.command_from_controls(command, full)
+
+
+def linearise(plant: Plant, states: list, commands: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The nominal's state vectors (``(T + 1, N_STATE + 1)``) and the simulator's map over each of its ``T`` control
+    steps linearised about it by central differences: ``A`` (``(T, N_STATE, N_STATE)``) and ``B`` (``(T, N_STATE,
+    N_CONTROL)``)."""
+    from lifelike_mj.butterfly.flight3d.kinematics import JOINTS
+
+    m = plant.m
+    qj = np.array([m.jnt_qposadr[m.joint(n).id] for n in JOINTS])
+    dj = np.array([m.jnt_dofadr[m.joint(n).id] for n in JOINTS])
+    S = np.array([state_vector(s, qj, dj) for s in states])
+    T = len(commands)
+    A, B = np.zeros((T, N_STATE, N_STATE)), np.zeros((T, N_STATE, N_CONTROL))
+
+    def after(k, i=-1, h=0.0, du=None):
+        mujoco.mj_copyData(plant.d, m, states[k])
+        plant.f._rec[:] = plant.rec0
+        plant.f._task[:] = plant.task0
+        if i >= 0:
+            _perturb(plant.d, i, h, qj, dj)
+        cmd = commands[k] if du is None else controls_to_command(commands[k], du)
+        plant.fly(cmd, EVERY)
+        return state_error(state_vector(plant.d, qj, dj), S[k + 1])
+
+    for k in range(T):
+        for i in range(N_STATE):
+            h = STATE_STEP[i]
+            A[k, :, i] = (after(k, i, h) - after(k, i, -h)) / (2 * h)
+        for j in range(N_CONTROL):
+            du = np.zeros(N_CONTROL)
+            du[j] = CONTROL_STEP[j]
+            B[k, :, j] = (after(k, du=du) - after(k, du=-du)) / (2 * CONTROL_STEP[j])
+    return S, A, B
+
+
+def riccati(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """The time-varying LQR's gains ``K`` (``(T, N_CONTROL, N_STATE)``, ``u = -K x``) of the linearised nominal, with
+    Bryson's weights (:data:`CONTROL_SCALE`, :data:`RUN_SCALE`, :data:`END_SCALE`)."""
+    q = np.zeros(N_STATE)
+    q[0:3], q[3:6], q[6:9] = RUN_SCALE[0] ** -2, RUN_SCALE[1] ** -2, RUN_SCALE[2] ** -2
+    Q = np.diag(q)
+    R = np.diag(CONTROL_SCALE ** -2.0)
+    qf = np.zeros(N_STATE)
+    qf[0:3] = np.array(END_SCALE[0]) ** -2.0
+    qf[3:6], qf[6:9], qf[9:12] = END_SCALE[1] ** -2, END_SCALE[2] ** -2, END_SCALE[3] ** -2
+    P = np.diag(qf)
+    T = len(A)
+    K = np.zeros((T, N_CONTROL, N_STATE))
+    for k in range(T - 1, -1, -1):
+        a, b = A[k], B[k]
+        K[k] = np.linalg.solve(R + b.T @ P @ b, b.T @ P @ a)
+        P = Q + a.T @ P @ (a - b @ K[k])
+        P = 0.5 * (P + P.T)
+    return K
+
+#: A manoeuvre starts when the thorax is at most this much nearer the flower's axis than its start distance (m),
+#: flying toward the axis within ``START_SIDE_M`` (m) aside and within ``START_HEIGHT_M`` (m) of the approach's height.
+START_WINDOW_M, START_SIDE_M, START_HEIGHT_M = 0.05, 0.04, 0.3
+#: A manoeuvre that sinks this far below the standing point without touching down is given up (m).
+BELOW_M = 0.1
+#: The most the tracking may change a control, in its Bryson scales (:data:`CONTROL_SCALE`).
+CONTROL_LIMIT = 3.0
+
+
+def check_landing(landing: dict, where: str) -> None:
+    """A controller file's ``landing`` checked for what the compiled loop reads (one sentence, else nothing): each
+    manoeuvre's states, commands and gains of matching lengths and sizes, all finite."""
+    from lifelike_mj.errors import UserError
+
+    for i, m in enumerate(landing["manoeuvres"]):
+        try:
+            s = np.array(m["states"], dtype=float)
+            u = np.array(m["commands"], dtype=float)
+            k = np.array(m["gains"], dtype=float)
+        except (TypeError, ValueError):
+            raise UserError(f"{where}: the landing's manoeuvre {i} holds something other than arrays of numbers.") from None
+        t = len(u)
+        if (t < 1 or s.shape != (t + 1, N_STATE + 1) or u.shape != (t, N_PARAMS)
+                or k.shape != (t, N_CONTROL, N_STATE)):
+            raise UserError(f"{where}: the landing's manoeuvre {i} has states, commands and gains of shapes "
+                            f"{s.shape}, {u.shape}, {k.shape}; (T + 1, {N_STATE + 1}), (T, {N_PARAMS}) and "
+                            f"(T, {N_CONTROL}, {N_STATE}) are asked.")
+        if not (np.isfinite(s).all() and np.isfinite(u).all() and np.isfinite(k).all()):
+            raise UserError(f"{where}: the landing's manoeuvre {i} holds a number that is not finite.")
+
+
+def manoeuvre(plant: Plant, phase: float, z: np.ndarray) -> dict | None:
+    """The manoeuvre of decisions ``z`` started at the beat's ``phase`` (rad) as the controller file keeps it: its
+    start distance, its nominal (states and commands at each control step, to the touchdown) and its tracking's gains
+    (:func:`linearise`, :func:`riccati`), with how the nominal itself lands (``touchdown_m_s``, ``up``). ``None`` if
+    the nominal does not touch down."""
+    snap = plant.settled(phase)
+    o = run(plant, snap, z, record=True)
+    if not o["touched"]:
+        return None
+    S, A, B = linearise(plant, o["states"], o["commands"])
+    K = riccati(A, B)
+
+    def r(a, digits=7):
+        return [float(f"{v:.{digits}g}") for v in a] if np.ndim(a) == 1 else [r(x, digits) for x in a]
+
+    return {"phase_rad": float(phase), "start_m": float(z[14]), "decisions": r(z), "touchdown_m_s": o["speed_m_s"],
+            "up": o["up"], "states": r(S, 9), "commands": r(o["commands"], 9), "gains": r(K, 6)}
+#: The approach's final (``designed_kernel.approach``): it aims this far ahead along its line (m); begun nearer the
+#: flower than ``FINAL_MIN_M`` it first flies out to ``FINAL_OUT_M`` (m) and turns back.
+FINAL_LOOKAHEAD_M, FINAL_MIN_M, FINAL_OUT_M = 0.6, 1.4, 1.8
