@@ -243,9 +243,15 @@ def cmd_design3d(args) -> None:
         spec = designed.design(model)
         lagged = designed.lagged_poles(model, spec, designed.CONTROL_LAG_S)
     speeds = [s["speed_m_s"] for s in spec["schedule"]]
+    if not args.no_landing:
+        from lifelike_mj.butterfly.flight3d import perching
+
+        with stage(f"the landing: {perching.N_BINS} manoeuvres shot and their tracking", total=perching.N_BINS,
+                   unit="manoeuvre") as bar:
+            spec["landing"] = perching.design_landing(spec, progress=lambda done, _n: bar.update(done - bar.n))
     ctl = designed.DesignedController(spec, name=Path(args.out).stem, provenance=provenance(
         model=args.model, model_provenance=model.get("provenance"), speeds_m_s=speeds, q_scales=spec["q_scales"],
-        r_scales=spec["r_scales"]))
+        r_scales=spec["r_scales"], landing=not args.no_landing))
     with stage("a check: 4 s of level flight at 1.5 m/s"):
         from lifelike_mj.butterfly.flight3d import tasks
         from lifelike_mj.butterfly.flight3d.flight import Flight3D
@@ -310,7 +316,6 @@ def cmd_strobe3d(args) -> None:
 
 
 def cmd_land3d(args) -> None:
-    from lifelike_mj.butterfly.flight3d.controllers import load_controller
     from lifelike_mj.butterfly.flight3d.flowers import check_room, place_flowers
     from lifelike_mj.butterfly.flight3d.landing import visit_flowers
 
@@ -327,7 +332,7 @@ def cmd_land3d(args) -> None:
     checks.work(f"visiting {args.flowers} flowers, perched {args.perch:g} s on each",
                 (args.flowers - 1) * checks.steps_of(MAX_LANDING_S + args.perch, DT_S), checks.MAX_BODY_STEPS,
                 "time steps", "fewer flowers or a shorter perch")
-    ctrl = load_controller(args.controller)
+    ctrl = _flown(args.controller)
     blossoms = place_flowers(args.seed, args.flowers, args.size)
     with stage(f"visiting {args.flowers} flowers by landing, perched {args.perch:g} s on each"):
         res = visit_flowers(ctrl, blossoms, args.perch)
@@ -567,6 +572,8 @@ def add_commands(bf) -> None:
     p.add_argument("--speeds", type=_speeds, default=[0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5],
                    help="without --model: forward speeds of the level trims, m/s, comma-separated "
                         "(default 0.5 to 2.5 by 0.25)")
+    p.add_argument("--no-landing", action="store_true", help="leave the landing out (its manoeuvres take most of "
+                   "the design's time); the controller then passes flowers by")
     add_overwrite(p)
     add_json(p)
     p.set_defaults(func=cmd_design3d)

@@ -89,19 +89,21 @@ def landing_tables(landing: dict | None) -> tuple[np.ndarray, ...]:
 
 @njit(cache=True)
 def trigger(st, task, qpos, qvel, psi, lm, lc):
-    """Whether a landing's manoeuvre starts now (then marked in ``st``): the one for the eighth of the beat the phase
-    ``psi`` is nearest, if the thorax is between its start distance and :data:`~lifelike_mj.butterfly.flight3d.
-    perching.START_WINDOW_M` nearer the flower's axis, flying toward it within ``START_SIDE_M`` and at the
+    """Whether a landing's manoeuvre starts now (then marked in ``st``): the one whose phase the beat's phase ``psi``
+    is nearest, if the thorax's distance from the flower's axis is within half :data:`~lifelike_mj.butterfly.flight3d.
+    perching.START_WINDOW_M` of its start distance, flying toward it within ``START_SIDE_M`` and at the
     approach's height within ``START_HEIGHT_M``. The manoeuvre's frame: the flower's standing point, its ``x`` the
     bearing to the axis now."""
     b = L.T_ROW0
     sx, sy, sz = task[b], task[b + 1], task[b + 2] + task[b + 3]
     tx, ty = sx - qpos[0], sy - qpos[1]
     dist = math.sqrt(tx * tx + ty * ty)
-    nb = lm.shape[0]
-    two_pi = 2.0 * math.pi
-    j = int(math.floor((psi % two_pi) / (two_pi / nb) + 0.5)) % nb
-    if dist > lm[j, 0] or dist < lm[j, 0] - lc[2]:
+    j, best = 0, 10.0
+    for i in range(lm.shape[0]):  # the manoeuvre whose phase is nearest the beat's now
+        gap = abs((psi - lm[i, 2] + math.pi) % (2.0 * math.pi) - math.pi)
+        if gap < best:
+            j, best = i, gap
+    if abs(dist - lm[j, 0]) > 0.5 * lc[2]:
         return False
     sp = math.sqrt(qvel[0] * qvel[0] + qvel[1] * qvel[1])
     if sp < 0.5 or abs(qvel[0] * ty - qvel[1] * tx) / sp > lc[3] or abs(qpos[2] - sz - lc[0]) > lc[4]:
@@ -134,7 +136,7 @@ def approach(st, task, qpos, lm, lc, wp):
         else:
             wp[0], wp[1], wp[2] = sx - lc[16] * c, sy - lc[16] * s, sz + lc[0]
             return
-    if along < lm[:, 0].min() - lc[2] - 0.05:  # every start passed: around again, the other way
+    if along < lm[:, 0].min() - 0.5 * lc[2] - 0.05:  # every start passed: around again, the other way
         st[f0 + 1] = st[f0 + 1] + math.pi
         st[f0 + 2] = 1.0
         wp[0], wp[1], wp[2] = sx + lc[16] * c, sy + lc[16] * s, sz + lc[0]
@@ -144,27 +146,14 @@ def approach(st, task, qpos, lm, lc, wp):
 
 
 @njit(cache=True)
-def tracked(st, ud, qpos, qvel, lm, ls, lu, lk, lc, out):
-    """The command (into ``out``) of a landing's manoeuvre under way (``st``'s landing scalars): its nominal's
-    command at this control step less its gain times the state's error from the nominal
-    (:func:`~lifelike_mj.butterfly.flight3d.perching.state_error`, the state taken in the manoeuvre's frame), each
-    control within :data:`~lifelike_mj.butterfly.flight3d.perching.CONTROL_LIMIT` of its scales; after the nominal's
-    end, its last command. A manoeuvre that has glided on ``MAX_GLIDE_S`` or sunk ``BELOW_M`` under the standing point
-    without touching down is given up (the approach flies again)."""
+def tracking_error(st, ud, qpos, qvel, nom, lc):
+    """The state's error from the nominal's state ``nom`` (:func:`~lifelike_mj.butterfly.flight3d.perching.
+    state_error`'s order), the state taken in the manoeuvre's frame (``st``'s landing scalars: the standing point and
+    the final's bearing) as the nominal was shot: the standing point ``RISE_M`` below the start, the approach along
+    ``x``."""
     s0 = ST_LAND
-    j, k = int(st[s0 + 1]), int(st[s0 + 2])
-    t = int(lm[j, 1])
-    if k >= t + lc[5] or qpos[2] < st[s0 + 6] - lc[6]:
-        st[s0] = 0.0
-        return
-    st[s0 + 2] = k + 1
-    if k >= t:
-        for i in range(N_PARAMS):
-            out[i] = lu[j, t - 1, i]
-        return
     cy, sy = math.cos(st[s0 + 3]), math.sin(st[s0 + 3])
     rx, ry, rz = qpos[0] - st[s0 + 4], qpos[1] - st[s0 + 5], qpos[2] - st[s0 + 6]
-    nom = ls[j, k]
     e = np.empty(PE.N_STATE)
     e[0] = cy * rx + sy * ry - nom[0]
     e[1] = -sy * rx + cy * ry - nom[1]
@@ -188,6 +177,29 @@ def tracked(st, ud, qpos, qvel, lm, ls, lu, lk, lc, out):
     for i in range(N_PARAMS):
         e[23 + i] = ud[mj3d.U_P0 + i] - nom[24 + i]
         e[23 + N_PARAMS + i] = ud[mj3d.U_DP0 + i] - nom[24 + N_PARAMS + i]
+    return e
+
+
+@njit(cache=True)
+def tracked(st, ud, qpos, qvel, lm, ls, lu, lk, lc, out):
+    """The command (into ``out``) of a landing's manoeuvre under way (``st``'s landing scalars): its nominal's
+    command at this control step less its gain times the state's error from the nominal
+    (:func:`~lifelike_mj.butterfly.flight3d.perching.state_error`, the state taken in the manoeuvre's frame), each
+    control within :data:`~lifelike_mj.butterfly.flight3d.perching.CONTROL_LIMIT` of its scales; after the nominal's
+    end, its last command. A manoeuvre that has glided on ``MAX_GLIDE_S`` or sunk ``BELOW_M`` under the standing point
+    without touching down is given up (the approach flies again)."""
+    s0 = ST_LAND
+    j, k = int(st[s0 + 1]), int(st[s0 + 2])
+    t = int(lm[j, 1])
+    if k >= t + lc[5] or qpos[2] < st[s0 + 6] - lc[6]:
+        st[s0] = 0.0
+        return
+    st[s0 + 2] = k + 1
+    if k >= t:
+        for i in range(N_PARAMS):
+            out[i] = lu[j, t - 1, i]
+        return
+    e = tracking_error(st, ud, qpos, qvel, ls[j, k], lc)
     u = -(np.ascontiguousarray(lk[j, k]) @ e)
     full = np.zeros(9)
     for i in range(PE.N_CONTROL):

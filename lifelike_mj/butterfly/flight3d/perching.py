@@ -30,7 +30,7 @@ import numpy as np
 
 from lifelike_mj.butterfly.flight3d import controls as ct
 from lifelike_mj.butterfly.flight3d import model as mj3d
-from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
+from lifelike_mj.butterfly.flight3d.kinematics import JOINTS, N_PARAMS
 
 #: The approach's speed over the ground (m/s): the designed controller's level trim the manoeuvres start from.
 APPROACH_M_S = 1.5
@@ -326,7 +326,6 @@ def linearise(plant: Plant, states: list, commands: np.ndarray) -> tuple[np.ndar
     """The nominal's state vectors (``(T + 1, N_STATE + 1)``) and the simulator's map over each of its ``T`` control
     steps linearised about it by central differences: ``A`` (``(T, N_STATE, N_STATE)``) and ``B`` (``(T, N_STATE,
     N_CONTROL)``)."""
-    from lifelike_mj.butterfly.flight3d.kinematics import JOINTS
 
     m = plant.m
     qj = np.array([m.jnt_qposadr[m.joint(n).id] for n in JOINTS])
@@ -376,7 +375,7 @@ def riccati(A: np.ndarray, B: np.ndarray) -> np.ndarray:
         P = 0.5 * (P + P.T)
     return K
 
-#: A manoeuvre starts when the thorax is at most this much nearer the flower's axis than its start distance (m),
+#: A manoeuvre starts when the thorax's distance from the flower's axis is within half this of its start distance (m),
 #: flying toward the axis within ``START_SIDE_M`` (m) aside and within ``START_HEIGHT_M`` (m) of the approach's height.
 START_WINDOW_M, START_SIDE_M, START_HEIGHT_M = 0.05, 0.04, 0.3
 #: A manoeuvre that sinks this far below the standing point without touching down is given up (m).
@@ -427,3 +426,50 @@ def manoeuvre(plant: Plant, phase: float, z: np.ndarray) -> dict | None:
 #: The approach's final (``designed_kernel.approach``): it aims this far ahead along its line (m); begun nearer the
 #: flower than ``FINAL_MIN_M`` it first flies out to ``FINAL_OUT_M`` (m) and turns back.
 FINAL_LOOKAHEAD_M, FINAL_MIN_M, FINAL_OUT_M = 0.6, 1.4, 1.8
+
+
+#: The shooting's settings (:func:`design_landing`): CMA-ES generations for the first manoeuvre (phase 0) and for each
+#: next one, started from its neighbour's decisions with a smaller step; the population; the seed.
+FIRST_GENERATIONS, NEXT_GENERATIONS, POPULATION, NEXT_SIGMA, SEED = 150, 50, 12, 0.15, 1
+
+
+def _chain(spec: dict, start: list, bins: list, seed: int) -> list:
+    """Shoot the manoeuvres of ``bins`` (phase bins) one after another, each started from the last one's decisions
+    (the first from ``start``), and build each (:func:`manoeuvre`). Returns ``(bin, decisions, score, manoeuvre)``."""
+    plant = Plant(spec)
+    z, out = np.asarray(start, float), []
+    for b in bins:
+        z, f = shoot(plant, 2 * math.pi * b / N_BINS, seed, NEXT_GENERATIONS, POPULATION, NEXT_SIGMA, start=z)
+        out.append((b, z.tolist(), f, manoeuvre(plant, 2 * math.pi * b / N_BINS, z)))
+    return out
+
+
+def design_landing(spec: dict, seed: int = SEED, workers: int = 2, progress=None) -> dict:
+    """The designed controller ``spec``'s landing (its file's ``landing``): the manoeuvre for phase 0 shot from
+    :data:`DECISION_START` (:data:`FIRST_GENERATIONS`), then the others in two chains around the beat (phases 1-4 and
+    7-5 eighths), each from its neighbour's decisions, on ``workers`` processes; each built with its tracking
+    (:func:`manoeuvre`). ``progress(done, total)`` after each manoeuvre. A manoeuvre whose nominal does not touch
+    down is left out (its phases then start the nearest other)."""
+    import concurrent.futures
+    import multiprocessing
+
+    plant = Plant(spec)
+    z0, f0 = shoot(plant, 0.0, seed, FIRST_GENERATIONS, POPULATION, 0.4)
+    results = [(0, z0.tolist(), f0, manoeuvre(plant, 0.0, z0))]
+    if progress:
+        progress(1, N_BINS)
+    half = N_BINS // 2
+    chains = [list(range(1, half + 1)), list(range(N_BINS - 1, half, -1))]
+    ctx = multiprocessing.get_context("spawn")
+    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, workers), mp_context=ctx) as pool:
+        futures = [pool.submit(_chain, spec, z0.tolist(), c, seed) for c in chains]
+        for fu in concurrent.futures.as_completed(futures):
+            results += fu.result()
+            if progress:
+                progress(len(results), N_BINS)
+    results.sort(key=lambda r: r[0])
+    return {"manoeuvres": [r[3] for r in results if r[3] is not None],
+            "shooting": {"bins": N_BINS, "seed": seed, "first_generations": FIRST_GENERATIONS,
+                         "next_generations": NEXT_GENERATIONS, "population": POPULATION,
+                         "scores": [r[2] for r in results], "touched": [r[3] is not None for r in results],
+                         "rise_m": RISE_M, "approach_m_s": APPROACH_M_S}}

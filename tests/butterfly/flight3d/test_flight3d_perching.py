@@ -1,0 +1,99 @@
+"""The designed controller's landing (flight3d.perching and the compiled loop's approach, trigger and tracking)."""
+
+import json
+import math
+
+import mujoco
+import numpy as np
+import pytest
+
+from lifelike_mj.butterfly.flight3d import designed_kernel as DK
+from lifelike_mj.butterfly.flight3d import perching as P
+from lifelike_mj.errors import UserError
+
+SPEC = json.loads(open("controllers/butterfly3d/designed.json").read())
+
+
+@pytest.fixture(scope="module")
+def plant():
+    return P.Plant(SPEC)
+
+
+@pytest.fixture(scope="module")
+def snap(plant):
+    return plant.settled(1.0)
+
+
+def test_settled_at_the_phase_asked(plant, snap):
+    """The approach's state is taken at the step its phase passes the one asked, level at the approach's speed."""
+    psi = snap.userdata[P.mj3d.U_PSI0] % (2 * math.pi)
+    step = 2 * math.pi * snap.userdata[P.mj3d.U_P0] * plant.dt  # the phase one step moves
+    assert 0.0 <= psi - 1.0 < step + 1e-9
+    assert abs(snap.qvel[0] - P.APPROACH_M_S) < 0.25 and abs(snap.qpos[2]) < 1e-12
+
+
+def test_perturbation_moves_the_error_by_its_step(plant, snap):
+    """Each tracked coordinate moved by h reads back as h in that coordinate alone (the attitude as a body-frame
+    rotation, the phase wrapped)."""
+    m = plant.m
+    qj = np.array([m.jnt_qposadr[m.joint(n).id] for n in P.JOINTS])
+    dj = np.array([m.jnt_dofadr[m.joint(n).id] for n in P.JOINTS])
+    s0 = P.state_vector(snap, qj, dj)
+    assert np.array_equal(P.state_error(s0, s0), np.zeros(P.N_STATE))
+    for i in range(P.N_STATE):
+        d = mujoco.MjData(m)
+        mujoco.mj_copyData(d, m, snap)
+        P._perturb(d, i, 1e-3, qj, dj)
+        e = P.state_error(P.state_vector(d, qj, dj), s0)
+        want = np.zeros(P.N_STATE)
+        want[i] = 1e-3
+        assert np.allclose(e, want, atol=1e-9), i
+
+
+@pytest.mark.parametrize("yaw", [0.0, 2.0, -2.7])
+def test_the_loop_reads_the_error_in_the_manoeuvres_frame(plant, snap, yaw):
+    """The compiled loop's tracking error (``designed_kernel.tracking_error``) of a state moved into a garden (the
+    flower elsewhere, the final's bearing ``yaw``) equals the design's (``perching.state_error``) of the same state
+    in the manoeuvre's own frame."""
+    m = plant.m
+    qj = np.array([m.jnt_qposadr[m.joint(n).id] for n in P.JOINTS])
+    dj = np.array([m.jnt_dofadr[m.joint(n).id] for n in P.JOINTS])
+    nom = P.state_vector(snap, qj, dj)
+    d = mujoco.MjData(m)
+    mujoco.mj_copyData(d, m, snap)
+    for i, h in ((0, 0.02), (1, -0.01), (2, 0.005), (4, 0.1), (7, 0.05), (10, 0.3), (23, 0.2)):
+        P._perturb(d, i, h, qj, dj)
+    local = P.state_error(P.state_vector(d, qj, dj), nom)
+    # the same body in a garden: the standing point at S, the final's x along yaw
+    S = np.array([1.3, -0.7, 0.25])
+    c, s = math.cos(yaw), math.sin(yaw)
+    Rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    g = mujoco.MjData(m)
+    mujoco.mj_copyData(g, m, d)
+    rel = d.qpos[0:3] - P.standing_point()
+    g.qpos[0:3] = S + Rz @ rel
+    g.qvel[0:3] = Rz @ d.qvel[0:3]
+    qz = np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
+    q = np.empty(4)
+    mujoco.mju_mulQuat(q, qz, d.qpos[3:7].copy())
+    g.qpos[3:7] = q
+    st = np.zeros(len(DK.ST_NAMES))
+    st[DK.ST_LAND + 3], st[DK.ST_LAND + 4 : DK.ST_LAND + 7] = yaw, S
+    lc = DK.landing_tables(None)[4]
+    e = DK.tracking_error(st, g.userdata, g.qpos, g.qvel, nom, lc)
+    assert np.allclose(e, local, atol=1e-9)
+
+
+def test_a_landing_file_is_checked():
+    """A controller file's landing with arrays of the wrong shapes, or not numbers, gets one sentence."""
+    t = 3
+    good = {"phase_rad": 0.0, "start_m": 0.5, "states": np.zeros((t + 1, P.N_STATE + 1)).tolist(),
+            "commands": np.zeros((t, P.N_PARAMS)).tolist(), "gains": np.zeros((t, P.N_CONTROL, P.N_STATE)).tolist()}
+    P.check_landing({"manoeuvres": [good]}, "here")
+    with pytest.raises(UserError, match="shapes"):
+        P.check_landing({"manoeuvres": [dict(good, states=good["states"][:-1])]}, "here")
+    with pytest.raises(UserError, match="arrays of numbers"):
+        P.check_landing({"manoeuvres": [dict(good, gains=[["a"]])]}, "here")
+    bad = dict(good, commands=np.full((t, P.N_PARAMS), np.nan).tolist())
+    with pytest.raises(UserError, match="not finite"):
+        P.check_landing({"manoeuvres": [bad]}, "here")
