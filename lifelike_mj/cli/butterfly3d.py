@@ -32,8 +32,8 @@ MAX_COURSES = 1000
 #: The --controller option's help: the shipped 3D controllers' names.
 CONTROLLER_HELP = f"a shipped 3D controller's name ({', '.join(shipped_names('butterfly3d'))}) or a file"
 #: The 3D controller flown unless another is named: the one designed from the averaged model (``design3d``); the
-#: commands that fly networks only (``land3d``, ``evolve3d``) and ``export`` (whose animation tests hold its flights)
-#: keep the evolved ``monarch``.
+#: command that evolves networks (``evolve3d``) and ``export`` (whose animation tests hold its flights) keep the
+#: evolved ``monarch``.
 DEFAULT_CONTROLLER = "designed"
 
 
@@ -347,11 +347,11 @@ def cmd_land3d(args) -> None:
             img, what = landing_strobe(ctrl, blossoms[:2], width=args.width, height=args.height, land=landed)
         write_png(args.picture, img)
         out["picture"] = {"out": str(args.picture), **what}
-    ok = sum(v["within_bound"] and v["stayed"] for v in res["visits"])
+    ok = sum(v["within_bound"] and v["stayed"] and v["upright"] for v in res["visits"])
     still = sum(v["within_bound"] and v["still"] for v in res["visits"])
     emit(args, out, f"landed on {res['landed']} of {args.flowers - 1} flowers, {ok} within "
-                    f"{res['touchdown_bound_m_s']:g} m/s and still on the blossom after {args.perch:g} s ({still} of "
-                    f"them moving less than {STILL_M * 1000:g} mm)"
+                    f"{res['touchdown_bound_m_s']:g} m/s and still on the blossom, upright, after {args.perch:g} s "
+                    f"({still} moving less than {STILL_M * 1000:g} mm)"
                     + (f"; picture written to {args.picture}" if args.picture else ""))
 
 
@@ -591,8 +591,8 @@ def add_commands(bf) -> None:
     p.set_defaults(func=cmd_strobe3d)
     p = bf.add_parser("land3d", help="one butterfly visits flowers by landing on each in turn (touchdown speed, perch, "
                                      "take-off), with a picture of a landing and a take-off")
-    p.add_argument("--controller", default="monarch", help="a 3D controller (default: monarch). No shipped "
-                   "controller lands yet; the report says so for each visit")
+    p.add_argument("--controller", default=DEFAULT_CONTROLLER, help=CONTROLLER_HELP + f" (default: {DEFAULT_CONTROLLER}, "
+                   "which lands by a manoeuvre shot in advance and tracked; the report counts each visit)")
     p.add_argument("--flowers", type=count(2, 200), default=11, help="flowers, 2 to 200: perched on the first, it "
                    "visits each other once")
     add_seed(p)

@@ -431,8 +431,8 @@ def controller_from_dict(data: object, name: str = "") -> Controller3D:
     kind = d.get("kind", "network")
     if kind == "designed":
         raise UserError(f"{where} is a designed controller (kind \"designed\"): it flies through 'lifelike-mj "
-                        "butterfly fly3d' (assess3d, measure3d, strobe3d) and Flight3D, not here, where network "
-                        "controllers fly.")
+                        "butterfly fly3d' (assess3d, measure3d, strobe3d, land3d, garden) and Flight3D, not here, "
+                        "where network controllers fly.")
     if kind != "network":
         raise UserError(f"{where}: kind is {' or '.join(repr(k) for k in KINDS)}, got {_short(kind)}.")
     schema = json_schema()

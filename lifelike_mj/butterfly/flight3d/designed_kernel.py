@@ -91,7 +91,8 @@ def landing_tables(landing: dict | None) -> tuple[np.ndarray, ...]:
 def trigger(st, task, qpos, qvel, psi, lm, lc):
     """Whether a landing's manoeuvre starts now (then marked in ``st``): the one whose phase the beat's phase ``psi``
     is nearest, if the thorax's distance from the flower's axis is within half :data:`~lifelike_mj.butterfly.flight3d.
-    perching.START_WINDOW_M` of its start distance, flying toward it within ``START_SIDE_M`` and at the
+    perching.START_WINDOW_M` of its start distance, on the final (not flying out), flying toward the axis and
+    passing it within ``START_SIDE_M`` and at the
     approach's height within ``START_HEIGHT_M``. The manoeuvre's frame: the flower's standing point, its ``x`` the
     bearing to the axis now."""
     b = L.T_ROW0
@@ -106,7 +107,9 @@ def trigger(st, task, qpos, qvel, psi, lm, lc):
     if abs(dist - lm[j, 0]) > 0.5 * lc[2]:
         return False
     sp = math.sqrt(qvel[0] * qvel[0] + qvel[1] * qvel[1])
-    if sp < 0.5 or abs(qvel[0] * ty - qvel[1] * tx) / sp > lc[3] or abs(qpos[2] - sz - lc[0]) > lc[4]:
+    if st[ST_LAND + 9] != 0.0 or sp < 0.5 or qvel[0] * tx + qvel[1] * ty <= 0.0:  # flying out, or away
+        return False
+    if abs(qvel[0] * ty - qvel[1] * tx) / sp > lc[3] or abs(qpos[2] - sz - lc[0]) > lc[4]:
         return False
     s0 = ST_LAND
     st[s0], st[s0 + 1], st[s0 + 2], st[s0 + 3] = 1.0, j, 0.0, math.atan2(ty, tx)
@@ -578,14 +581,16 @@ def _head(ud, qpos, qvel, time, dt, every, task, rec, st, buf, tmpl, wp, ref, ba
     """A step's first part for the designed controller: its sample (:func:`sample`) and, every ``every`` samples, its
     command (:func:`control`, the waypoint or the schedule's references the task gives) into ``baseline`` and the
     kinematics' target. Returns whether a new command was set (a control step: a residual policy's decision)."""
+    if int(task[L.T_KIND]) == L.TASK_PERCH:  # perched: the perch's kinematics stay (loop.perch_command), and the
+        st[:] = 0.0  # controller starts afresh at the take-off, as a new flight's does
+        tmpl[:] = 0.0
+        return False
     freq = ud[mj3d.U_P0]
     n_beat = max(1, int(round(1.0 / (freq * dt))))
     sample(st, buf, qpos, qvel, D.quat2mat(qpos[3:7]), ud[mj3d.U_PSI0], n_beat)
     if (int(st[0]) - 1) % every != 0:
         return False
     kind = int(task[L.T_KIND])
-    if kind == L.TASK_PERCH:  # perched: the perch's kinematics stay (loop.perch_command)
-        return False
     if kind == L.TASK_LAND and lm.shape[0] > 0:
         if st[ST_LAND] == 0.0:
             trigger(st, task, qpos, qvel, ud[mj3d.U_PSI0], lm, lc)

@@ -120,8 +120,8 @@ class Garden(StepCounter):
     older spelling of ``wind_to_m_s``): each butterfly's flutter and the weather
     (:class:`~lifelike_mj.butterfly.flight3d.tasks.Task3D`); ``speed_m_s``: the cruise speed; ``dt_s`` the time step.
     ``land``: the butterflies land on the flowers (module docstring); default: a controller that lands (:func:`lands`:
-    one with a ``land`` network, or evolved on the ``garden`` task set) lands, the others pass the flowers by (a
-    designed controller does not land yet, and ``land=True`` with one is refused).
+    a designed controller with a landing, one with a ``land`` network, or evolved on the ``garden`` task set) lands,
+    the others pass the flowers by (``land=True`` with a designed controller without a landing is refused).
     """
 
     @checks.known_keywords
@@ -142,9 +142,9 @@ class Garden(StepCounter):
         self.dt = checks.positive("time step dt_s", dt_s, "s")
         #: Whether the butterflies land on the flowers (else they pass them by).
         self.land = lands(self.controller) if land is None else checks.flag("land", land)
-        if self.land and self.designed:
-            raise UserError("a designed controller does not land yet: its garden passes the flowers by (land=False), "
-                            "or fly a network that lands.")
+        if self.land and self.designed and not lands(self.controller):
+            raise UserError("this designed controller has no landing (designed with --no-landing): its garden passes "
+                            "the flowers by (land=False); design3d without --no-landing makes one that lands.")
         wind = checks.one_wind("Garden", wind_to_m_s, wind_from_m_s, wind_m_s, "to") or (0.0, 0.0, 0.0)
         self._speed = speed_m_s = checks.positive("speed_m_s", speed_m_s, "m/s")
         weather = {"wind_to_m_s": wind, "gust_m_s": gust_m_s, "gust_vertical_m_s": gust_vertical_m_s,
@@ -298,8 +298,11 @@ class Garden(StepCounter):
 
 
 def lands(controller) -> bool:
-    """Whether ``controller`` lands: a network with a ``land`` behaviour network, or evolved on the ``garden`` task set
-    (or started from one that was). A designed controller does not land yet."""
+    """Whether ``controller`` lands: a designed controller with a landing (its manoeuvres:
+    :mod:`~lifelike_mj.butterfly.flight3d.perching`), a network with a ``land`` behaviour network, or evolved on the
+    ``garden`` task set (or started from one that was)."""
+    if isinstance(controller, CompiledDesigned):
+        return len(controller.landing[0]) > 0
     if not isinstance(controller, Controller3D):
         return False
     if "land" in controller.modes:

@@ -23,6 +23,16 @@ from lifelike_mj.butterfly.flight3d.tasks import TOUCHDOWN_M_S
 MAX_LANDING_S, STILL_M = 20.0, 0.005
 #: A take-off's acceleration is averaged over this long (s), as a film at 200 frames per second resolves it.
 SMOOTH_S = 0.005
+#: A perched body counts as upright while its dorsal axis's vertical component (:func:`up`) is above this (within
+#: 60 deg of the vertical); below, it lies on its side or back.
+UPRIGHT = 0.5
+
+
+def up(data) -> float:
+    """How upright the thorax of the flight's ``data`` (``MjData``, the butterfly's free joint first) is: its dorsal
+    axis's vertical component (1 upright, 0 on its side, -1 on its back)."""
+    _w, x, y, _z = data.qpos[3:7]
+    return float(1.0 - 2.0 * (x * x + y * y))
 
 
 def on_blossom(thorax_m, blossom_m) -> bool:
@@ -40,7 +50,8 @@ def visit_flowers(controller, flowers, perch_s: float = 2.0, *, dt_s: float | No
     turn (``(n, 3)`` blossom centres, m), landing on each and perching ``perch_s`` s. Returns ``visits`` (one per
     flower after the first: ``flower``, ``landed``, ``flight_s`` (take-off to touchdown), ``touchdown_speed_m_s``,
     ``within_bound`` (:data:`TOUCHDOWN_M_S`), ``perch_moved_m``, ``still`` (:data:`STILL_M`), ``stayed`` (still
-    perched on the blossom at the end: :func:`on_blossom`), ``tilt_max_deg`` (the largest roll or pitch in flight)),
+    perched on the blossom at the end: :func:`on_blossom`), ``upright`` (perched upright at the end:
+    :data:`UPRIGHT`), ``tilt_max_deg`` (the largest roll or pitch in flight)),
     ``landed`` (how many), and with ``record_every_s`` the path: ``t_s``, ``position_m``, ``attitude_rad``,
     ``perched`` and the flight itself (``flight``)."""
     from lifelike_mj.butterfly.flight3d.flight import DT_S, Flight3D
@@ -87,11 +98,12 @@ def visit_flowers(controller, flowers, perch_s: float = 2.0, *, dt_s: float | No
              "touchdown_speed_m_s": None if td is None else td["speed_m_s"],
              "within_bound": td is not None and td["speed_m_s"] <= TOUCHDOWN_M_S, "tilt_max_deg": math.degrees(tilt)}
         if td is None:
-            visits.append(v | {"perch_moved_m": None, "still": False, "stayed": False})
+            visits.append(v | {"perch_moved_m": None, "still": False, "stayed": False, "upright": False})
             break
         _, moved = fly(int(round(perch_s / f.dt)))
         visits.append(v | {"perch_moved_m": moved, "still": moved <= STILL_M and f.perched,
-                           "stayed": f.perched and on_blossom(f.state()["position_m"], f.flowers[k])})
+                           "stayed": f.perched and on_blossom(f.state()["position_m"], f.flowers[k]),
+                           "upright": f.perched and up(f.data) > UPRIGHT})
     out = {"visits": visits, "landed": sum(v["landed"] for v in visits), "flowers": n, "perch_s": perch_s,
            "touchdown_bound_m_s": TOUCHDOWN_M_S}
     if rec_every:

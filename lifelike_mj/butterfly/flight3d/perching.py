@@ -31,6 +31,7 @@ import numpy as np
 from lifelike_mj.butterfly.flight3d import controls as ct
 from lifelike_mj.butterfly.flight3d import model as mj3d
 from lifelike_mj.butterfly.flight3d.kinematics import JOINTS, N_PARAMS
+from lifelike_mj.butterfly.flight3d.landing import up
 
 #: The approach's speed over the ground (m/s): the designed controller's level trim the manoeuvres start from.
 APPROACH_M_S = 1.5
@@ -49,8 +50,12 @@ TRACKED_CONTROLS = (0, 1, 2, 3, 4, 6)
 #: frequency (Hz), stroke offset, amplitude, feathering mean and abdomen (rad) from the approach's trim and how long it
 #: is held (s); the spread wings' flap angle and feathering (rad); the start's distance before the flower's axis (m).
 N_DECISION = 2 * 6 + 2 + 1
-#: Where the decisions start (a gentle flare: slower, a higher stroke, the wings spread from 0.5 s) and their scales.
-DECISION_START = np.array([-1.0, 0.1, 0.0, 0.0, 0.0, 0.15, -1.0, 0.2, -0.1, 0.0, 0.0, 0.15, 0.3, 0.0, 0.55])
+#: Where the shooting starts (:func:`design_landing`'s first manoeuvre, at half a beat): a manoeuvre that an earlier,
+#: longer search found (2026-11-29: 150 generations of CMA-ES at phase 0 from a gentle flare, then each next eighth of
+#: the beat from its neighbour, 50 generations each; its phase-4 manoeuvre touched down at 0.03-0.11 m/s from every
+#: start it was scored on), rounded: slower and with a larger, higher stroke for 0.16 s, then faster with a smaller
+#: stroke for 0.36 s, then the wings spread 48 deg up, starting 0.43 m before the flower's axis.
+DECISION_START = np.array([-1.0, 0.17, 0.4, -0.5, 0.59, 0.16, 0.42, 0.36, -0.14, -0.19, -0.09, 0.36, 0.84, 0.58, 0.43])
 DECISION_SCALE = np.array([1.0, 0.3, 0.3, 0.3, 0.3, 0.1, 1.0, 0.3, 0.3, 0.3, 0.3, 0.1, 0.5, 0.3, 0.1])
 #: The bounds the decisions are kept in.
 DECISION_LO = np.array([-3.0, -0.6, -0.9, -0.6, -0.6, 0.02, -3.0, -0.6, -0.9, -0.6, -0.6, 0.02, -0.8, -0.8, 0.3])
@@ -158,16 +163,12 @@ class Plant:
         return self.f.perched
 
 
-def up(d: mujoco.MjData) -> float:
-    """How upright the thorax is: its dorsal axis's vertical component (1 upright, -1 on its back)."""
-    w, x, y, _z = d.qpos[3:7]
-    return 1.0 - 2.0 * (x * x + y * y)
 
 
 #: How long after its touchdown a manoeuvre's perch is judged (s): a body going over backwards has done so by then.
-JUDGE_S = 0.5
-#: The perturbed entries a manoeuvre is scored from: (along, height) offsets of its start (m).
-SHOT_OFFSETS = ((0.0, 0.0), (0.015, 0.0), (-0.015, 0.0), (0.0, 0.004), (0.0, -0.004))
+JUDGE_S = 0.3
+#: The entries a manoeuvre is scored from: (along, height) offsets of its start (m), across the start window.
+SHOT_OFFSETS = ((0.0, 0.0), (0.02, 0.0), (-0.02, 0.0))
 
 
 def run(plant: Plant, snap: mujoco.MjData, z: np.ndarray, along_m: float = 0.0, height_m: float = 0.0,
@@ -208,10 +209,10 @@ def run(plant: Plant, snap: mujoco.MjData, z: np.ndarray, along_m: float = 0.0, 
 
 def cost(outcome: dict) -> float:
     """A run's cost (lower is better): a miss costs its closest approach beyond 5; a touchdown its speed above
-    0.2 m/s (4 per m/s) and how far from upright the perch stands :data:`JUDGE_S` later (2 when on its side)."""
+    0.1 m/s (4 per m/s) and how far from upright the perch stands :data:`JUDGE_S` later (2 when on its side)."""
     if not outcome["touched"]:
         return 5.0 + 10.0 * outcome["miss_m"]
-    return 4.0 * max(0.0, outcome["speed_m_s"] - 0.2) + 2.0 * (1.0 - outcome["up"])
+    return 4.0 * max(0.0, outcome["speed_m_s"] - 0.1) + 2.0 * (1.0 - outcome["up"])
 
 
 def score(plant: Plant, snap: mujoco.MjData, z: np.ndarray) -> float:
@@ -377,7 +378,7 @@ def riccati(A: np.ndarray, B: np.ndarray) -> np.ndarray:
 
 #: A manoeuvre starts when the thorax's distance from the flower's axis is within half this of its start distance (m),
 #: flying toward the axis within ``START_SIDE_M`` (m) aside and within ``START_HEIGHT_M`` (m) of the approach's height.
-START_WINDOW_M, START_SIDE_M, START_HEIGHT_M = 0.05, 0.04, 0.3
+START_WINDOW_M, START_SIDE_M, START_HEIGHT_M = 0.05, 0.06, 0.3
 #: A manoeuvre that sinks this far below the standing point without touching down is given up (m).
 BELOW_M = 0.1
 #: The most the tracking may change a control, in its Bryson scales (:data:`CONTROL_SCALE`).
@@ -425,51 +426,64 @@ def manoeuvre(plant: Plant, phase: float, z: np.ndarray) -> dict | None:
             "up": o["up"], "states": r(S, 9), "commands": r(o["commands"], 9), "gains": r(K, 6)}
 #: The approach's final (``designed_kernel.approach``): it aims this far ahead along its line (m); begun nearer the
 #: flower than ``FINAL_MIN_M`` it first flies out to ``FINAL_OUT_M`` (m) and turns back.
-FINAL_LOOKAHEAD_M, FINAL_MIN_M, FINAL_OUT_M = 0.6, 1.4, 1.8
+FINAL_LOOKAHEAD_M, FINAL_MIN_M, FINAL_OUT_M = 0.9, 1.8, 2.4
 
 
-#: The shooting's settings (:func:`design_landing`): CMA-ES generations for the first manoeuvre (phase 0) and for each
-#: next one, started from its neighbour's decisions with a smaller step; the population; the seed.
-FIRST_GENERATIONS, NEXT_GENERATIONS, POPULATION, NEXT_SIGMA, SEED = 150, 50, 12, 0.15, 1
+#: The shooting's settings (:func:`design_landing`): CMA-ES generations and step for each chain's first manoeuvre and
+#: for each next one (started from its neighbour's decisions), the population, the seed.
+FIRST_GENERATIONS, FIRST_SIGMA, NEXT_GENERATIONS, NEXT_SIGMA, POPULATION, SEED = 40, 0.2, 35, 0.15, 12, 1
+#: The design's two chains around the beat, shot at once: each first shoots phase bin 4 (half a beat) from
+#: :data:`DECISION_START` (each with its own seed; the better is kept), then its other bins, each from the decisions
+#: of the bin named with it.
+HALVES = ((4, ((3, 4), (2, 3), (1, 2), (0, 1))), (4, ((5, 4), (6, 5), (7, 6))))
 
 
-def _chain(spec: dict, start: list, bins: list, seed: int) -> list:
-    """Shoot the manoeuvres of ``bins`` (phase bins) one after another, each started from the last one's decisions
-    (the first from ``start``), and build each (:func:`manoeuvre`). Returns ``(bin, decisions, score, manoeuvre)``."""
+def _half(spec: dict, first: int, rest: tuple, seed: int, generations: tuple[int, int]) -> list:
+    """One chain around the beat (:data:`HALVES`): its first bin shot from :data:`DECISION_START`, the rest each from the
+    decisions of the bin named with it; each built (:func:`manoeuvre`). Returns ``(bin, decisions, score,
+    manoeuvre)``."""
     plant = Plant(spec)
-    z, out = np.asarray(start, float), []
-    for b in bins:
-        z, f = shoot(plant, 2 * math.pi * b / N_BINS, seed, NEXT_GENERATIONS, POPULATION, NEXT_SIGMA, start=z)
-        out.append((b, z.tolist(), f, manoeuvre(plant, 2 * math.pi * b / N_BINS, z)))
-    return out
+
+    def phase(b):
+        return 2 * math.pi * b / N_BINS
+
+    z, f = shoot(plant, phase(first), seed, generations[0], POPULATION, FIRST_SIGMA)
+    found = {first: (z, f)}
+    for b, start in rest:
+        found[b] = shoot(plant, phase(b), seed, generations[1], POPULATION, NEXT_SIGMA, start=found[start][0])
+    return [(b, z.tolist(), f, manoeuvre(plant, phase(b), z)) for b, (z, f) in found.items()]
 
 
-def design_landing(spec: dict, seed: int = SEED, workers: int = 2, progress=None) -> dict:
-    """The designed controller ``spec``'s landing (its file's ``landing``): the manoeuvre for phase 0 shot from
-    :data:`DECISION_START` (:data:`FIRST_GENERATIONS`), then the others in two chains around the beat (phases 1-4 and
-    7-5 eighths), each from its neighbour's decisions, on ``workers`` processes; each built with its tracking
-    (:func:`manoeuvre`). ``progress(done, total)`` after each manoeuvre. A manoeuvre whose nominal does not touch
-    down is left out (its phases then start the nearest other)."""
+def design_landing(spec: dict, seed: int = SEED, workers: int = 2, progress=None,
+                   generations: tuple[int, int] = (FIRST_GENERATIONS, NEXT_GENERATIONS)) -> dict:
+    """The designed controller ``spec``'s landing (its file's ``landing``): one manoeuvre per eighth of the wing
+    beat, shot in two chains at once (:data:`HALVES`, on ``workers`` processes, seeds ``seed`` and ``seed + 1``):
+    each chain's first from :data:`DECISION_START`, its others each from a neighbour's decisions (a manoeuvre for the
+    next eighth of the beat is near its neighbour's); each built with its tracking (:func:`manoeuvre`).
+    ``generations``: CMA-ES's for each chain's first and for each next manoeuvre. ``progress(done, total)`` as chains
+    are done. A manoeuvre whose nominal does not touch down is left out (its
+    phases then start the nearest other)."""
     import concurrent.futures
     import multiprocessing
 
-    plant = Plant(spec)
-    z0, f0 = shoot(plant, 0.0, seed, FIRST_GENERATIONS, POPULATION, 0.4)
-    results = [(0, z0.tolist(), f0, manoeuvre(plant, 0.0, z0))]
-    if progress:
-        progress(1, N_BINS)
-    half = N_BINS // 2
-    chains = [list(range(1, half + 1)), list(range(N_BINS - 1, half, -1))]
     ctx = multiprocessing.get_context("spawn")
+    results: list = []
     with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, workers), mp_context=ctx) as pool:
-        futures = [pool.submit(_chain, spec, z0.tolist(), c, seed) for c in chains]
+        futures = [pool.submit(_half, spec, first, rest, seed + i, generations)
+                   for i, (first, rest) in enumerate(HALVES)]
         for fu in concurrent.futures.as_completed(futures):
             results += fu.result()
             if progress:
-                progress(len(results), N_BINS)
-    results.sort(key=lambda r: r[0])
+                progress(len({r[0] for r in results}), N_BINS)
+    best: dict = {}
+    for r in results:  # a bin shot by both chains: the better kept
+        if r[0] not in best or r[2] < best[r[0]][2]:
+            best[r[0]] = r
+    results = [best[b] for b in sorted(best)]
     return {"manoeuvres": [r[3] for r in results if r[3] is not None],
-            "shooting": {"bins": N_BINS, "seed": seed, "first_generations": FIRST_GENERATIONS,
-                         "next_generations": NEXT_GENERATIONS, "population": POPULATION,
-                         "scores": [r[2] for r in results], "touched": [r[3] is not None for r in results],
+            "shooting": {"bins": N_BINS, "seed": seed, "halves": [[h[0], [list(r) for r in h[1]]] for h in HALVES],
+                         "first_generations": generations[0], "first_sigma": FIRST_SIGMA,
+                         "next_generations": generations[1], "population": POPULATION, "next_sigma": NEXT_SIGMA,
+                         "start": DECISION_START.tolist(), "scores": [r[2] for r in results],
+                         "touched": [r[3] is not None for r in results], "offsets_m": [list(o) for o in SHOT_OFFSETS],
                          "rise_m": RISE_M, "approach_m_s": APPROACH_M_S}}

@@ -1,9 +1,12 @@
 """The garden: many 3D butterflies on their own courses among the flowers, drawn in one scene."""
 
+import json
+
 import numpy as np
 import pytest
 
 from lifelike_mj.butterfly import flight3d
+from lifelike_mj.butterfly.flight3d.designed_kernel import CompiledDesigned
 from lifelike_mj.butterfly.flight3d.flight import Flight3D
 from lifelike_mj.butterfly.flight3d.garden import Garden, course_among, flowers
 from lifelike_mj.errors import UserError
@@ -38,9 +41,10 @@ def test_each_garden_butterfly_flies_what_its_own_flight_flies():
 
 
 def test_a_garden_of_the_designed_controller_flies_each_butterfly_as_its_own_flight():
-    """The default garden flies the shipped designed controller (threaded, fly_designed_batch): each butterfly the
-    flight a Flight3D of the same controller gives it on its own task, and they pass flowers; it does not land."""
-    g = Garden(3, seed=2, flutter=0.1, gust_m_s=0.3)
+    """A garden of the shipped designed controller passing the flowers by (``land=False``; threaded,
+    fly_designed_batch): each butterfly flies what a Flight3D of the same controller flies on its own task, and they
+    pass flowers."""
+    g = Garden(3, seed=2, flutter=0.1, gust_m_s=0.3, land=False)
     assert g.designed and g.controller.name == "designed" and not g.land
     starts = [d.qpos[:7].copy() for d in g._datas]
     g.step(800)
@@ -52,8 +56,27 @@ def test_a_garden_of_the_designed_controller_flies_each_butterfly_as_its_own_fli
         np.testing.assert_array_equal(f.state()["position_m"], state["position_m"][i])
     g.step(int(round(9.0 / g.dt)))
     assert g.state()["waypoints_passed"].min() >= 2  # ten seconds among flowers 1.2 m or more apart
-    with pytest.raises(UserError, match="does not land yet"):
-        Garden(2, land=True)
+
+
+@pytest.mark.slow
+def test_the_default_garden_lands_on_its_flowers():
+    """The default garden (the shipped designed controller, which has a landing) lands: in 25 s each of four
+    butterflies touches down on at least one flower within the bound, and every touchdown that has taken off again
+    stayed on its blossom. A designed controller without a landing is refused ``land=True`` in one sentence."""
+    from lifelike_mj.butterfly.flight3d.tasks import TOUCHDOWN_M_S
+
+    g = Garden(4, seed=3)
+    assert g.designed and g.land
+    g.step(int(round(25.0 / g.dt)))
+    visits = g.visits()
+    for vs in visits:
+        landed = [v for v in vs if v["touchdown_s"] is not None]
+        assert landed and any(v["touchdown_speed_m_s"] <= TOUCHDOWN_M_S for v in landed), vs
+        assert all(v["stayed"] for v in landed if v["take_off_s"] is not None), vs
+    spec = json.loads(open("controllers/butterfly3d/designed.json").read())
+    del spec["landing"]
+    with pytest.raises(UserError, match="has no landing"):
+        Garden(2, CompiledDesigned(spec), land=True)
 
 
 def test_bad_garden_arguments_are_one_sentence():

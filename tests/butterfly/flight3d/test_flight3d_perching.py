@@ -97,3 +97,42 @@ def test_a_landing_file_is_checked():
     bad = dict(good, commands=np.full((t, P.N_PARAMS), np.nan).tolist())
     with pytest.raises(UserError, match="not finite"):
         P.check_landing({"manoeuvres": [bad]}, "here")
+
+
+#: Gardens no design or choice of this landing has seen (the design's tuning gardens were 100-111), four flowers each:
+#: three visits a garden, a failed visit ending it.
+REPORT_GARDENS = range(400, 410)
+
+
+@pytest.mark.slow
+def test_the_shipped_controller_lands_on_unseen_gardens():
+    """The shipped designed controller, flown through ``land3d``'s ``visit_flowers``, lands within the touchdown bound,
+    stays on the blossom and perches upright to the end of a 2 s perch on at least 9 of 10 visits of gardens it was
+    never tuned on, and takes off for the next."""
+    from lifelike_mj.butterfly.flight3d.flowers import place_flowers
+    from lifelike_mj.butterfly.flight3d.landing import visit_flowers
+
+    ctrl = DK.load_compiled("designed")
+    good = total = 0
+    for seed in REPORT_GARDENS:
+        res = visit_flowers(ctrl, place_flowers(seed, 4, 6.0), 2.0)
+        for v in res["visits"]:
+            total += 1
+            good += v["within_bound"] and v["stayed"] and v["upright"]
+    assert total >= 25 and good >= 0.9 * total, (good, total)
+
+
+@pytest.mark.slow
+def test_design_landing_writes_what_the_loop_flies():
+    """``design_landing`` (here with two generations a manoeuvre) gives eight manoeuvres whose arrays pass the file's
+    check and load as the loop's tables, each with the phase and start distance it was shot at, and records how."""
+    land = P.design_landing(SPEC, workers=2, generations=(2, 2))
+    P.check_landing(land, "here")
+    ms = land["manoeuvres"]
+    assert [round(m["phase_rad"] / (2 * math.pi / P.N_BINS)) for m in ms] == [b for b, t in
+                                                                             enumerate(land["shooting"]["touched"]) if t]
+    assert all(abs(m["start_m"] - m["decisions"][14]) < 1e-6 and len(m["states"]) == len(m["commands"]) + 1
+               for m in ms)
+    lm, ls, lu, lk, _ = DK.landing_tables(land)
+    assert lm.shape == (len(ms), 3) and np.array_equal(lm[:, 1], [len(m["commands"]) for m in ms])
+    assert land["shooting"]["first_generations"] == 2 and land["shooting"]["start"] == P.DECISION_START.tolist()
