@@ -72,7 +72,7 @@ def landing_tables(landing: dict | None) -> tuple[np.ndarray, ...]:
     (``lc``). Without a landing, zero manoeuvres."""
     lc = np.array([PE.RISE_M, PE.APPROACH_M_S, PE.START_WINDOW_M, PE.START_SIDE_M, PE.START_HEIGHT_M,
                    PE.MAX_GLIDE_S / (PE.EVERY * 1.0 / 800.0), PE.BELOW_M, *PE.CONTROL_SCALE, PE.CONTROL_LIMIT,
-                   PE.FINAL_LOOKAHEAD_M, PE.FINAL_MIN_M, PE.FINAL_OUT_M])
+                   PE.FINAL_LOOKAHEAD_M, PE.FINAL_MIN_M, PE.FINAL_OUT_M, PE.TAKE_OFF_STRAIGHT_S])
     bins = (landing or {}).get("manoeuvres") or []
     n = len(bins)
     t_max = max([len(b["commands"]) for b in bins] + [1])
@@ -118,16 +118,21 @@ def trigger(st, task, qpos, qvel, psi, lm, lc):
 
 
 @njit(cache=True)
-def approach(st, task, qpos, lm, lc, wp):
+def approach(st, task, qpos, lm, lc, wp, t, rec):
     """The landing's approach (its waypoint into ``wp``): a straight final toward the flower's axis at the approach's
     height (:data:`~lifelike_mj.butterfly.flight3d.perching.RISE_M` above the standing point), followed by aiming
     ``FINAL_LOOKAHEAD_M`` ahead of the body's foot on it. The final's line is the bearing to the axis at the landing's
     start; begun nearer than ``FINAL_MIN_M``, the butterfly first flies out along it, away from the flower, to
     ``FINAL_OUT_M``, and turns back. A final that passes every manoeuvre's start without one starting goes around:
-    out beyond the flower, then back along the line the other way."""
+    out beyond the flower, then back along the line the other way. For ``TAKE_OFF_STRAIGHT_S`` after a take-off (at
+    ``rec[R_TOOK_OFF_AT]``; ``t`` now) it flies straight ahead first, climbing: a turn at once upsets the body."""
     b = L.T_ROW0
     sx, sy, sz = task[b], task[b + 1], task[b + 2] + task[b + 3]
     f0 = ST_LAND + 7
+    if t - rec[L.R_TOOK_OFF_AT] < lc[17]:  # the take-off: straight ahead, climbing
+        yaw = L.attitude(qpos[3:7])[2]
+        wp[0], wp[1], wp[2] = qpos[0] + 3.0 * math.cos(yaw), qpos[1] + 3.0 * math.sin(yaw), sz + lc[0]
+        return
     if st[f0] == 0.0:
         st[f0], st[f0 + 1] = 1.0, math.atan2(sy - qpos[1], sx - qpos[0])
         st[f0 + 2] = 1.0 if math.hypot(sx - qpos[0], sy - qpos[1]) < lc[15] else 0.0
@@ -406,6 +411,8 @@ def control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins
     if st[15] == 0.0:
         st[15] = 1.0
         st[16] = asked
+        if kind == 2:  # a landing's approach, from a perch: the speed asked starts from the speed flown
+            st[16] = min(max(math.sqrt(vel[0] ** 2 + vel[1] ** 2), vmin), asked)
     dv = max_dv * every * dt
     st[16] = st[16] + min(max(asked - st[16], -dv), dv)
     airspeed = st[16]
@@ -600,13 +607,14 @@ def _head(ud, qpos, qvel, time, dt, every, task, rec, st, buf, tmpl, wp, ref, ba
                 for j in range(N_PARAMS):
                     ud[mj3d.U_TARGET + j] = baseline[j]
                 return True
-        approach(st, task, qpos, lm, lc, wp)
+        approach(st, task, qpos, lm, lc, wp, time[0], rec)
         cmd = control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins,
                       ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS].copy(), ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS].copy(), dt,
                       every, 2, wp, lc[1], ref, n_beat)
         for j in range(N_PARAMS):
             baseline[j] = cmd[j]
             ud[mj3d.U_TARGET + j] = cmd[j]
+        clap(ud, time[0], rec)
         return True
     if kind == L.TASK_WAYPOINTS:
         i = min(int(rec[L.R_PASSED]), int(task[L.T_ROWS]) - 1)
@@ -628,7 +636,19 @@ def _head(ud, qpos, qvel, time, dt, every, task, rec, st, buf, tmpl, wp, ref, ba
     for j in range(N_PARAMS):
         baseline[j] = cmd[j]
         ud[mj3d.U_TARGET + j] = cmd[j]
+    clap(ud, time[0], rec)
     return True
+
+
+@njit(cache=True)
+def clap(ud, t, rec):
+    """A take-off's first :data:`~lifelike_mj.butterfly.flight3d.tasks.CLAP_S` (until ``rec[R_CLAP_UNTIL]``): each
+    wing's amplitude puts the top of its stroke at ``CLAP_TOP_RAD`` about the offset asked, so that the wings clap with
+    a larger stroke and the body climbs from its first downstroke (Sunada et al. 1993), as a network's take-off does
+    (``loop._act``)."""
+    if t < rec[L.R_CLAP_UNTIL]:
+        ud[mj3d.U_TARGET + 3] = L.CLAP_TOP_RAD - ud[mj3d.U_TARGET + 1]
+        ud[mj3d.U_TARGET + 4] = L.CLAP_TOP_RAD - ud[mj3d.U_TARGET + 2]
 
 
 @njit(cache=True)

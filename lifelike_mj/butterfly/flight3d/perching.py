@@ -487,3 +487,5 @@ def design_landing(spec: dict, seed: int = SEED, workers: int = 2, progress=None
                          "start": DECISION_START.tolist(), "scores": [r[2] for r in results],
                          "touched": [r[3] is not None for r in results], "offsets_m": [list(o) for o in SHOT_OFFSETS],
                          "rise_m": RISE_M, "approach_m_s": APPROACH_M_S}}
+#: After a take-off the approach flies straight ahead this long (s) before it turns for its final.
+TAKE_OFF_STRAIGHT_S = 0.5
