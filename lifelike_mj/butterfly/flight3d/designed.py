@@ -695,7 +695,7 @@ def controller_from_dict(data: object, name: str = "") -> DesignedController:
     for p in d["schedule"]:
         KinematicsCommand(*p["command"])  # its own sentence for a command out of bounds
     if "landing" in d:
-        from lifelike_mj.butterfly.flight3d.perching import check_landing
+        from lifelike_mj.butterfly.flight3d.perch_layout import check_landing
 
         check_landing(d["landing"], where)
     return DesignedController(d, name=name, provenance=d.get("provenance"))

@@ -20,7 +20,7 @@ from numba import njit, prange
 from lifelike_mj.butterfly.flight3d import designed as D
 from lifelike_mj.butterfly.flight3d import loop as L
 from lifelike_mj.butterfly.flight3d import model as mj3d
-from lifelike_mj.butterfly.flight3d import perching as PE
+from lifelike_mj.butterfly.flight3d import perch_layout as PE
 from lifelike_mj.butterfly.flight3d.designed import _log
 from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
 

@@ -32,20 +32,30 @@ from lifelike_mj.butterfly.flight3d import controls as ct
 from lifelike_mj.butterfly.flight3d import model as mj3d
 from lifelike_mj.butterfly.flight3d.kinematics import JOINTS, N_PARAMS
 from lifelike_mj.butterfly.flight3d.landing import up
+from lifelike_mj.butterfly.flight3d.perch_layout import (  # noqa: F401 - the layout, read here too
+    APPROACH_M_S,
+    BELOW_M,
+    CONTROL_LIMIT,
+    CONTROL_SCALE,
+    END_SCALE,
+    EVERY,
+    FINAL_LOOKAHEAD_M,
+    FINAL_MIN_M,
+    FINAL_OUT_M,
+    MAX_GLIDE_S,
+    N_BINS,
+    N_CONTROL,
+    N_STATE,
+    RISE_M,
+    RUN_SCALE,
+    START_HEIGHT_M,
+    START_SIDE_M,
+    START_WINDOW_M,
+    TAKE_OFF_STRAIGHT_S,
+    TRACKED_CONTROLS,
+    check_landing,
+)
 
-#: The approach's speed over the ground (m/s): the designed controller's level trim the manoeuvres start from.
-APPROACH_M_S = 1.5
-#: How far above the butterfly's standing point on the blossom the approach flies (m); every manoeuvre ends that much
-#: lower than it starts.
-RISE_M = 0.28
-#: Manoeuvres per wing beat: one for each eighth of the beat at which it may start.
-N_BINS = 8
-#: Physics steps per control step of the manoeuvre (the designed controller's rate, 10 ms at 800 Hz).
-EVERY = 8
-#: The tracked state's and controls' sizes (module docstring).
-N_STATE, N_CONTROL = 12 + 10 + 1 + 2 * N_PARAMS, 6
-#: The controls the tracking moves (indices into :data:`~lifelike_mj.butterfly.flight3d.controls.CONTROLS`).
-TRACKED_CONTROLS = (0, 1, 2, 3, 4, 6)
 #: The manoeuvre's decision variables (:func:`command_of`): for each of its two held commands the changes of
 #: frequency (Hz), stroke offset, amplitude, feathering mean and abdomen (rad) from the approach's trim and how long it
 #: is held (s); the spread wings' flap angle and feathering (rad); the start's distance before the flower's axis (m).
@@ -60,8 +70,6 @@ DECISION_SCALE = np.array([1.0, 0.3, 0.3, 0.3, 0.3, 0.1, 1.0, 0.3, 0.3, 0.3, 0.3
 #: The bounds the decisions are kept in.
 DECISION_LO = np.array([-3.0, -0.6, -0.9, -0.6, -0.6, 0.02, -3.0, -0.6, -0.9, -0.6, -0.6, 0.02, -0.8, -0.8, 0.3])
 DECISION_HI = np.array([2.0, 0.8, 0.4, 0.6, 0.6, 0.4, 2.0, 0.8, 0.4, 0.6, 0.6, 0.4, 1.2, 0.8, 0.9])
-#: The longest a manoeuvre may fly after its held commands before it counts as missed (s).
-MAX_GLIDE_S = 0.8
 
 
 def standing_point(animal: str = "monarch") -> np.ndarray:
@@ -308,12 +316,6 @@ def _perturb(d: mujoco.MjData, i: int, h: float, q_joints: np.ndarray, d_joints:
 STATE_STEP = np.concatenate([np.full(3, 1e-3), np.full(3, 1e-2), np.full(3, 1e-3), np.full(3, 1e-2), np.full(5, 1e-3),
                              np.full(5, 1e-1), [1e-3], np.full(N_PARAMS, 1e-3), np.full(N_PARAMS, 1e-2)])
 CONTROL_STEP = np.array([0.05, 0.005, 0.005, 0.005, 0.005, 0.005])
-#: Bryson's scales of the tracking: controls (Hz, rad; the largest change it may make is three of these), the running
-#: state (position, velocity, attitude; the rest unweighted) and the touchdown's (along, aside, height; velocity,
-#: attitude, rates).
-CONTROL_SCALE = np.array([1.0, 0.1, 0.1, 0.1, 0.1, 0.1])
-RUN_SCALE = (0.05, 0.3, 0.2)
-END_SCALE = ((0.005, 0.01, 0.003), 0.1, 0.05, 1.0)
 
 
 def controls_to_command(command: np.ndarray, u: np.ndarray) -> np.ndarray:
@@ -376,35 +378,8 @@ def riccati(A: np.ndarray, B: np.ndarray) -> np.ndarray:
         P = 0.5 * (P + P.T)
     return K
 
-#: A manoeuvre starts when the thorax's distance from the flower's axis is within half this of its start distance (m),
-#: flying toward the axis within ``START_SIDE_M`` (m) aside and within ``START_HEIGHT_M`` (m) of the approach's height.
-START_WINDOW_M, START_SIDE_M, START_HEIGHT_M = 0.05, 0.06, 0.3
-#: A manoeuvre that sinks this far below the standing point without touching down is given up (m).
-BELOW_M = 0.1
-#: The most the tracking may change a control, in its Bryson scales (:data:`CONTROL_SCALE`).
-CONTROL_LIMIT = 3.0
 
 
-def check_landing(landing: dict, where: str) -> None:
-    """A controller file's ``landing`` checked for what the compiled loop reads (one sentence, else nothing): each
-    manoeuvre's states, commands and gains of matching lengths and sizes, all finite."""
-    from lifelike_mj.errors import UserError
-
-    for i, m in enumerate(landing["manoeuvres"]):
-        try:
-            s = np.array(m["states"], dtype=float)
-            u = np.array(m["commands"], dtype=float)
-            k = np.array(m["gains"], dtype=float)
-        except (TypeError, ValueError):
-            raise UserError(f"{where}: the landing's manoeuvre {i} holds something other than arrays of numbers.") from None
-        t = len(u)
-        if (t < 1 or s.shape != (t + 1, N_STATE + 1) or u.shape != (t, N_PARAMS)
-                or k.shape != (t, N_CONTROL, N_STATE)):
-            raise UserError(f"{where}: the landing's manoeuvre {i} has states, commands and gains of shapes "
-                            f"{s.shape}, {u.shape}, {k.shape}; (T + 1, {N_STATE + 1}), (T, {N_PARAMS}) and "
-                            f"(T, {N_CONTROL}, {N_STATE}) are asked.")
-        if not (np.isfinite(s).all() and np.isfinite(u).all() and np.isfinite(k).all()):
-            raise UserError(f"{where}: the landing's manoeuvre {i} holds a number that is not finite.")
 
 
 def manoeuvre(plant: Plant, phase: float, z: np.ndarray) -> dict | None:
@@ -424,9 +399,6 @@ def manoeuvre(plant: Plant, phase: float, z: np.ndarray) -> dict | None:
 
     return {"phase_rad": float(phase), "start_m": float(z[14]), "decisions": r(z), "touchdown_m_s": o["speed_m_s"],
             "up": o["up"], "states": r(S, 9), "commands": r(o["commands"], 9), "gains": r(K, 6)}
-#: The approach's final (``designed_kernel.approach``): it aims this far ahead along its line (m); begun nearer the
-#: flower than ``FINAL_MIN_M`` it first flies out to ``FINAL_OUT_M`` (m) and turns back.
-FINAL_LOOKAHEAD_M, FINAL_MIN_M, FINAL_OUT_M = 0.9, 1.8, 2.4
 
 
 #: The shooting's settings (:func:`design_landing`): CMA-ES generations and step for each chain's first manoeuvre and
@@ -487,5 +459,3 @@ def design_landing(spec: dict, seed: int = SEED, workers: int = 2, progress=None
                          "start": DECISION_START.tolist(), "scores": [r[2] for r in results],
                          "touched": [r[3] is not None for r in results], "offsets_m": [list(o) for o in SHOT_OFFSETS],
                          "rise_m": RISE_M, "approach_m_s": APPROACH_M_S}}
-#: After a take-off the approach flies straight ahead this long (s) before it turns for its final.
-TAKE_OFF_STRAIGHT_S = 0.5
