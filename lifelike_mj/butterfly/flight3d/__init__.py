@@ -71,7 +71,7 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "level_measures": "measures", "default_base": "controllers", "strobe": ".",
     "flowers": ".", "landing": ".", "land": "tasks", "visit_flowers": "landing", "place_flowers": "flowers",
     "calibrate": ".", "averaged": ".", "controls": ".", "designed": ".", "designed_kernel": ".",
-    "load_compiled": "designed_kernel",
+    "load_compiled": "designed_kernel", "perching": ".", "perch_layout": ".", "design_landing": "perching",
     "parts": ".", "Butterfly": "parts",
     "World": "parts",
 }, globals())
