@@ -30,7 +30,7 @@ import numpy as np
 
 from lifelike_mj.butterfly.flight3d import controls as ct
 from lifelike_mj.butterfly.flight3d import model as mj3d
-from lifelike_mj.butterfly.flight3d.kinematics import JOINTS, N_PARAMS
+from lifelike_mj.butterfly.flight3d.kinematics import N_PARAMS
 from lifelike_mj.butterfly.flight3d.landing import up
 from lifelike_mj.butterfly.flight3d.perch_layout import (  # noqa: F401 - the layout, read here too
     APPROACH_M_S,
@@ -72,7 +72,7 @@ DECISION_LO = np.array([-3.0, -0.6, -0.9, -0.6, -0.6, 0.02, -3.0, -0.6, -0.9, -0
 DECISION_HI = np.array([2.0, 0.8, 0.4, 0.6, 0.6, 0.4, 2.0, 0.8, 0.4, 0.6, 0.6, 0.4, 1.2, 0.8, 0.9])
 
 
-def standing_point(animal: str = "monarch") -> np.ndarray:
+def standing_point() -> np.ndarray:
     """The thorax's point when standing on the manoeuvres' flower (m): the approach flies at height 0, the flower's
     blossom stands :data:`RISE_M` below, on the axis ``x = y = 0``."""
     return np.array([0.0, 0.0, -RISE_M])
@@ -83,7 +83,7 @@ def blossom_centre(animal: str = "monarch") -> np.ndarray:
     height and the blossom's half height."""
     from lifelike_mj.butterfly.flight3d.flowers import blossom_under
 
-    return blossom_under(standing_point(animal) - np.array([0.0, 0.0, mj3d.standing_height_m(animal)]))
+    return blossom_under(standing_point() - np.array([0.0, 0.0, mj3d.standing_height_m(animal)]))
 
 
 def commands_of(trim: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, float]:
@@ -148,14 +148,18 @@ class Plant:
         snap.qpos[1:3] = 0.0
         return snap
 
-    def load(self, snap: mujoco.MjData, start_x: float) -> None:
-        """Start a run from ``snap`` with the thorax ``start_x`` m along the approach's line (``x``), the landing
-        task afresh."""
+    def restore(self, snap: mujoco.MjData) -> None:
+        """The simulation back at ``snap`` (an ``MjData`` of this plant), the landing task and its record afresh."""
         mujoco.mj_copyData(self.d, self.m, snap)
-        self.d.qpos[0] = start_x
         self.f._rec[:] = self.rec0
         self.f._task[:] = self.task0
         self.f._diverged = ""
+
+    def load(self, snap: mujoco.MjData, start_x: float) -> None:
+        """Start a run from ``snap`` (:meth:`restore`) with the thorax ``start_x`` m along the approach's line
+        (``x``)."""
+        self.restore(snap)
+        self.d.qpos[0] = start_x
 
     def fly(self, target: np.ndarray, n: int) -> None:
         """``n`` steps with the kinematics' target ``target`` (stops stepping once perched: the perch's own)."""
@@ -329,18 +333,13 @@ def linearise(plant: Plant, states: list, commands: np.ndarray) -> tuple[np.ndar
     """The nominal's state vectors (``(T + 1, N_STATE + 1)``) and the simulator's map over each of its ``T`` control
     steps linearised about it by central differences: ``A`` (``(T, N_STATE, N_STATE)``) and ``B`` (``(T, N_STATE,
     N_CONTROL)``)."""
-
-    m = plant.m
-    qj = np.array([m.jnt_qposadr[m.joint(n).id] for n in JOINTS])
-    dj = np.array([m.jnt_dofadr[m.joint(n).id] for n in JOINTS])
+    qj, dj, _ = mj3d.driven_dofs(plant.m)
     S = np.array([state_vector(s, qj, dj) for s in states])
     T = len(commands)
     A, B = np.zeros((T, N_STATE, N_STATE)), np.zeros((T, N_STATE, N_CONTROL))
 
     def after(k, i=-1, h=0.0, du=None):
-        mujoco.mj_copyData(plant.d, m, states[k])
-        plant.f._rec[:] = plant.rec0
-        plant.f._task[:] = plant.task0
+        plant.restore(states[k])
         if i >= 0:
             _perturb(plant.d, i, h, qj, dj)
         cmd = commands[k] if du is None else controls_to_command(commands[k], du)

@@ -36,8 +36,7 @@ def test_perturbation_moves_the_error_by_its_step(plant, snap):
     """Each tracked coordinate moved by h reads back as h in that coordinate alone (the attitude as a body-frame
     rotation, the phase wrapped)."""
     m = plant.m
-    qj = np.array([m.jnt_qposadr[m.joint(n).id] for n in P.JOINTS])
-    dj = np.array([m.jnt_dofadr[m.joint(n).id] for n in P.JOINTS])
+    qj, dj, _ = P.mj3d.driven_dofs(m)
     s0 = P.state_vector(snap, qj, dj)
     assert np.array_equal(P.state_error(s0, s0), np.zeros(P.N_STATE))
     for i in range(P.N_STATE):
@@ -56,8 +55,7 @@ def test_the_loop_reads_the_error_in_the_manoeuvres_frame(plant, snap, yaw):
     flower elsewhere, the final's bearing ``yaw``) equals the design's (``perching.state_error``) of the same state
     in the manoeuvre's own frame."""
     m = plant.m
-    qj = np.array([m.jnt_qposadr[m.joint(n).id] for n in P.JOINTS])
-    dj = np.array([m.jnt_dofadr[m.joint(n).id] for n in P.JOINTS])
+    qj, dj, _ = P.mj3d.driven_dofs(m)
     nom = P.state_vector(snap, qj, dj)
     d = mujoco.MjData(m)
     mujoco.mj_copyData(d, m, snap)
