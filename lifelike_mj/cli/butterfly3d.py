@@ -204,7 +204,8 @@ def cmd_model3d(args) -> None:
     with stage("the filmed flight with the calibrated law"):
         filmed = calibrate.filmed_flight()
     with stage(f"{total} trims, their linear models and their flights", total=total, unit="trim") as bar:
-        model = averaged.build(args.speeds, args.climbs, progress=lambda done, _n: bar.update(1))
+        model = averaged.build(args.speeds, args.climbs, progress=lambda done, _n: bar.update(1),
+                               workers=_workers(args))
     model["filmed_flight"] = {"filmed": calibrate.FILMED, "calibrated": filmed}
     out = {"provenance": provenance(speeds_m_s=args.speeds, climbs_m_s=args.climbs, force_law=model["force_law"],
                                     animal=model["animal"], n_phases=model["n_phases"]), **model}
@@ -238,7 +239,8 @@ def cmd_design3d(args) -> None:
     else:
         with stage(f"{len(args.speeds)} level trims and their linear models", total=len(args.speeds),
                    unit="trim") as bar:
-            model = averaged.build(args.speeds, [0.0], progress=lambda done, _n: bar.update(1))
+            model = averaged.build(args.speeds, [0.0], progress=lambda done, _n: bar.update(1),
+                                   workers=_workers(args))
     with stage("the gains (LQR at every level trim)"):
         spec = designed.design(model)
         lagged = designed.lagged_poles(model, spec, designed.CONTROL_LAG_S)
@@ -248,7 +250,8 @@ def cmd_design3d(args) -> None:
 
         with stage(f"the landing: {perching.N_BINS} manoeuvres shot and their tracking", total=perching.N_BINS,
                    unit="manoeuvre") as bar:
-            spec["landing"] = perching.design_landing(spec, progress=lambda done, _n: bar.update(done - bar.n))
+            spec["landing"] = perching.design_landing(spec, workers=min(2, _workers(args)),
+                                                      progress=lambda done, _n: bar.update(done - bar.n))
     ctl = designed.DesignedController(spec, name=Path(args.out).stem, provenance=provenance(
         model=args.model, model_provenance=model.get("provenance"), speeds_m_s=speeds, q_scales=spec["q_scales"],
         r_scales=spec["r_scales"], landing=not args.no_landing))
@@ -276,6 +279,19 @@ def cmd_design3d(args) -> None:
     emit(args, {"out": args.out, "speeds_m_s": speeds, "level_altitude_rms_m": alt_rms,
                 "slowest_pole_per_s": [s["slowest_pole_per_s"] for s in spec["schedule"]],
                 "lagged_poles": lagged}, human)
+
+
+def _workers(args) -> int:
+    """``--workers``, or every core."""
+    import os
+
+    return args.workers or os.cpu_count() or 1
+
+
+def _add_workers(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--workers", type=count(1, 1024), default=None,
+                   help="processes the trims' and the landing's work is shared among, 1 to 1024 (default: all cores); "
+                        "the trims are the same to the bit with any number")
 
 
 def _values(text: str, lo: float, hi: float) -> list[float]:
@@ -560,6 +576,7 @@ def add_commands(bf) -> None:
                    help="forward speeds of the trims, m/s, comma-separated (default 0.5 to 2.5 by 0.25)")
     p.add_argument("--climbs", type=_climbs, default=[-0.5, 0.0, 0.5],
                    help="climb rates of the trims, m/s, comma-separated; 0 is always among them (default -0.5,0,0.5)")
+    _add_workers(p)
     add_overwrite(p)
     add_json(p)
     p.set_defaults(func=cmd_model3d)
@@ -575,6 +592,7 @@ def add_commands(bf) -> None:
                         "(default 0.5 to 2.5 by 0.25)")
     p.add_argument("--no-landing", action="store_true", help="leave the landing out (its manoeuvres take most of "
                    "the design's time); the controller then passes flowers by")
+    _add_workers(p)
     add_overwrite(p)
     add_json(p)
     p.set_defaults(func=cmd_design3d)

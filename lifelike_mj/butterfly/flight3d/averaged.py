@@ -370,43 +370,84 @@ def _command(g: np.ndarray) -> np.ndarray:
     return p
 
 
-def trim(av: Averager, speed_m_s: float, climb_m_s: float = 0.0, start: Trim | None = None) -> Trim:
+#: Averagers made in a worker process, by their settings (:func:`_averager`).
+_OWN: dict = {}
+
+
+def _averager(settings: tuple) -> Averager:
+    """This process's Averager of ``settings`` (animal, force law, phases, rotation), made once: a worker's twin of
+    the one the caller holds (an Averager poses its model afresh at every call, so twins give the same numbers to the
+    bit)."""
+    if settings not in _OWN:
+        animal, force_law, n_phases, turns = settings
+        _OWN[settings] = Averager(animal=animal, force_law=force_law, n_phases=n_phases, rotation=turns)
+    return _OWN[settings]
+
+
+class _Own:
+    """A function of an Averager that can be sent to a worker process: there it runs on the worker's twin of ``av``
+    (:func:`_averager`); here, on ``av`` itself."""
+
+    def __init__(self, av: Averager) -> None:
+        self.av: Averager | None = av
+        self.settings = (av.animal, av.force_law, av.n_phases, av.rotation)
+
+    def __getstate__(self) -> dict:
+        return dict(self.__dict__, av=None)
+
+    def averager(self) -> Averager:
+        return self.av if self.av is not None else _averager(self.settings)
+
+
+class _Balance(_Own):
+    """:func:`trim`'s balance and residual at a speed and climb (m/s)."""
+
+    def __init__(self, av: Averager, speed_m_s: float, climb_m_s: float) -> None:
+        super().__init__(av)
+        self.v_world = np.array([speed_m_s, 0.0, climb_m_s])
+        self.nat = _gait(natural_command().as_array())
+        self.scales = np.array(list(TRIM_UNKNOWNS.values()))
+        from lifelike_mj.butterfly.flight3d.evolution import body_angle_target_deg
+
+        self.body = math.radians(body_angle_target_deg(speed_m_s))
+
+    def balance(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The averaged force (per weight) and pitch moment (per weight and :data:`ARM_M`) left over at the body
+        angle and gait ``z``."""
+        av = self.averager()
+        p = _command(z[1:])
+        R = rotation(0.0, z[0], 0.0)
+        g = R.T @ np.array([0.0, 0.0, -av.params.gravity])
+        force, moment = av.wrench(p, R.T @ self.v_world, np.zeros(3))  # moments about p's own centre of mass
+        return (force + av.mass_kg * g) / av.weight_N, moment / (av.weight_N * ARM_M)
+
+    def __call__(self, z: np.ndarray) -> np.ndarray:
+        f, m = self.balance(z)
+        av = self.averager()
+        return np.concatenate([1e4 * np.array([f[0], f[2], m[1]]), (z[1:] - self.nat) / self.scales,
+                               [(z[0] - self.body) / BODY_ANGLE_SCALE, av.power_W / av.mass_kg / POWER_SCALE_W_KG]])
+
+
+def trim(av: Averager, speed_m_s: float, climb_m_s: float = 0.0, start: Trim | None = None, workers=map) -> Trim:
     """The trimmed straight flight at ``speed_m_s`` forward and ``climb_m_s`` up (module docstring): the body angle and
     the symmetric kinematics (:data:`TRIM_UNKNOWNS`) that zero the averaged force and pitch moment, as close to the
-    filmed gait as they can be, inside the natural envelope; from ``start`` if given."""
+    filmed gait as they can be, inside the natural envelope; from ``start`` if given. ``workers``: a map-like callable
+    (a process pool's ``map``) the Jacobian's columns are evaluated with; the result is the same to the bit."""
     from scipy.optimize import least_squares
 
-    from lifelike_mj.butterfly.flight3d.evolution import body_angle_target_deg
-
-    nat = _gait(natural_command().as_array())
     bounds = {"frequency_hz": ENVELOPE["frequency_hz"], "top": (top_floor(speed_m_s), TOP_RANGE[1]),
               "amplitude": ENVELOPE["amplitude"], "feather_mean": ENVELOPE["feather_mean"],
               "feather_amplitude": ENVELOPE["feather_amplitude"], "abdomen_mean": ENVELOPE["abdomen_mean"]}
     lo = [math.radians(-30.0)] + [bounds[k][0] for k in TRIM_UNKNOWNS]
     hi = [math.radians(60.0)] + [bounds[k][1] for k in TRIM_UNKNOWNS]
-    scales = np.array(list(TRIM_UNKNOWNS.values()))
-    v_world = np.array([speed_m_s, 0.0, climb_m_s])
-
-    def balance(z):
-        p = _command(z[1:])
-        R = rotation(0.0, z[0], 0.0)
-        g = R.T @ np.array([0.0, 0.0, -av.params.gravity])
-        force, moment = av.wrench(p, R.T @ v_world, np.zeros(3))  # moments about p's own centre of mass
-        return (force + av.mass_kg * g) / av.weight_N, moment / (av.weight_N * ARM_M)
-
-    body = math.radians(body_angle_target_deg(speed_m_s))
-
-    def residual(z):
-        f, m = balance(z)
-        return np.concatenate([1e4 * np.array([f[0], f[2], m[1]]), (z[1:] - nat) / scales,
-                               [(z[0] - body) / BODY_ANGLE_SCALE, av.power_W / av.mass_kg / POWER_SCALE_W_KG]])
+    residual = _Balance(av, speed_m_s, climb_m_s)
 
     # from the filmed gait, or from the neighbouring trim (continuation along the envelope)
-    z0 = (np.concatenate([[body], nat]) if start is None
+    z0 = (np.concatenate([[residual.body], residual.nat]) if start is None
           else np.concatenate([[start.pitch_rad], _gait(start.command)]))
     sol = least_squares(residual, np.clip(z0, lo, hi), bounds=(lo, hi), diff_step=1e-3, xtol=1e-10, ftol=1e-10,
-                        gtol=1e-10)
-    f, m = balance(sol.x)
+                        gtol=1e-10, workers=workers)
+    f, m = residual.balance(sol.x)
     p = _command(sol.x[1:])
     com, inertia = av.mass_properties(p)
     return Trim(float(speed_m_s), float(climb_m_s), float(sol.x[0]), p, com, inertia,
@@ -418,22 +459,36 @@ STATE_STEPS = np.array([0.02, 0.02, 0.02, 0.2, 0.2, 0.2, 0.01, 0.01, 0.01])
 CONTROL_STEPS = np.array([0.1] + [0.01] * (len(CONTROLS) - 1))
 
 
-def linearise(av: Averager, trim: Trim) -> tuple[np.ndarray, np.ndarray]:
+class _Derivative(_Own):
+    """:func:`derivative` at a trim, of a state and controls ``(x, u)``."""
+
+    def __init__(self, av: Averager, trim: Trim) -> None:
+        super().__init__(av)
+        self.trim = trim
+
+    def __call__(self, xu: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+        return derivative(self.averager(), self.trim, *xu)
+
+
+def linearise(av: Averager, trim: Trim, workers=map) -> tuple[np.ndarray, np.ndarray]:
     """``A = df/dx`` (9 x 9) and ``B = df/du`` (9 x 9) of :func:`derivative` at ``trim`` (module docstring), by central
-    differences of whole-beat averages (:data:`STATE_STEPS`, :data:`CONTROL_STEPS`)."""
+    differences of whole-beat averages (:data:`STATE_STEPS`, :data:`CONTROL_STEPS`); ``workers``: a map-like callable
+    the differences are evaluated with (the same to the bit)."""
     x0 = np.concatenate([trim.velocity_body(), np.zeros(6)])
     u0 = np.zeros(len(CONTROLS))
-    A = np.empty((9, 9))
-    B = np.empty((9, len(CONTROLS)))
+    points = []
     for j, h in enumerate(STATE_STEPS):
         e = np.zeros(9)
         e[j] = h
-        A[:, j] = (derivative(av, trim, x0 + e, u0) - derivative(av, trim, x0 - e, u0)) / (2.0 * h)
+        points += [(x0 + e, u0), (x0 - e, u0)]
     for j, h in enumerate(CONTROL_STEPS):
         e = np.zeros(len(CONTROLS))
         e[j] = h
-        B[:, j] = (derivative(av, trim, x0, u0 + e) - derivative(av, trim, x0, u0 - e)) / (2.0 * h)
-    return A, B
+        points += [(x0, u0 + e), (x0, u0 - e)]
+    f = list(workers(_Derivative(av, trim), points))
+    steps = np.concatenate([STATE_STEPS, CONTROL_STEPS])
+    J = np.array([(f[2 * j] - f[2 * j + 1]) / (2.0 * h) for j, h in enumerate(steps)]).T
+    return J[:, :9].copy(), J[:, 9:].copy()
 
 
 def name_modes(eigenvalues: np.ndarray, tol: float = 1e-6) -> list[str]:
@@ -514,36 +569,51 @@ def flown(av: Averager, trim: Trim, beats: int = 6) -> dict:
             "body_pitch_swing_deg": m["body_pitch_swing_deg"], "beats": len(bb)}
 
 
-def build(speeds=SPEEDS_M_S, climbs=CLIMBS_M_S, force_law: str = "calibrated", progress=None) -> dict:
+def build(speeds=SPEEDS_M_S, climbs=CLIMBS_M_S, force_law: str = "calibrated", progress=None,
+          workers: int = 1) -> dict:
     """The averaged model over the envelope (module docstring): at each forward speed and climb rate the trim, its
     check in the simulator with its power (:func:`flown`), the linear model ``A, B`` and its modes. Level trims are
     found from the fastest down, each from the one before (one branch of trims, continuous in speed); climbing and
-    sinking trims from the level trim at their speed. ``progress(done, total)`` is told after each trim is found."""
+    sinking trims from the level trim at their speed. ``progress(done, total)`` is told after each trim is found.
+    ``workers`` > 1: the trims' and the linear models' differences are evaluated on that many processes (the model is
+    the same to the bit)."""
+    import contextlib
+
     av = Averager(force_law=force_law)
     climbs = sorted(set(float(c) for c in climbs) | {0.0})  # the level trims are where the others start
     total, done = len(speeds) * len(climbs), 0
     level = {}
     prev = None
-    for v in sorted(speeds, reverse=True):
-        prev = level[v] = trim(av, v, 0.0, start=prev)
-        done += 1
-        if progress is not None:
-            progress(done, total)
-    points = []
-    for v in sorted(speeds):
-        for c in climbs:
-            t = level[v] if c == 0.0 else trim(av, v, c, start=level[v])
-            A, B = linearise(av, t)
-            points.append({"speed_m_s": v, "climb_m_s": c, "body_angle_deg": math.degrees(t.pitch_rad),
-                           "command": dict(zip(KinematicsCommand.names(), (float(x) for x in t.command))),
-                           "com_m": t.com_m.tolist(), "inertia_kg_m2": t.inertia_kg_m2.tolist(),
-                           "residual_force_per_weight": t.residual_force, "residual_moment_N_m": t.residual_moment_N_m,
-                           "trimmed": bool(t.residual_force <= TRIMMED_RESIDUAL),
-                           "flown": flown(av, t), "A": A.tolist(), "B": B.tolist(), "modes": modes(A)})
-            if c != 0.0:
-                done += 1
-                if progress is not None:
-                    progress(done, total)
+    with contextlib.ExitStack() as stack:
+        pmap = map
+        if workers > 1:
+            import concurrent.futures
+            import multiprocessing
+
+            pool = stack.enter_context(concurrent.futures.ProcessPoolExecutor(
+                max_workers=workers, mp_context=multiprocessing.get_context("spawn")))
+            pmap = pool.map
+        for v in sorted(speeds, reverse=True):
+            prev = level[v] = trim(av, v, 0.0, start=prev, workers=pmap)
+            done += 1
+            if progress is not None:
+                progress(done, total)
+        points = []
+        for v in sorted(speeds):
+            for c in climbs:
+                t = level[v] if c == 0.0 else trim(av, v, c, start=level[v], workers=pmap)
+                A, B = linearise(av, t, workers=pmap)
+                points.append({"speed_m_s": v, "climb_m_s": c, "body_angle_deg": math.degrees(t.pitch_rad),
+                               "command": dict(zip(KinematicsCommand.names(), (float(x) for x in t.command))),
+                               "com_m": t.com_m.tolist(), "inertia_kg_m2": t.inertia_kg_m2.tolist(),
+                               "residual_force_per_weight": t.residual_force,
+                               "residual_moment_N_m": t.residual_moment_N_m,
+                               "trimmed": bool(t.residual_force <= TRIMMED_RESIDUAL),
+                               "flown": flown(av, t), "A": A.tolist(), "B": B.tolist(), "modes": modes(A)})
+                if c != 0.0:
+                    done += 1
+                    if progress is not None:
+                        progress(done, total)
     return {"animal": av.animal, "force_law": force_law, "mass_kg": av.mass_kg, "states": list(STATES),
             "controls": list(CONTROLS), "n_phases": av.n_phases, "points": points}
 
