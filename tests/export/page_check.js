@@ -80,8 +80,10 @@ const path = require("path");
       }
       for (const xy of (process.env.CLICKS || "").split(" ").filter(Boolean)) { // buttons drawn in the canvas
         const [x, y] = xy.split(",").map(Number);
-        await page.mouse.click(x, y);
-        await page.waitForTimeout(300);
+        // held a fifth of a second and a second and a half apart: the WASM client reads the mouse once a frame, and
+        // on a loaded machine a frame can take longer than a quick click (a click between two frames is lost)
+        await page.mouse.click(x, y, { delay: 200 });
+        await page.waitForTimeout(1500);
       }
       await page.waitForTimeout(3000);
       await shot("live2.png");
