@@ -14,6 +14,18 @@ from PIL import Image, ImageSequence
 
 from lifelike_mj.errors import UserError
 
+#: Test files whose tests pytest-xdist shares among its workers one by one: long commands, each independent of the
+#: others. Every other file's tests run in one worker together (``--dist loadgroup``), its module fixtures made once.
+SHARED_FILES = {"test_doc_commands.py"}
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    """Each test file one pytest-xdist group (:data:`SHARED_FILES` apart), before xdist reads the groups."""
+    for item in items:
+        if item.path.name not in SHARED_FILES:
+            item.add_marker(pytest.mark.xdist_group(item.path.relative_to(config.rootpath).as_posix()))
+
 
 @pytest.fixture(scope="session")
 def gl_backend():
