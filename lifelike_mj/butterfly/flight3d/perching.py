@@ -426,12 +426,13 @@ def _half(spec: dict, first: int, rest: tuple, seed: int, generations: tuple[int
 
 
 def design_landing(spec: dict, seed: int = SEED, workers: int = 2, progress=None,
-                   generations: tuple[int, int] = (FIRST_GENERATIONS, NEXT_GENERATIONS)) -> dict:
+                   generations: tuple[int, int] = (FIRST_GENERATIONS, NEXT_GENERATIONS), halves: tuple = HALVES) -> dict:
     """The designed controller ``spec``'s landing (its file's ``landing``): one manoeuvre per eighth of the wing
     beat, shot in two chains at once (:data:`HALVES`, on ``workers`` processes, seeds ``seed`` and ``seed + 1``):
     each chain's first from :data:`DECISION_START`, its others each from a neighbour's decisions (a manoeuvre for the
     next eighth of the beat is near its neighbour's); each built with its tracking (:func:`manoeuvre`).
-    ``generations``: CMA-ES's for each chain's first and for each next manoeuvre. ``progress(done, total)`` as chains
+    ``generations``: CMA-ES's for each chain's first and for each next manoeuvre; ``halves``: the chains (each its
+    first bin, then ``(bin, from bin)`` pairs; a test shoots fewer). ``progress(done, total)`` as chains
     are done. A manoeuvre whose nominal does not touch down is left out (its
     phases then start the nearest other)."""
     import concurrent.futures
@@ -441,7 +442,7 @@ def design_landing(spec: dict, seed: int = SEED, workers: int = 2, progress=None
     results: list = []
     with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, workers), mp_context=ctx) as pool:
         futures = [pool.submit(_half, spec, first, rest, seed + i, generations)
-                   for i, (first, rest) in enumerate(HALVES)]
+                   for i, (first, rest) in enumerate(halves)]
         for fu in concurrent.futures.as_completed(futures):
             results += fu.result()
             if progress:
@@ -452,7 +453,7 @@ def design_landing(spec: dict, seed: int = SEED, workers: int = 2, progress=None
             best[r[0]] = r
     results = [best[b] for b in sorted(best)]
     return {"manoeuvres": [r[3] for r in results if r[3] is not None],
-            "shooting": {"bins": N_BINS, "seed": seed, "halves": [[h[0], [list(r) for r in h[1]]] for h in HALVES],
+            "shooting": {"bins": N_BINS, "seed": seed, "halves": [[h[0], [list(r) for r in h[1]]] for h in halves],
                          "first_generations": generations[0], "first_sigma": FIRST_SIGMA,
                          "next_generations": generations[1], "population": POPULATION, "next_sigma": NEXT_SIGMA,
                          "start": DECISION_START.tolist(), "scores": [r[2] for r in results],

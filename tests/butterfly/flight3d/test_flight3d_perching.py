@@ -122,15 +122,18 @@ def test_the_shipped_controller_lands_on_unseen_gardens():
 
 @pytest.mark.slow
 def test_design_landing_writes_what_the_loop_flies():
-    """``design_landing`` (here with two generations a manoeuvre) gives eight manoeuvres whose arrays pass the file's
-    check and load as the loop's tables, each with the phase and start distance it was shot at, and records how."""
-    land = P.design_landing(SPEC, workers=2, generations=(2, 2))
+    """``design_landing`` (here two chains of two manoeuvres, with two generations each) gives manoeuvres whose arrays
+    pass the file's check and load as the loop's tables, each with the phase and start distance it was shot at, and
+    records how."""
+    halves = ((4, ((3, 4),)), (6, ((7, 6),)))
+    land = P.design_landing(SPEC, workers=2, generations=(2, 2), halves=halves)
     P.check_landing(land, "here")
     ms = land["manoeuvres"]
     assert [round(m["phase_rad"] / (2 * math.pi / P.N_BINS)) for m in ms] == [b for b, t in
-                                                                             enumerate(land["shooting"]["touched"]) if t]
+                                                                             zip((3, 4, 6, 7), land["shooting"]["touched"]) if t]
     assert all(abs(m["start_m"] - m["decisions"][14]) < 1e-6 and len(m["states"]) == len(m["commands"]) + 1
                for m in ms)
     lm, ls, lu, lk, _ = DK.landing_tables(land)
     assert lm.shape == (len(ms), 3) and np.array_equal(lm[:, 1], [len(m["commands"]) for m in ms])
     assert land["shooting"]["first_generations"] == 2 and land["shooting"]["start"] == P.DECISION_START.tolist()
+    assert land["shooting"]["halves"] == [[4, [[3, 4]]], [6, [[7, 6]]]]
