@@ -250,7 +250,7 @@ def cmd_design3d(args) -> None:
 
         with stage(f"the landing: {perching.N_BINS} manoeuvres shot and their tracking", total=perching.N_BINS,
                    unit="manoeuvre") as bar:
-            spec["landing"] = perching.design_landing(spec, workers=min(2, _workers(args)),
+            spec["landing"] = perching.design_landing(spec, workers=_workers(args),
                                                       progress=lambda done, _n: bar.update(done - bar.n))
     ctl = designed.DesignedController(spec, name=Path(args.out).stem, provenance=provenance(
         model=args.model, model_provenance=model.get("provenance"), speeds_m_s=speeds, q_scales=spec["q_scales"],

@@ -577,22 +577,19 @@ def build(speeds=SPEEDS_M_S, climbs=CLIMBS_M_S, force_law: str = "calibrated", p
     sinking trims from the level trim at their speed. ``progress(done, total)`` is told after each trim is found.
     ``workers`` > 1: the trims' and the linear models' differences are evaluated on that many processes (the model is
     the same to the bit)."""
+    import concurrent.futures
     import contextlib
+    import multiprocessing
 
     av = Averager(force_law=force_law)
     climbs = sorted(set(float(c) for c in climbs) | {0.0})  # the level trims are where the others start
     total, done = len(speeds) * len(climbs), 0
     level = {}
     prev = None
-    with contextlib.ExitStack() as stack:
-        pmap = map
-        if workers > 1:
-            import concurrent.futures
-            import multiprocessing
-
-            pool = stack.enter_context(concurrent.futures.ProcessPoolExecutor(
-                max_workers=workers, mp_context=multiprocessing.get_context("spawn")))
-            pmap = pool.map
+    pool = (concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+            if workers > 1 else contextlib.nullcontext())
+    with pool:
+        pmap = pool.map if workers > 1 else map
         for v in sorted(speeds, reverse=True):
             prev = level[v] = trim(av, v, 0.0, start=prev, workers=pmap)
             done += 1

@@ -40,6 +40,12 @@ START_WINDOW_M, START_SIDE_M, START_HEIGHT_M = 0.05, 0.06, 0.3
 BELOW_M = 0.1
 #: The most the tracking may change a control, in its Bryson scales (:data:`CONTROL_SCALE`).
 CONTROL_LIMIT = 3.0
+#: The approach's final (``designed_kernel.approach``): it aims this far ahead along its line (m); begun nearer the
+#: flower than ``FINAL_MIN_M`` it first flies out to ``FINAL_OUT_M`` (m) and turns back.
+FINAL_LOOKAHEAD_M, FINAL_MIN_M, FINAL_OUT_M = 0.9, 1.8, 2.4
+#: After a take-off the approach flies straight ahead this long (s) before it turns for its final.
+TAKE_OFF_STRAIGHT_S = 0.5
+
 
 def check_landing(landing: dict, where: str) -> None:
     """A controller file's ``landing`` checked for what the compiled loop reads (one sentence, else nothing): each
@@ -61,10 +67,3 @@ def check_landing(landing: dict, where: str) -> None:
                             f"(T, {N_CONTROL}, {N_STATE}) are asked.")
         if not (np.isfinite(s).all() and np.isfinite(u).all() and np.isfinite(k).all()):
             raise UserError(f"{where}: the landing's manoeuvre {i} holds a number that is not finite.")
-
-#: The approach's final (``designed_kernel.approach``): it aims this far ahead along its line (m); begun nearer the
-#: flower than ``FINAL_MIN_M`` it first flies out to ``FINAL_OUT_M`` (m) and turns back.
-FINAL_LOOKAHEAD_M, FINAL_MIN_M, FINAL_OUT_M = 0.9, 1.8, 2.4
-
-#: After a take-off the approach flies straight ahead this long (s) before it turns for its final.
-TAKE_OFF_STRAIGHT_S = 0.5

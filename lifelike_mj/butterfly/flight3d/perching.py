@@ -378,9 +378,6 @@ def riccati(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     return K
 
 
-
-
-
 def manoeuvre(plant: Plant, phase: float, z: np.ndarray) -> dict | None:
     """The manoeuvre of decisions ``z`` started at the beat's ``phase`` (rad) as the controller file keeps it: its
     start distance, its nominal (states and commands at each control step, to the touchdown) and its tracking's gains
@@ -440,7 +437,7 @@ def design_landing(spec: dict, seed: int = SEED, workers: int = 2, progress=None
 
     ctx = multiprocessing.get_context("spawn")
     results: list = []
-    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, workers), mp_context=ctx) as pool:
+    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, min(workers, len(halves))), mp_context=ctx) as pool:
         futures = [pool.submit(_half, spec, first, rest, seed + i, generations)
                    for i, (first, rest) in enumerate(halves)]
         for fu in concurrent.futures.as_completed(futures):
