@@ -6,6 +6,8 @@ import json
 import os
 import shutil
 import subprocess
+import threading
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -187,12 +189,34 @@ class _Chromium:
     def __init__(self, executable: str) -> None:
         self.executable = executable
 
-    def check(self, *args: str, clicks: str = "") -> dict:
-        """``page_check.js`` run on ``args`` (``clicks``: "x,y x,y" pressed in a live viewer): its JSON report."""
-        out = subprocess.run(["node", str(Path(__file__).parent / "export" / "page_check.js"), *args], capture_output=True,
-                             text=True, timeout=240, check=True,
-                             env=dict(os.environ, NODE_PATH=str(self.modules), CHROMIUM=self.executable, CLICKS=clicks))
-        return json.loads(out.stdout.strip().splitlines()[-1])
+    def check(self, *args: str, clicks: str = "", pressed: Callable[[int], bool] | None = None) -> dict:
+        """``page_check.js`` run on ``args``: its JSON report. ``clicks`` ("x,y x,y"): pressed in a live viewer one by
+        one; after the i-th, ``pressed(i)`` says whether it took effect (it waits for it), else it is pressed again,
+        at most three times."""
+        env = dict(os.environ, NODE_PATH=str(self.modules), CHROMIUM=self.executable, CLICKS=clicks)
+        node = subprocess.Popen(["node", str(Path(__file__).parent / "export" / "page_check.js"), *args], env=env,
+                                stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        timer = threading.Timer(300.0, node.kill)  # never a hang: at most five minutes
+        timer.start()
+        try:
+            tries: dict[int, int] = {}
+            for line in node.stdout:
+                if not line.startswith('{"pressed":'):
+                    break  # the report, the last line
+                i = json.loads(line)["pressed"]
+                tries[i] = tries.get(i, 0) + 1  # pressed once more, held longer (page_check.js)
+                again = pressed is not None and not pressed(i) and tries[i] < 3
+                node.stdin.write("again\n" if again else "next\n")
+                node.stdin.flush()
+            rest, err = node.communicate(timeout=240)
+        finally:
+            timer.cancel()
+            if node.poll() is None:
+                node.kill()
+                node.communicate()
+        assert node.returncode == 0, err
+        report = json.loads((line + rest).strip().splitlines()[-1])
+        return {**report, "presses": [tries[i] for i in sorted(tries)]}
 
     @staticmethod
     def changed_pixels(a: str, b: str) -> int:

@@ -1,7 +1,8 @@
 // Opens a page in headless Chromium (Debian's, through playwright-core) and takes pictures of it:
 //   node page_check.js web URL [EMPTY] OUTDIR      MuJoCo's web viewer: shots after 20 s and 23 s of live simulation
 //                                                  (and of the viewer at the address EMPTY after 20 s); the
-//                                                  environment's CLICKS ("x,y x,y") are clicked between the two
+//                                                  environment's CLICKS ("x,y x,y") are clicked between the two,
+//                                                  each confirmed on stdin (below)
 //   node page_check.js html FILE EMPTY OUTDIR T1 T2   an exported page paused at T1 and T2 s (by the slider), then
 //                                                     the page EMPTY (the same without the creature) at T1
 // Prints one JSON line: {"errors": [console errors and page errors], "shots": [png paths],
@@ -17,6 +18,10 @@ const path = require("path");
     args: ["--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-sandbox"],
   });
   const page = await browser.newPage({ viewport: { width: 640, height: 480 } });
+  if (process.env.THROTTLE) { // a slow machine, for trying this script: the page's CPU slowed this many times
+    const cdp = await page.context().newCDPSession(page);
+    await cdp.send("Emulation.setCPUThrottlingRate", { rate: Number(process.env.THROTTLE) });
+  }
   const errors = [];
   page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
   page.on("pageerror", (e) => errors.push(String(e)));
@@ -78,13 +83,28 @@ const path = require("path");
         await pages[1].screenshot({ path: file });
         shots.push(file);
       }
-      for (const xy of (process.env.CLICKS || "").split(" ").filter(Boolean)) { // buttons drawn in the canvas
-        const [x, y] = xy.split(",").map(Number);
-        // held a fifth of a second and a second and a half apart: the WASM client reads the mouse once a frame, and
-        // on a loaded machine a frame can take longer than a quick click (a click between two frames is lost)
-        await page.mouse.click(x, y, { delay: 200 });
-        await page.waitForTimeout(1500);
+      // buttons drawn in the canvas, pressed one by one: the page sends the mouse to the server once a frame and
+      // the server reads it once a frame of its own, so on a loaded machine a press can fall between two frames and
+      // be lost. After each press this prints {"pressed": i} and reads a line: "again" presses it once more, anything
+      // else goes on (the caller watches the server for the press's effect); with no reader, stdin's end goes on.
+      const clicks = (process.env.CLICKS || "").split(" ").filter(Boolean);
+      const reader = clicks.length ? require("readline").createInterface({ input: process.stdin }) : null;
+      const lines = reader && reader[Symbol.asyncIterator]();
+      let hold = 300; // ms, longer at each try of the same button
+      for (let i = 0; i < clicks.length; i++) {
+        const [x, y] = clicks[i].split(",").map(Number);
+        await page.mouse.move(x, y);
+        await page.waitForTimeout(hold);
+        await page.mouse.down();
+        await page.waitForTimeout(hold);
+        await page.mouse.up();
+        console.log(JSON.stringify({ pressed: i, hold_ms: hold }));
+        const answer = await lines.next();
+        const again = !answer.done && answer.value.trim() === "again";
+        if (again) i--;
+        hold = again ? hold * 3 : 300;
       }
+      if (reader) reader.close();
       await page.waitForTimeout(3000);
       await shot("live2.png");
     }

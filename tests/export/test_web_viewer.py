@@ -8,6 +8,7 @@ import socket
 import subprocess
 import sys
 import textwrap
+import threading
 from pathlib import Path
 
 import pytest
@@ -68,6 +69,38 @@ EMPTY = textwrap.dedent("""
 #: pellet", then "tap the front glass", then the shadow that looms over one fish).
 SCENES = {"fish": (["fish", "--seed", "1"], "126,128 126,102 126,154"), "butterfly": (["butterfly"], ""),
           "butterfly3d": (["butterfly3d"], ""), "boids": (["boids", "--n", "100"], "")}
+#: What the server prints when each of those buttons reaches the scene.
+LABELS = {"fish": ["drop a food pellet", "tap the front glass", "a shadow looms over one fish: it alone startles"]}
+
+
+class _Said:
+    """The lines a server prints, read as they come (a thread), so that a press in the page can be confirmed: the
+    i-th press took effect when the server has printed the i-th of ``labels``."""
+
+    def __init__(self, proc: subprocess.Popen, labels: list[str]) -> None:
+        self.lines: list[str] = []
+        self.labels = labels
+        self.changed = threading.Condition()
+        self.thread = threading.Thread(target=self._read, args=(proc,), daemon=True)
+        self.thread.start()
+
+    def _read(self, proc: subprocess.Popen) -> None:
+        for line in proc.stdout:
+            with self.changed:
+                self.lines.append(line)
+                self.changed.notify_all()
+
+    def text(self) -> str:
+        with self.changed:
+            return "".join(self.lines)
+
+    def pressed(self, i: int, seconds: float = 10.0) -> bool:
+        """Whether the i-th label has been printed (after the ones before it), waiting for it at most ``seconds``."""
+        def seen() -> bool:
+            said = [line.rstrip("\n") for line in self.lines if line.rstrip("\n") in self.labels]
+            return said[:i + 1] == self.labels[:i + 1]
+        with self.changed:
+            return self.changed.wait_for(seen, timeout=seconds)
 
 
 @pytest.mark.skipif(not Path("/proc/net/tcp").exists(), reason="reads the listening sockets from Linux's /proc")
@@ -79,16 +112,19 @@ def test_the_web_viewer_draws_the_live_creature_on_localhost_only(chromium, tmp_
     args, clicks = SCENES[scene]
     port, empty_port = _free_port(), _free_port()
     live, url, keys = _start([sys.executable, "-m", "lifelike_mj", "view", *args, "--web", "--port", str(port)])
+    said = _Said(live, LABELS.get(scene, []))
     empty, empty_url, _ = _start([sys.executable, "-c", EMPTY, "view", *args, "--web", "--port", str(empty_port)])
     try:
         assert url == f"http://localhost:{port}/"
         assert _listening_soon(port) == ["0100007F"]  # 127.0.0.1 only: not reachable from another machine
-        r = chromium.check("web", url, empty_url, str(tmp_path), clicks=clicks)
+        r = chromium.check("web", url, empty_url, str(tmp_path), clicks=clicks, pressed=said.pressed)
     finally:
         live.send_signal(signal.SIGINT)  # Ctrl+C
         empty.send_signal(signal.SIGINT)
         try:
-            out, err = live.communicate(timeout=60)
+            err = live.communicate(timeout=60)[1]
+            said.thread.join(timeout=60)
+            out = said.text()
             empty.communicate(timeout=60)
         finally:  # never leave a server behind, even when it does not stop
             for proc in (live, empty):
@@ -105,7 +141,7 @@ def test_the_web_viewer_draws_the_live_creature_on_localhost_only(chromium, tmp_
     assert keys == ("keys: Space tap the front glass; Enter drop a food pellet; Right a shadow looms over one fish: it "
                     "alone startles")
     # the buttons reached the aquarium, in order
-    assert "drop a food pellet\ntap the front glass\na shadow looms over one fish: it alone startles" in out
+    assert "drop a food pellet\ntap the front glass\na shadow looms over one fish: it alone startles" in out, (out, r["presses"])
 
 
 @pytest.mark.skipif(not Path("/proc/net/tcp").exists(), reason="reads the listening sockets from Linux's /proc")
