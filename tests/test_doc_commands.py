@@ -148,7 +148,6 @@ RUN_SLOW = {
     "lifelike-mj butterfly land3d --flowers 4 --seed 360 --picture land.png",
     "lifelike-mj butterfly land3d",
     "lifelike-mj butterfly land3d --picture land.png",
-    "lifelike-mj butterfly garden --n 20 --duration 10 --out garden.mp4 --paths garden.png",
     "lifelike-mj export butterfly3d --task course --seed 101 --duration 6 --out flight.glb",
     "lifelike-mj export butterfly3d --task level --start 5 --duration 2 --loop --out cycle.glb",
     "lifelike-mj export boids --preset 5b --n 300 --steps 1500 --out flock.glb",

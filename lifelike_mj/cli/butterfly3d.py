@@ -248,7 +248,7 @@ def cmd_design3d(args) -> None:
     if not args.no_landing:
         from lifelike_mj.butterfly.flight3d import perching
 
-        with stage(f"the landing: {perching.N_BINS} manoeuvres shot and their tracking", total=perching.N_BINS,
+        with stage(f"the landing: {perching.N_BINS} manoeuvres and the take-off shot, and their tracking", total=perching.N_BINS,
                    unit="manoeuvre") as bar:
             spec["landing"] = perching.design_landing(spec, workers=_workers(args),
                                                       progress=lambda done, _n: bar.update(done - bar.n))

@@ -666,7 +666,16 @@ def json_schema() -> dict:
                             "commands": {"type": "array", "maxItems": 2000,
                                          "description": "its kinematics at each control step"},
                             "gains": {"type": "array", "maxItems": 2000,
-                                      "description": "the tracking's gain at each control step"}}}}}},
+                                      "description": "the tracking's gain at each control step"}}}},
+                        "take_off": {"type": "object", "required": ["states", "commands", "gains"], "description":
+                                     "the take-off: a manoeuvre shot from perched states and its tracking",
+                                     "properties": {
+                                         "states": {"type": "array", "maxItems": 2001,
+                                                    "description": "the nominal's state at each control step and its end"},
+                                         "commands": {"type": "array", "maxItems": 2000,
+                                                      "description": "its kinematics at each control step"},
+                                         "gains": {"type": "array", "maxItems": 2000,
+                                                   "description": "the tracking's gain at each control step"}}}}},
         "provenance": {"type": "object"},
     }
     return document_schema(FORMAT, "lifelike-mj 3D butterfly controller, designed", props,

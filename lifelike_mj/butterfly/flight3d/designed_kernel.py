@@ -69,11 +69,15 @@ def landing_tables(landing: dict | None) -> tuple[np.ndarray, ...]:
     design_landing`) as the arrays the compiled loop reads: per manoeuvre its start distance (m), length (control
     steps) and phase (rad) (``lm``), its nominal states (``ls``, :func:`~lifelike_mj.butterfly.flight3d.perching.
     state_vector`), commands (``lu``) and gains (``lk``), padded to the longest; and the landing's constants
-    (``lc``). Without a landing, zero manoeuvres."""
+    (``lc``). The take-off (``landing["take_off"]``, if any) is the last row, its start distance -1. Without a
+    landing, zero manoeuvres."""
     lc = np.array([PE.RISE_M, PE.APPROACH_M_S, PE.START_WINDOW_M, PE.START_SIDE_M, PE.START_HEIGHT_M,
                    PE.MAX_GLIDE_S / (PE.EVERY * 1.0 / 800.0), PE.BELOW_M, *PE.CONTROL_SCALE, PE.CONTROL_LIMIT,
                    PE.FINAL_LOOKAHEAD_M, PE.FINAL_MIN_M, PE.FINAL_OUT_M, PE.TAKE_OFF_STRAIGHT_S])
-    bins = (landing or {}).get("manoeuvres") or []
+    bins = list((landing or {}).get("manoeuvres") or [])
+    rising = (landing or {}).get("take_off")
+    if bins and rising:
+        bins.append({**rising, "start_m": -1.0, "phase_rad": 0.0})
     n = len(bins)
     t_max = max([len(b["commands"]) for b in bins] + [1])
     lm, ls = np.zeros((n, 3)), np.zeros((n, t_max + 1, PE.N_STATE + 1))
@@ -100,7 +104,9 @@ def trigger(st, task, qpos, qvel, psi, lm, lc):
     tx, ty = sx - qpos[0], sy - qpos[1]
     dist = math.sqrt(tx * tx + ty * ty)
     j, best = 0, 10.0
-    for i in range(lm.shape[0]):  # the manoeuvre whose phase is nearest the beat's now
+    for i in range(lm.shape[0]):  # the manoeuvre whose phase is nearest the beat's now (not the take-off)
+        if lm[i, 0] < 0.0:
+            continue
         gap = abs((psi - lm[i, 2] + math.pi) % (2.0 * math.pi) - math.pi)
         if gap < best:
             j, best = i, gap
@@ -144,7 +150,11 @@ def approach(st, task, qpos, lm, lc, wp, t, rec):
         else:
             wp[0], wp[1], wp[2] = sx - lc[16] * c, sy - lc[16] * s, sz + lc[0]
             return
-    if along < lm[:, 0].min() - 0.5 * lc[2] - 0.05:  # every start passed: around again, the other way
+    nearest = 1e9
+    for i in range(lm.shape[0]):
+        if lm[i, 0] >= 0.0:
+            nearest = min(nearest, lm[i, 0])
+    if along < nearest - 0.5 * lc[2] - 0.05:  # every start passed: around again, the other way
         st[f0 + 1] = st[f0 + 1] + math.pi
         st[f0 + 2] = 1.0
         wp[0], wp[1], wp[2] = sx + lc[16] * c, sy + lc[16] * s, sz + lc[0]
@@ -189,6 +199,21 @@ def tracking_error(st, ud, qpos, qvel, nom, lc):
 
 
 @njit(cache=True)
+def rise(st, qpos, ls, j):
+    """Start the take-off's manoeuvre (row ``j`` of the landing's tables, :func:`landing_tables`): its frame (``st``'s
+    landing scalars, as :func:`tracking_error` reads them) placed so that the nominal's first state lies where the
+    body is, turned to its heading: the error starts with the attitude's and the joints' alone."""
+    s0 = ST_LAND
+    yaw = L.attitude(qpos[3:7])[2] - L.attitude(ls[j, 0, 6:10])[2]
+    c, s = math.cos(yaw), math.sin(yaw)
+    n0 = ls[j, 0]
+    st[s0], st[s0 + 1], st[s0 + 2], st[s0 + 3] = 1.0, j, 0.0, yaw
+    st[s0 + 4] = qpos[0] - (c * n0[0] - s * n0[1])
+    st[s0 + 5] = qpos[1] - (s * n0[0] + c * n0[1])
+    st[s0 + 6] = qpos[2] - PE.RISE_M - n0[2]
+
+
+@njit(cache=True)
 def tracked(st, ud, qpos, qvel, lm, ls, lu, lk, lc, out):
     """The command (into ``out``) of a landing's manoeuvre under way (``st``'s landing scalars): its nominal's
     command at this control step less its gain times the state's error from the nominal
@@ -199,7 +224,7 @@ def tracked(st, ud, qpos, qvel, lm, ls, lu, lk, lc, out):
     s0 = ST_LAND
     j, k = int(st[s0 + 1]), int(st[s0 + 2])
     t = int(lm[j, 1])
-    if k >= t + lc[5] or qpos[2] < st[s0 + 6] - lc[6]:
+    if k >= t + lc[5] or qpos[2] < st[s0 + 6] - lc[6] or (lm[j, 0] < 0.0 and k >= t):  # a take-off: no glide
         st[s0] = 0.0
         return
     st[s0 + 2] = k + 1
@@ -598,6 +623,17 @@ def _head(ud, qpos, qvel, time, dt, every, task, rec, st, buf, tmpl, wp, ref, ba
     if (int(st[0]) - 1) % every != 0:
         return False
     kind = int(task[L.T_KIND])
+    j = lm.shape[0] - 1
+    if j >= 0 and lm[j, 0] < 0.0:  # a take-off's manoeuvre: started at the take-off's first step, whatever the task
+        # (its time as the caller's clock gives it: a sum of steps, which the data's may differ from by a rounding)
+        if st[ST_LAND] == 0.0 and abs(time[0] - rec[L.R_TOOK_OFF_AT]) < 0.5 * every * dt:
+            rise(st, qpos, ls, j)
+        if st[ST_LAND] != 0.0 and int(st[ST_LAND + 1]) == j:
+            tracked(st, ud, qpos, qvel, lm, ls, lu, lk, lc, baseline)
+            if st[ST_LAND] != 0.0:
+                for i in range(N_PARAMS):
+                    ud[mj3d.U_TARGET + i] = baseline[i]
+                return True
     if kind == L.TASK_LAND and lm.shape[0] > 0:
         if st[ST_LAND] == 0.0:
             trigger(st, task, qpos, qvel, ud[mj3d.U_PSI0], lm, lc)

@@ -49,21 +49,24 @@ TAKE_OFF_STRAIGHT_S = 0.5
 
 def check_landing(landing: dict, where: str) -> None:
     """A controller file's ``landing`` checked for what the compiled loop reads (one sentence, else nothing): each
-    manoeuvre's states, commands and gains of matching lengths and sizes, all finite."""
+    manoeuvre's, and the take-off's, states, commands and gains of matching lengths and sizes, all finite."""
     from lifelike_mj.errors import UserError
 
-    for i, m in enumerate(landing["manoeuvres"]):
+    named = [(f"manoeuvre {i}", m) for i, m in enumerate(landing["manoeuvres"])]
+    if "take_off" in landing:
+        named.append(("take-off", landing["take_off"]))
+    for name, m in named:
         try:
             s = np.array(m["states"], dtype=float)
             u = np.array(m["commands"], dtype=float)
             k = np.array(m["gains"], dtype=float)
         except (TypeError, ValueError):
-            raise UserError(f"{where}: the landing's manoeuvre {i} holds something other than arrays of numbers.") from None
+            raise UserError(f"{where}: the landing's {name} holds something other than arrays of numbers.") from None
         t = len(u)
         if (t < 1 or s.shape != (t + 1, N_STATE + 1) or u.shape != (t, N_PARAMS)
                 or k.shape != (t, N_CONTROL, N_STATE)):
-            raise UserError(f"{where}: the landing's manoeuvre {i} has states, commands and gains of shapes "
+            raise UserError(f"{where}: the landing's {name} has states, commands and gains of shapes "
                             f"{s.shape}, {u.shape}, {k.shape}; (T + 1, {N_STATE + 1}), (T, {N_PARAMS}) and "
                             f"(T, {N_CONTROL}, {N_STATE}) are asked.")
         if not (np.isfinite(s).all() and np.isfinite(u).all() and np.isfinite(k).all()):
-            raise UserError(f"{where}: the landing's manoeuvre {i} holds a number that is not finite.")
+            raise UserError(f"{where}: the landing's {name} holds a number that is not finite.")

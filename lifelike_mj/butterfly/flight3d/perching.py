@@ -148,11 +148,12 @@ class Plant:
         snap.qpos[1:3] = 0.0
         return snap
 
-    def restore(self, snap: mujoco.MjData) -> None:
-        """The simulation back at ``snap`` (an ``MjData`` of this plant), the landing task and its record afresh."""
+    def restore(self, snap: mujoco.MjData, task: np.ndarray | None = None) -> None:
+        """The simulation back at ``snap`` (an ``MjData`` of this plant), the landing task (or ``task``, a task array)
+        and its record afresh."""
         mujoco.mj_copyData(self.d, self.m, snap)
         self.f._rec[:] = self.rec0
-        self.f._task[:] = self.task0
+        self.f._task[:] = self.task0 if task is None else task
         self.f._diverged = ""
 
     def load(self, snap: mujoco.MjData, start_x: float) -> None:
@@ -329,17 +330,18 @@ def controls_to_command(command: np.ndarray, u: np.ndarray) -> np.ndarray:
     return ct.command_from_controls(command, full)
 
 
-def linearise(plant: Plant, states: list, commands: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def linearise(plant: Plant, states: list, commands: np.ndarray,
+              task: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The nominal's state vectors (``(T + 1, N_STATE + 1)``) and the simulator's map over each of its ``T`` control
     steps linearised about it by central differences: ``A`` (``(T, N_STATE, N_STATE)``) and ``B`` (``(T, N_STATE,
-    N_CONTROL)``)."""
+    N_CONTROL)``). ``task``: the task array flown (default the landing's, :meth:`Plant.restore`)."""
     qj, dj, _ = mj3d.driven_dofs(plant.m)
     S = np.array([state_vector(s, qj, dj) for s in states])
     T = len(commands)
     A, B = np.zeros((T, N_STATE, N_STATE)), np.zeros((T, N_STATE, N_CONTROL))
 
     def after(k, i=-1, h=0.0, du=None):
-        plant.restore(states[k])
+        plant.restore(states[k], task)
         if i >= 0:
             _perturb(plant.d, i, h, qj, dj)
         cmd = commands[k] if du is None else controls_to_command(commands[k], du)
@@ -357,16 +359,17 @@ def linearise(plant: Plant, states: list, commands: np.ndarray) -> tuple[np.ndar
     return S, A, B
 
 
-def riccati(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+def riccati(A: np.ndarray, B: np.ndarray, end: tuple = END_SCALE) -> np.ndarray:
     """The time-varying LQR's gains ``K`` (``(T, N_CONTROL, N_STATE)``, ``u = -K x``) of the linearised nominal, with
-    Bryson's weights (:data:`CONTROL_SCALE`, :data:`RUN_SCALE`, :data:`END_SCALE`)."""
+    Bryson's weights (:data:`CONTROL_SCALE`, :data:`RUN_SCALE`, and at the end ``end``: :data:`END_SCALE`'s
+    layout)."""
     q = np.zeros(N_STATE)
     q[0:3], q[3:6], q[6:9] = RUN_SCALE[0] ** -2, RUN_SCALE[1] ** -2, RUN_SCALE[2] ** -2
     Q = np.diag(q)
     R = np.diag(CONTROL_SCALE ** -2.0)
     qf = np.zeros(N_STATE)
-    qf[0:3] = np.array(END_SCALE[0]) ** -2.0
-    qf[3:6], qf[6:9], qf[9:12] = END_SCALE[1] ** -2, END_SCALE[2] ** -2, END_SCALE[3] ** -2
+    qf[0:3] = np.array(end[0]) ** -2.0
+    qf[3:6], qf[6:9], qf[9:12] = end[1] ** -2, end[2] ** -2, end[3] ** -2
     P = np.diag(qf)
     T = len(A)
     K = np.zeros((T, N_CONTROL, N_STATE))
@@ -389,12 +392,178 @@ def manoeuvre(plant: Plant, phase: float, z: np.ndarray) -> dict | None:
         return None
     S, A, B = linearise(plant, o["states"], o["commands"])
     K = riccati(A, B)
-
-    def r(a, digits=7):
-        return [float(f"{v:.{digits}g}") for v in a] if np.ndim(a) == 1 else [r(x, digits) for x in a]
-
+    r = _rounded
     return {"phase_rad": float(phase), "start_m": float(z[14]), "decisions": r(z), "touchdown_m_s": o["speed_m_s"],
             "up": o["up"], "states": r(S, 9), "commands": r(o["commands"], 9), "gains": r(K, 6)}
+
+
+#: The take-off's decisions (:func:`take_off_commands`): for each of its two held commands the changes of frequency
+#: (Hz), stroke offset, amplitude, feathering mean and abdomen (rad) from the approach's trim and how long it is held
+#: (s); then the trim itself is flown for :data:`TAKE_OFF_HOLD_S`, and the regulator takes over.
+N_TAKE_OFF = 12
+#: Where the take-off's shooting starts: what a first search found (2026-11-29: 30 generations from the trim held
+#: throughout, which drops the body 0.34 m), rounded: a faster beat with a larger, lower stroke and the abdomen raised
+#: for 0.09 s, then a still faster one with the wings' offset raised for 0.13 s.
+TAKE_OFF_START = np.array([0.04, -0.1, 0.4, 0.0, -0.22, 0.09, 1.16, 0.02, 0.33, 0.14, 0.01, 0.13])
+TAKE_OFF_SCALE = DECISION_SCALE[:12]
+TAKE_OFF_LO = DECISION_LO[:12]
+TAKE_OFF_HI = np.array([2.0, 0.8, 0.6, 0.6, 0.6, 0.4] * 2)
+#: How long the trim is flown at the end of the take-off's nominal (s), the last beat of it scored.
+TAKE_OFF_HOLD_S = 0.25
+#: The perches the take-off is shot from: the landings of :data:`DECISION_START` begun at these eighths of the beat
+#: and these (along, height) offsets (m), each then perched for a second (one still upright then: :func:`perches`):
+#: bodies pitched -0.24 to +0.10 rad on their blossom.
+TAKE_OFF_PERCHES = ((4, 0.0, 0.0), (4, 0.02, 0.0), (4, -0.02, 0.0), (5, -0.02, 0.0))
+#: The take-off's tracking: Bryson's scales at its end (:data:`END_SCALE`'s layout: position, velocity, attitude,
+#: rates), looser than a touchdown's: it hands over to the regulator, which holds the trim.
+TAKE_OFF_END_SCALE = ((0.05, 0.05, 0.05), 0.2, 0.1, 1.0)
+#: The take-off's shooting: CMA-ES generations, step, population (the seed is the landing's).
+TAKE_OFF_GENERATIONS, TAKE_OFF_SIGMA, TAKE_OFF_POPULATION = 30, 0.3, 12
+
+
+def take_off_commands(trim: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """The take-off of decisions ``z`` (:data:`N_TAKE_OFF`) from the trim kinematics ``trim``: its first and second
+    held commands and how long each is held (s)."""
+    c1, c2, _, t1, t2 = commands_of(trim, np.concatenate([z, [0.0, 0.0, 0.0]]))
+    return c1, c2, t1, t2
+
+
+def perches(plant: Plant) -> list:
+    """The perched states the take-off is shot from (:data:`TAKE_OFF_PERCHES`; those still perched and upright,
+    :func:`~lifelike_mj.butterfly.flight3d.landing.up` above 0.9, after a second): ``MjData`` copies."""
+    out = []
+    for b, along, height in TAKE_OFF_PERCHES:
+        run(plant, plant.settled(2.0 * math.pi * b / N_BINS), DECISION_START, along, height)
+        if plant.perched:
+            plant.fly(plant.trim, int(round(1.0 / plant.dt)))
+            if plant.perched and up(plant.d) > 0.9:
+                out.append(copy.copy(plant.d))
+    return out
+
+
+def take_off_task(plant: Plant) -> np.ndarray:
+    """The task flown after a take-off on the plant: the landing's, its flower 30 m ahead (no touchdown on the
+    flower just left)."""
+    from lifelike_mj.butterfly.flight3d.tasks import T_ROW0
+
+    task = plant.task0.copy()
+    task[T_ROW0] += 30.0
+    return task
+
+
+def trim_pitch(plant: Plant) -> float:
+    """The approach trim's pitch (rad, nose up), averaged over a beat of settled flight."""
+    from lifelike_mj.butterfly.flight3d.loop import attitude
+
+    plant.restore(plant.settled(0.0))
+    pitch = []
+    for _ in range(int(round(0.1 / plant.dt))):
+        plant.fly(plant.trim, 1)
+        pitch.append(attitude(plant.d.qpos[3:7])[1])
+    return float(np.mean(pitch))
+
+
+def take_off_run(plant: Plant, perch: mujoco.MjData, z: np.ndarray, pitch_ref: float, record: bool = False) -> dict:
+    """Take off from ``perch`` (:func:`perches`) flying the decisions ``z`` open loop, as a garden's butterfly takes
+    off (:func:`~lifelike_mj.butterfly.flight3d.loop.take_off_kinematics`, the task then :func:`take_off_task`).
+    Returns ``drop_m`` (the most the thorax sank below its perch), ``tilt_rad`` (the largest roll or pitch from
+    ``pitch_ref``), ``gain_m`` (height gained at the end), and over the last beat: ``forward_m_s``, ``side_m_s``,
+    ``climb_m_s`` (along, across and up from the heading at the start), ``pitch_rad``, ``roll_rad``, ``yaw_rad`` (turned
+    since the start), ``rates_rad_s`` (norm); ``failed`` if it diverged or touched down; with ``record`` the
+    ``states`` and ``commands`` at each control step."""
+    from lifelike_mj.butterfly.flight3d.loop import attitude, take_off_kinematics
+
+    c1, c2, t1, t2 = take_off_commands(plant.trim, z)
+    plant.restore(perch, take_off_task(plant))
+    take_off_kinematics(plant.d.userdata, plant.f._batch.base)
+    d, step = plant.d, EVERY * plant.dt
+    z0, yaw0 = float(d.qpos[2]), attitude(d.qpos[3:7])[2]
+    n1, n2, n3 = int(round(t1 / step)), int(round(t2 / step)), int(round(TAKE_OFF_HOLD_S / step))
+    n_last = max(1, int(round(0.1 / step)))
+    low, tilt, last, states, commands = z0, 0.0, [], [], []
+    for k in range(n1 + n2 + n3):
+        cmd = c1 if k < n1 else (c2 if k < n1 + n2 else plant.trim)
+        if record:
+            states.append(copy.copy(d))
+            commands.append(cmd)
+        plant.fly(cmd, EVERY)
+        if plant.f._diverged or plant.perched:
+            return {"failed": True}
+        roll, pitch, yaw = attitude(d.qpos[3:7])
+        low, tilt = min(low, float(d.qpos[2])), max(tilt, abs(roll), abs(pitch - pitch_ref))
+        if k >= n1 + n2 + n3 - n_last:
+            last.append([roll, pitch, (yaw - yaw0 + math.pi) % (2.0 * math.pi) - math.pi, *d.qvel[0:6]])
+    m = np.mean(last, axis=0)
+    c, s = math.cos(yaw0), math.sin(yaw0)
+    out = {"failed": False, "drop_m": z0 - low, "tilt_rad": tilt, "gain_m": float(d.qpos[2]) - z0,
+           "forward_m_s": c * m[3] + s * m[4], "side_m_s": -s * m[3] + c * m[4], "climb_m_s": m[5],
+           "pitch_rad": m[1], "roll_rad": m[0], "yaw_rad": m[2], "rates_rad_s": float(np.linalg.norm(m[6:9]))}
+    if record:
+        states.append(copy.copy(d))
+        out.update(states=states, commands=np.array(commands))
+    return out
+
+
+def take_off_cost(o: dict, pitch_ref: float) -> float:
+    """A take-off's cost (lower is better; :func:`take_off_run`'s outcome ``o``): 20 per m of drop below the perch,
+    2 per rad of tilt beyond 0.4 rad, 10 per m short of a 5 cm gain, and a quarter of the hand-over's squared
+    distance from the approach's trim in Bryson's scales (0.3 m/s along and across, sinking or climbing faster than
+    0.5 m/s; 0.2 rad of pitch and roll, 0.3 rad of turn; 1 rad/s of rates). A failed run costs 50."""
+    if o["failed"]:
+        return 50.0
+    climb = o["climb_m_s"]
+    climb_off = climb if climb < 0.0 else max(0.0, climb - 0.5)
+    end = (((o["forward_m_s"] - APPROACH_M_S) / 0.3) ** 2 + (o["side_m_s"] / 0.3) ** 2 + (climb_off / 0.3) ** 2
+           + ((o["pitch_rad"] - pitch_ref) / 0.2) ** 2 + (o["roll_rad"] / 0.2) ** 2 + (o["yaw_rad"] / 0.3) ** 2
+           + o["rates_rad_s"] ** 2)
+    return (20.0 * o["drop_m"] + 2.0 * max(0.0, o["tilt_rad"] - 0.4) + 10.0 * max(0.0, 0.05 - o["gain_m"])
+            + 0.25 * end)
+
+
+def design_take_off(spec: dict, seed: int = 1, generations: int = TAKE_OFF_GENERATIONS) -> dict:
+    """The designed controller ``spec``'s take-off (its file's ``landing["take_off"]``): decisions shot by CMA-ES
+    (``seed``, ``generations``) from :data:`TAKE_OFF_START`, minimising the mean :func:`take_off_cost` over
+    :func:`perches`; its nominal flown from the first perch and tracked by a time-varying LQR (:func:`linearise`,
+    :func:`riccati` with :data:`TAKE_OFF_END_SCALE`), as the landing's manoeuvres are."""
+    import cma
+
+    plant = Plant(spec)
+    snaps, pitch_ref = perches(plant), trim_pitch(plant)
+
+    def score(z):
+        z = np.clip(z, TAKE_OFF_LO, TAKE_OFF_HI)
+        return float(np.mean([take_off_cost(take_off_run(plant, p, z, pitch_ref), pitch_ref) for p in snaps]))
+
+    x0 = TAKE_OFF_START
+    lo, hi = (TAKE_OFF_LO - x0) / TAKE_OFF_SCALE, (TAKE_OFF_HI - x0) / TAKE_OFF_SCALE
+    es = cma.CMAEvolutionStrategy(np.zeros(N_TAKE_OFF), TAKE_OFF_SIGMA, {
+        "seed": seed, "popsize": TAKE_OFF_POPULATION, "bounds": [list(lo), list(hi)], "verbose": -9,
+        "maxiter": generations})
+    best, best_f = x0, score(x0)
+    while not es.stop():
+        xs = es.ask()
+        fs = [score(x0 + TAKE_OFF_SCALE * x) for x in xs]
+        es.tell(xs, fs)
+        i = int(np.argmin(fs))
+        if fs[i] < best_f:
+            best, best_f = x0 + TAKE_OFF_SCALE * xs[i], fs[i]
+    best = np.clip(best, TAKE_OFF_LO, TAKE_OFF_HI)
+    o = take_off_run(plant, snaps[0], best, pitch_ref, record=True)
+    task = take_off_task(plant)
+    S, A, B = linearise(plant, o["states"], o["commands"], task)
+    K = riccati(A, B, TAKE_OFF_END_SCALE)
+    outcomes = [take_off_run(plant, p, best, pitch_ref) for p in snaps]
+    return {"decisions": _rounded(best), "score": best_f, "pitch_ref_rad": pitch_ref,
+            "drop_m": [o["drop_m"] for o in outcomes], "gain_m": [o["gain_m"] for o in outcomes],
+            "states": _rounded(S, 9), "commands": _rounded(o["commands"], 9), "gains": _rounded(K, 6),
+            "shooting": {"seed": seed, "generations": generations, "sigma": TAKE_OFF_SIGMA,
+                         "population": TAKE_OFF_POPULATION, "start": TAKE_OFF_START.tolist(),
+                         "perches": [list(p) for p in TAKE_OFF_PERCHES], "hold_s": TAKE_OFF_HOLD_S}}
+
+
+def _rounded(a, digits: int = 7):
+    """``a`` (an array or a list of them) as nested lists of floats with ``digits`` significant digits."""
+    return [float(f"{v:.{digits}g}") for v in a] if np.ndim(a) == 1 else [_rounded(x, digits) for x in a]
 
 
 #: The shooting's settings (:func:`design_landing`): CMA-ES generations and step for each chain's first manoeuvre and
@@ -423,7 +592,8 @@ def _half(spec: dict, first: int, rest: tuple, seed: int, generations: tuple[int
 
 
 def design_landing(spec: dict, seed: int = SEED, workers: int = 2, progress=None,
-                   generations: tuple[int, int] = (FIRST_GENERATIONS, NEXT_GENERATIONS), halves: tuple = HALVES) -> dict:
+                   generations: tuple[int, int] = (FIRST_GENERATIONS, NEXT_GENERATIONS), halves: tuple = HALVES,
+                   take_off: int | None = TAKE_OFF_GENERATIONS) -> dict:
     """The designed controller ``spec``'s landing (its file's ``landing``): one manoeuvre per eighth of the wing
     beat, shot in two chains at once (:data:`HALVES`, on ``workers`` processes, seeds ``seed`` and ``seed + 1``):
     each chain's first from :data:`DECISION_START`, its others each from a neighbour's decisions (a manoeuvre for the
@@ -431,7 +601,8 @@ def design_landing(spec: dict, seed: int = SEED, workers: int = 2, progress=None
     ``generations``: CMA-ES's for each chain's first and for each next manoeuvre; ``halves``: the chains (each its
     first bin, then ``(bin, from bin)`` pairs; a test shoots fewer). ``progress(done, total)`` as chains
     are done. A manoeuvre whose nominal does not touch down is left out (its
-    phases then start the nearest other)."""
+    phases then start the nearest other). The take-off (:func:`design_take_off`, ``take_off`` generations; ``None``:
+    none) is shot on the same pool, by the first worker free (the chains are of unequal length)."""
     import concurrent.futures
     import multiprocessing
 
@@ -440,16 +611,18 @@ def design_landing(spec: dict, seed: int = SEED, workers: int = 2, progress=None
     with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, min(workers, len(halves))), mp_context=ctx) as pool:
         futures = [pool.submit(_half, spec, first, rest, seed + i, generations)
                    for i, (first, rest) in enumerate(halves)]
+        rising = None if take_off is None else pool.submit(design_take_off, spec, seed, take_off)
         for fu in concurrent.futures.as_completed(futures):
             results += fu.result()
             if progress:
                 progress(len({r[0] for r in results}), N_BINS)
+        rising = None if rising is None else rising.result()
     best: dict = {}
     for r in results:  # a bin shot by both chains: the better kept
         if r[0] not in best or r[2] < best[r[0]][2]:
             best[r[0]] = r
     results = [best[b] for b in sorted(best)]
-    return {"manoeuvres": [r[3] for r in results if r[3] is not None],
+    return {"manoeuvres": [r[3] for r in results if r[3] is not None], **({"take_off": rising} if rising else {}),
             "shooting": {"bins": N_BINS, "seed": seed, "halves": [[h[0], [list(r) for r in h[1]]] for h in halves],
                          "first_generations": generations[0], "first_sigma": FIRST_SIGMA,
                          "next_generations": generations[1], "population": POPULATION, "next_sigma": NEXT_SIGMA,

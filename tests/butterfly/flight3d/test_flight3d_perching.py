@@ -82,6 +82,36 @@ def test_the_loop_reads_the_error_in_the_manoeuvres_frame(plant, snap, yaw):
     assert np.allclose(e, local, atol=1e-9)
 
 
+@pytest.mark.parametrize("yaw", [0.0, 2.4])
+def test_a_take_off_starts_its_manoeuvre_where_the_body_is(plant, yaw):
+    """At a take-off the compiled loop places the take-off's frame (``designed_kernel.rise``) so that a body in the
+    nominal's first state, anywhere in a garden and facing anywhere, reads no error from it (``tracking_error``)."""
+    lm, ls, lu, lk, lc = DK.landing_tables(SPEC["landing"])
+    j = len(lm) - 1
+    assert lm[j, 0] == -1.0 and lm[j, 1] == len(SPEC["landing"]["take_off"]["commands"])
+    n0 = ls[j, 0]
+    d = mujoco.MjData(plant.m)
+    d.qpos[:] = plant.d.qpos
+    c, s = math.cos(yaw), math.sin(yaw)
+    d.qpos[0:3] = [2.0 + c * n0[0] - s * n0[1], -1.5 + s * n0[0] + c * n0[1], 0.4 + n0[2]]
+    d.qvel[0:3] = [c * n0[3] - s * n0[4], s * n0[3] + c * n0[4], n0[5]]
+    mujoco.mju_mulQuat(d.qpos[3:7], np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]), n0[6:10].copy())
+    d.qvel[3:6] = n0[10:13]
+    qj, dj, _ = P.mj3d.driven_dofs(plant.m)
+    d.qpos[qj], d.qvel[dj] = n0[13:18], n0[18:23]
+    d.userdata[:] = plant.d.userdata
+    d.userdata[P.mj3d.U_PSI0] = n0[23]
+    d.userdata[P.mj3d.U_P0 : P.mj3d.U_P0 + P.N_PARAMS] = n0[24 : 24 + P.N_PARAMS]
+    d.userdata[P.mj3d.U_DP0 : P.mj3d.U_DP0 + P.N_PARAMS] = n0[24 + P.N_PARAMS :]
+    st = np.zeros(len(DK.ST_NAMES))
+    DK.rise(st, d.qpos, ls, j)
+    assert st[DK.ST_LAND] == 1.0 and st[DK.ST_LAND + 1] == j and st[DK.ST_LAND + 2] == 0.0
+    e = DK.tracking_error(st, d.userdata, d.qpos, d.qvel, n0, lc)
+    assert np.allclose(e, 0.0, atol=1e-9), e
+    d.qpos[2] += 0.01  # and an error where there is one
+    assert abs(DK.tracking_error(st, d.userdata, d.qpos, d.qvel, n0, lc)[2] - 0.01) < 1e-9
+
+
 def test_a_landing_file_is_checked():
     """A controller file's landing with arrays of the wrong shapes, or not numbers, gets one sentence."""
     t = 3
@@ -95,6 +125,8 @@ def test_a_landing_file_is_checked():
     bad = dict(good, commands=np.full((t, P.N_PARAMS), np.nan).tolist())
     with pytest.raises(UserError, match="not finite"):
         P.check_landing({"manoeuvres": [bad]}, "here")
+    with pytest.raises(UserError, match="take-off has states"):
+        P.check_landing({"manoeuvres": [good], "take_off": dict(good, gains=good["gains"][:-1])}, "here")
 
 
 #: Gardens no design or choice of this landing has seen (the design's tuning gardens were 100-111), four flowers each:
@@ -122,11 +154,11 @@ def test_the_shipped_controller_lands_on_unseen_gardens():
 
 @pytest.mark.slow
 def test_design_landing_writes_what_the_loop_flies():
-    """``design_landing`` (here two chains of two manoeuvres, with two generations each) gives manoeuvres whose arrays
-    pass the file's check and load as the loop's tables, each with the phase and start distance it was shot at, and
-    records how."""
+    """``design_landing`` (here two chains of two manoeuvres, with two generations each, and a take-off of one) gives
+    manoeuvres whose arrays pass the file's check and load as the loop's tables, each with the phase and start
+    distance it was shot at, the take-off last, and records how."""
     halves = ((4, ((3, 4),)), (6, ((7, 6),)))
-    land = P.design_landing(SPEC, workers=2, generations=(2, 2), halves=halves)
+    land = P.design_landing(SPEC, workers=2, generations=(2, 2), halves=halves, take_off=1)
     P.check_landing(land, "here")
     ms = land["manoeuvres"]
     assert [round(m["phase_rad"] / (2 * math.pi / P.N_BINS)) for m in ms] == [b for b, t in
@@ -134,6 +166,9 @@ def test_design_landing_writes_what_the_loop_flies():
     assert all(abs(m["start_m"] - m["decisions"][14]) < 1e-6 and len(m["states"]) == len(m["commands"]) + 1
                for m in ms)
     lm, ls, lu, lk, _ = DK.landing_tables(land)
-    assert lm.shape == (len(ms), 3) and np.array_equal(lm[:, 1], [len(m["commands"]) for m in ms])
+    rising = land["take_off"]
+    assert lm.shape == (len(ms) + 1, 3) and np.array_equal(lm[:, 1], [len(m["commands"]) for m in [*ms, rising]])
+    assert (lm[:-1, 0] > 0).all() and lm[-1, 0] == -1.0 and rising["shooting"]["generations"] == 1
+    assert max(rising["drop_m"]) < 0.02 and min(rising["gain_m"]) > 0.0  # from the start's decisions, it climbs
     assert land["shooting"]["first_generations"] == 2 and land["shooting"]["start"] == P.DECISION_START.tolist()
     assert land["shooting"]["halves"] == [[4, [[3, 4]]], [6, [[7, 6]]]]
