@@ -7,7 +7,7 @@ manoeuvre's end); the largest roll within 1 s. For each butterfly, whether it ev
 blossom. Touchdowns and those within 0.5 m/s (``Garden.visits``).
 
     python benchmarks/garden_take_off.py --seeds 2,3,4                       # the shipped designed controller
-    python benchmarks/garden_take_off.py --seeds 2,3,4 --controller OLD.json
+    python benchmarks/garden_take_off.py --seeds 2,3,4 --without-take-off    # the same, its take-off left out
 
 Writes ``benchmarks/results/garden_take_off_NAME.json`` (``--out`` to choose) and prints one line. Seeds run in
 parallel (``--workers``, default 2); each is 20 butterflies for 20 s (about 1-2 min a seed here).
@@ -35,7 +35,14 @@ def one(job: tuple) -> dict:
     butterflies that went 0.3 m below the lowest blossom, touchdowns and those within 0.5 m/s."""
     from lifelike_mj.butterfly.flight3d.garden import Garden
 
-    seed, controller, n, duration = job
+    seed, controller, n, duration, without = job
+    if without:  # the designed controller with its take-off's manoeuvre left out: the regulator takes off, with a clap
+        from lifelike_mj.butterfly.flight3d.designed import load_any
+        from lifelike_mj.butterfly.flight3d.designed_kernel import CompiledDesigned
+
+        spec = load_any(controller).to_dict()
+        spec["landing"].pop("take_off", None)
+        controller = CompiledDesigned(spec)
     g = Garden(n, controller, seed=seed)
     every = int(round(SAMPLE_S / g.dt))
     z, roll, perched = [], [], []
@@ -65,6 +72,8 @@ def main(argv: list[str] | None = None) -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--seeds", default="2,3,4", help="gardens, comma separated (default 2,3,4: held out)")
     p.add_argument("--controller", default="designed", help="a controller's name or file (default designed)")
+    p.add_argument("--without-take-off", action="store_true",
+                   help="a designed controller's take-off manoeuvre left out (its regulator takes off, with a clap)")
     p.add_argument("--n", type=int, default=20, help="butterflies a garden (default 20)")
     p.add_argument("--duration", type=float, default=20.0, help="seconds a garden (default 20)")
     p.add_argument("--workers", type=int, default=2, help="gardens at once (default 2)")
@@ -76,7 +85,7 @@ def main(argv: list[str] | None = None) -> None:
         p.exit(2, f"--seeds is a comma-separated list of whole numbers, got {args.seeds!r}.\n")
     if not seeds or args.n < 1 or args.duration <= DROP_S or args.workers < 1:
         p.exit(2, "--seeds names one garden or more, --n is 1 or more, --duration over 1.5 s, --workers 1 or more.\n")
-    jobs = [(s, args.controller, args.n, args.duration) for s in seeds]
+    jobs = [(s, args.controller, args.n, args.duration, args.without_take_off) for s in seeds]
     with Pool(min(args.workers, len(jobs))) as pool:
         gardens = pool.map(one, jobs)
     drops = np.concatenate([g["drops_m"] for g in gardens])
@@ -89,10 +98,10 @@ def main(argv: list[str] | None = None) -> None:
                "butterflies": sum(g["butterflies"] for g in gardens),
                "touchdowns": sum(g["touchdowns"] for g in gardens),
                "touchdowns_within_0_5_m_s": sum(g["touchdowns_within_0_5_m_s"] for g in gardens)}
-    name = Path(args.controller).stem
+    name = Path(args.controller).stem + ("_without_take_off" if args.without_take_off else "")
     out = Path(args.out) if args.out else HERE / "results" / f"garden_take_off_{name}.json"
-    write_json(out, {"provenance": provenance(seeds=seeds,
-                                              controller=args.controller, n=args.n, duration_s=args.duration),
+    write_json(out, {"provenance": provenance(seeds=seeds, controller=args.controller, n=args.n,
+                                              duration_s=args.duration, without_take_off=args.without_take_off),
                      "machine": machine_info(), "summary": summary, "gardens": gardens})
     s = summary
     print(f"{name}, gardens {seeds}: {s['take_offs']} take-offs, median drop {s['median_drop_m']:.3f} m "
