@@ -123,14 +123,15 @@ def take_off_measures(controller, beats: int = 3, *, dt_s: float | None = None) 
     ``horizontal_N`` components and its angle above the horizontal (``angle_deg``), over the beats after lift-off."""
     import mujoco
 
-    from lifelike_mj.butterfly.flight3d.controllers import Controller3D, load_controller
+    from lifelike_mj.butterfly.flight3d.controllers import Controller3D
+    from lifelike_mj.butterfly.flight3d.designed_kernel import CompiledDesigned, load_compiled
     from lifelike_mj.butterfly.flight3d.flight import DT_S, Flight3D
     from lifelike_mj.butterfly.flight3d.flowers import blossom_under
     from lifelike_mj.butterfly.flight3d.model import standing_height_m
     from lifelike_mj.butterfly.flight3d.parts import World
 
     beats = checks.whole("beats", beats, 1, 100)
-    ctl = controller if isinstance(controller, Controller3D) else load_controller(controller)
+    ctl = controller if isinstance(controller, (Controller3D, CompiledDesigned)) else load_compiled(controller)
     start = blossom_under((0.0, 0.0, -standing_height_m(ctl.animal)))
     f = Flight3D(controller=ctl, world=World(flowers=[start, start + (1.2, 0.0, 0.0)]),
                  dt_s=DT_S if dt_s is None else dt_s)

@@ -48,3 +48,16 @@ def test_the_monarch_takes_off_from_a_flower_with_vertical_downstrokes_and_forwa
     assert r["downstroke"]["angle_deg"] > 60.0 and r["downstroke"]["vertical_N"] > 0.0
     assert r["upstroke"]["horizontal_N"] > 0.0
     assert r["downstroke"]["angle_deg"] - r["upstroke"]["angle_deg"] > 90.0
+
+
+def test_the_designed_take_off_pushes_up_on_the_downstroke_and_forward_on_the_upstroke():
+    """The shipped designed controller's take-off manoeuvre, measured as Sunada et al. (1993) filmed Pieris melete:
+    the downstroke's force mainly vertical, the upstroke's mainly horizontal (within 20 deg of it, forward), and the
+    largest acceleration within the first beat (where the network's came at 1.8 beats)."""
+    from lifelike_mj.butterfly.flight3d.landing import take_off_measures
+
+    r = take_off_measures("designed")
+    assert r["lift_off_s"] < 0.05
+    assert r["downstroke"]["angle_deg"] > 75.0 and r["downstroke"]["vertical_N"] > 0.0
+    assert r["upstroke"]["horizontal_N"] > 0.0 and abs(r["upstroke"]["angle_deg"]) < 20.0
+    assert r["peak_at_beat"] < 1.0
