@@ -21,6 +21,36 @@ from lifelike_mj.errors import UserError
 SHARED_FILES = {"test_doc_commands.py"}
 
 
+#: The compiled loops most test files fly, compiled once before pytest-xdist starts its workers (two processes at
+#: once, :func:`pytest_configure`): without this, two workers that reach the same loop together each compile it (a
+#: minute each for the designed controller's), and a fresh machine's suite pays that several times over.
+WARM_UP = (
+    "from lifelike_mj.butterfly.flight3d import Flight3D, level\n"
+    "Flight3D(controller='designed', task=level(1.5)).step(16)\n"
+    "Flight3D(controller='monarch', task=level(1.5)).step(16)\n",
+    "from lifelike_mj.butterfly.flight3d.garden import Garden\n"
+    "Garden(2, seed=0).step(16)\n",
+)
+
+
+def pytest_configure(config):
+    """In pytest-xdist's controller, before its workers start: :data:`WARM_UP` (the compiled loops into numba's
+    on-disk cache, which the workers then load). A warm-up that fails changes nothing: each test compiles what it
+    needs, as it would without it."""
+    if hasattr(config, "workerinput") or not config.getoption("numprocesses", None):
+        return
+    import sys
+
+    warm = [subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            for code in WARM_UP]
+    for proc in warm:
+        try:
+            proc.wait(timeout=600)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
     """Each test file one pytest-xdist group (:data:`SHARED_FILES` apart), before xdist reads the groups."""
