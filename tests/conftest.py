@@ -228,6 +228,7 @@ class _Chromium:
                                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         timer = threading.Timer(300.0, node.kill)  # never a hang: at most five minutes
         timer.start()
+        line = ""
         try:
             tries: dict[int, int] = {}
             for line in node.stdout:

@@ -646,6 +646,10 @@ def json_schema() -> dict:
                  "K": matrix(nu, N_AUG, "the LQR gain, u = -K x of the augmented state"),
                  "slowest_pole_per_s": number("1/s: the closed loop's slowest pole"),
              }}
+    tracked = {"states": {"type": "array", "maxItems": 2001,
+                          "description": "the nominal's state at each control step and its end"},
+               "commands": {"type": "array", "maxItems": 2000, "description": "its kinematics at each control step"},
+               "gains": {"type": "array", "maxItems": 2000, "description": "the tracking's gain at each control step"}}
     props = {
         "kind": {"const": "designed", "description": "a controller designed from the averaged model"},
         "animal": {"enum": list(ANIMALS), "description": "the butterfly it flies"},
@@ -661,21 +665,10 @@ def json_schema() -> dict:
                         "properties": {
                             "phase_rad": number("rad: the wing beat's phase at the start", 0.0, 2 * math.pi),
                             "start_m": number("m: the start's distance before the flower's axis", 0.0, 10.0),
-                            "states": {"type": "array", "maxItems": 2001,
-                                       "description": "the nominal's state at each control step and its end"},
-                            "commands": {"type": "array", "maxItems": 2000,
-                                         "description": "its kinematics at each control step"},
-                            "gains": {"type": "array", "maxItems": 2000,
-                                      "description": "the tracking's gain at each control step"}}}},
+                            **tracked}}},
                         "take_off": {"type": "object", "required": ["states", "commands", "gains"], "description":
                                      "the take-off: a manoeuvre shot from perched states and its tracking",
-                                     "properties": {
-                                         "states": {"type": "array", "maxItems": 2001,
-                                                    "description": "the nominal's state at each control step and its end"},
-                                         "commands": {"type": "array", "maxItems": 2000,
-                                                      "description": "its kinematics at each control step"},
-                                         "gains": {"type": "array", "maxItems": 2000,
-                                                   "description": "the tracking's gain at each control step"}}}}},
+                                     "properties": tracked}}},
         "provenance": {"type": "object"},
     }
     return document_schema(FORMAT, "lifelike-mj 3D butterfly controller, designed", props,

@@ -628,21 +628,14 @@ def _head(ud, qpos, qvel, time, dt, every, task, rec, st, buf, tmpl, wp, ref, ba
         # (its time as the caller's clock gives it: a sum of steps, which the data's may differ from by a rounding)
         if st[ST_LAND] == 0.0 and abs(time[0] - rec[L.R_TOOK_OFF_AT]) < 0.5 * every * dt:
             rise(st, qpos, ls, j)
-        if st[ST_LAND] != 0.0 and int(st[ST_LAND + 1]) == j:
-            tracked(st, ud, qpos, qvel, lm, ls, lu, lk, lc, baseline)
-            if st[ST_LAND] != 0.0:
-                for i in range(N_PARAMS):
-                    ud[mj3d.U_TARGET + i] = baseline[i]
-                return True
+        if st[ST_LAND] != 0.0 and int(st[ST_LAND + 1]) == j and _manoeuvre(st, ud, qpos, qvel, lm, ls, lu, lk, lc,
+                                                                             baseline):
+            return True
     if kind == L.TASK_LAND and lm.shape[0] > 0:
         if st[ST_LAND] == 0.0:
             trigger(st, task, qpos, qvel, ud[mj3d.U_PSI0], lm, lc)
-        if st[ST_LAND] != 0.0:
-            tracked(st, ud, qpos, qvel, lm, ls, lu, lk, lc, baseline)
-            if st[ST_LAND] != 0.0:
-                for j in range(N_PARAMS):
-                    ud[mj3d.U_TARGET + j] = baseline[j]
-                return True
+        if st[ST_LAND] != 0.0 and _manoeuvre(st, ud, qpos, qvel, lm, ls, lu, lk, lc, baseline):
+            return True
         approach(st, task, qpos, lm, lc, wp, time[0], rec)
         cmd = control(st, buf, tmpl, speeds, pitches, v0s, Ks, commands, As, Bs, c, n_bins,
                       ud[mj3d.U_P0 : mj3d.U_P0 + N_PARAMS].copy(), ud[mj3d.U_DP0 : mj3d.U_DP0 + N_PARAMS].copy(), dt,
@@ -673,6 +666,18 @@ def _head(ud, qpos, qvel, time, dt, every, task, rec, st, buf, tmpl, wp, ref, ba
         baseline[j] = cmd[j]
         ud[mj3d.U_TARGET + j] = cmd[j]
     clap(ud, time[0], rec)
+    return True
+
+
+@njit(cache=True)
+def _manoeuvre(st, ud, qpos, qvel, lm, ls, lu, lk, lc, baseline):
+    """The manoeuvre under way (:func:`tracked`) sets the kinematics' target (and ``baseline``); ``False`` when it has
+    just ended or been given up (the regulator flies this step)."""
+    tracked(st, ud, qpos, qvel, lm, ls, lu, lk, lc, baseline)
+    if st[ST_LAND] == 0.0:
+        return False
+    for i in range(N_PARAMS):
+        ud[mj3d.U_TARGET + i] = baseline[i]
     return True
 
 

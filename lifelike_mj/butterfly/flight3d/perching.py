@@ -234,30 +234,38 @@ def score(plant: Plant, snap: mujoco.MjData, z: np.ndarray) -> float:
     return float(np.mean([cost(run(plant, snap, z, a, h)) for a, h in SHOT_OFFSETS]))
 
 
+def _search(f, x0: np.ndarray, scale: np.ndarray, lo: np.ndarray, hi: np.ndarray, seed: int, generations: int,
+            population: int, sigma: float, log=None) -> tuple[np.ndarray, float]:
+    """CMA-ES (Hansen 2016; ``seed``, ``generations``, ``population``, step ``sigma``) minimising ``f`` over
+    ``x0 + scale * x`` kept within ``lo`` and ``hi``. Returns the best point met (clipped to the bounds) and its
+    value; ``log(generation, best)`` after each generation."""
+    import cma
+
+    es = cma.CMAEvolutionStrategy(np.zeros(len(x0)), sigma, {"seed": seed, "popsize": population,
+                                                              "bounds": [list((lo - x0) / scale), list((hi - x0) / scale)],
+                                                              "verbose": -9, "maxiter": generations})
+    best, best_f = x0, f(x0)
+    while not es.stop():
+        xs = es.ask()
+        fs = [f(x0 + scale * x) for x in xs]
+        es.tell(xs, fs)
+        i = int(np.argmin(fs))
+        if fs[i] < best_f:
+            best, best_f = x0 + scale * xs[i], fs[i]
+        if log is not None:
+            log(es.countiter, best_f)
+    return np.clip(best, lo, hi), float(best_f)
+
+
 def shoot(plant: Plant, phase: float, seed: int, generations: int = 150, population: int = 12, sigma: float = 0.4,
           start: np.ndarray | None = None, log=None) -> tuple[np.ndarray, float]:
     """A manoeuvre for starts at the wing beat's ``phase`` (rad): CMA-ES (``seed``) over the decisions, scaled by
     :data:`DECISION_SCALE`, from ``start`` (default :data:`DECISION_START`), minimising :func:`score`. Returns the
     decisions and their score."""
-    import cma
-
     snap = plant.settled(phase)
     x0 = DECISION_START if start is None else np.asarray(start, float)
-    lo, hi = (DECISION_LO - x0) / DECISION_SCALE, (DECISION_HI - x0) / DECISION_SCALE
-    es = cma.CMAEvolutionStrategy(np.zeros(N_DECISION), sigma, {"seed": seed, "popsize": population,
-                                                                  "bounds": [list(lo), list(hi)], "verbose": -9,
-                                                                  "maxiter": generations})
-    best, best_f = x0, score(plant, snap, x0)
-    while not es.stop():
-        xs = es.ask()
-        fs = [score(plant, snap, x0 + DECISION_SCALE * x) for x in xs]
-        es.tell(xs, fs)
-        i = int(np.argmin(fs))
-        if fs[i] < best_f:
-            best, best_f = x0 + DECISION_SCALE * xs[i], fs[i]
-        if log is not None:
-            log(es.countiter, best_f)
-    return np.clip(best, DECISION_LO, DECISION_HI), float(best_f)
+    return _search(lambda z: score(plant, snap, z), x0, DECISION_SCALE, DECISION_LO, DECISION_HI, seed, generations,
+                   population, sigma, log)
 
 
 def _quat_log_diff(qn: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -525,8 +533,6 @@ def design_take_off(spec: dict, seed: int = 1, generations: int = TAKE_OFF_GENER
     (``seed``, ``generations``) from :data:`TAKE_OFF_START`, minimising the mean :func:`take_off_cost` over
     :func:`perches`; its nominal flown from the first perch and tracked by a time-varying LQR (:func:`linearise`,
     :func:`riccati` with :data:`TAKE_OFF_END_SCALE`), as the landing's manoeuvres are."""
-    import cma
-
     plant = Plant(spec)
     snaps, pitch_ref = perches(plant), trim_pitch(plant)
 
@@ -534,20 +540,8 @@ def design_take_off(spec: dict, seed: int = 1, generations: int = TAKE_OFF_GENER
         z = np.clip(z, TAKE_OFF_LO, TAKE_OFF_HI)
         return float(np.mean([take_off_cost(take_off_run(plant, p, z, pitch_ref), pitch_ref) for p in snaps]))
 
-    x0 = TAKE_OFF_START
-    lo, hi = (TAKE_OFF_LO - x0) / TAKE_OFF_SCALE, (TAKE_OFF_HI - x0) / TAKE_OFF_SCALE
-    es = cma.CMAEvolutionStrategy(np.zeros(N_TAKE_OFF), TAKE_OFF_SIGMA, {
-        "seed": seed, "popsize": TAKE_OFF_POPULATION, "bounds": [list(lo), list(hi)], "verbose": -9,
-        "maxiter": generations})
-    best, best_f = x0, score(x0)
-    while not es.stop():
-        xs = es.ask()
-        fs = [score(x0 + TAKE_OFF_SCALE * x) for x in xs]
-        es.tell(xs, fs)
-        i = int(np.argmin(fs))
-        if fs[i] < best_f:
-            best, best_f = x0 + TAKE_OFF_SCALE * xs[i], fs[i]
-    best = np.clip(best, TAKE_OFF_LO, TAKE_OFF_HI)
+    best, best_f = _search(score, TAKE_OFF_START, TAKE_OFF_SCALE, TAKE_OFF_LO, TAKE_OFF_HI, seed, generations,
+                           TAKE_OFF_POPULATION, TAKE_OFF_SIGMA)
     o = take_off_run(plant, snaps[0], best, pitch_ref, record=True)
     task = take_off_task(plant)
     S, A, B = linearise(plant, o["states"], o["commands"], task)
