@@ -582,7 +582,7 @@ def add_commands(bf) -> None:
     p.set_defaults(func=cmd_model3d)
     p = bf.add_parser("design3d", help="design the flight controller from the averaged model: LQR at every level "
                                        "trim, with integral action and a wind estimate, and its landing and take-off "
-                                       "(about 6-7 minutes on 2 cores with --model, seconds with --no-landing; 14-16 minutes "
+                                       "(about 6-7 minutes on 2 cores with --model, seconds with --no-landing; 13-16 minutes "
                                        "from nothing)")
     p.add_argument("--out", required=True, help="the controller file to write (.json)")
     p.add_argument("--model", default=None, help="an averaged model file (lifelike-mj butterfly model3d); without it "
