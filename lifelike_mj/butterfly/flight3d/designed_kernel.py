@@ -73,7 +73,8 @@ def landing_tables(landing: dict | None) -> tuple[np.ndarray, ...]:
     landing, zero manoeuvres."""
     lc = np.array([PE.RISE_M, PE.APPROACH_M_S, PE.START_WINDOW_M, PE.START_SIDE_M, PE.START_HEIGHT_M,
                    PE.MAX_GLIDE_S / (PE.EVERY * 1.0 / 800.0), PE.BELOW_M, *PE.CONTROL_SCALE, PE.CONTROL_LIMIT,
-                   PE.FINAL_LOOKAHEAD_M, PE.FINAL_MIN_M, PE.FINAL_OUT_M, PE.TAKE_OFF_STRAIGHT_S])
+                   PE.FINAL_LOOKAHEAD_M, PE.FINAL_MIN_M, PE.FINAL_OUT_M, PE.TAKE_OFF_STRAIGHT_S,
+                   PE.START_PHASE_GAP_RAD])
     bins = list((landing or {}).get("manoeuvres") or [])
     rising = (landing or {}).get("take_off")
     if bins and rising:
@@ -94,10 +95,10 @@ def landing_tables(landing: dict | None) -> tuple[np.ndarray, ...]:
 @njit(cache=True)
 def trigger(st, task, qpos, qvel, psi, lm, lc):
     """Whether a landing's manoeuvre starts now (then marked in ``st``): the one whose phase the beat's phase ``psi``
-    is nearest, if the thorax's distance from the flower's axis is within half :data:`~lifelike_mj.butterfly.flight3d.
-    perching.START_WINDOW_M` of its start distance, on the final (not flying out), flying toward the axis and
-    passing it within ``START_SIDE_M`` and at the
-    approach's height within ``START_HEIGHT_M``. The manoeuvre's frame: the flower's standing point, its ``x`` the
+    is nearest, if it is within ``START_PHASE_GAP_RAD`` of it and the thorax's distance from the flower's axis is
+    within half :data:`~lifelike_mj.butterfly.flight3d.perching.START_WINDOW_M` of its start distance, on the final
+    (not flying out), flying toward the axis and passing it within ``START_SIDE_M`` and at the approach's height
+    within ``START_HEIGHT_M``. The manoeuvre's frame: the flower's standing point, its ``x`` the
     bearing to the axis now."""
     b = L.T_ROW0
     sx, sy, sz = task[b], task[b + 1], task[b + 2] + task[b + 3]
@@ -110,7 +111,7 @@ def trigger(st, task, qpos, qvel, psi, lm, lc):
         gap = abs((psi - lm[i, 2] + math.pi) % (2.0 * math.pi) - math.pi)
         if gap < best:
             j, best = i, gap
-    if abs(dist - lm[j, 0]) > 0.5 * lc[2]:
+    if abs(dist - lm[j, 0]) > 0.5 * lc[2] or best > lc[18]:
         return False
     sp = math.sqrt(qvel[0] * qvel[0] + qvel[1] * qvel[1])
     if st[ST_LAND + 9] != 0.0 or sp < 0.5 or qvel[0] * tx + qvel[1] * ty <= 0.0:  # flying out, or away

@@ -49,6 +49,7 @@ from lifelike_mj.butterfly.flight3d.perch_layout import (  # noqa: F401 - the la
     RISE_M,
     RUN_SCALE,
     START_HEIGHT_M,
+    START_PHASE_GAP_RAD,
     START_SIDE_M,
     START_WINDOW_M,
     TAKE_OFF_STRAIGHT_S,

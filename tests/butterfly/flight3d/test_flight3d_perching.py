@@ -112,6 +112,23 @@ def test_a_take_off_starts_its_manoeuvre_where_the_body_is(plant, yaw):
     assert abs(DK.tracking_error(st, d.userdata, d.qpos, d.qvel, n0, lc)[2] - 0.01) < 1e-9
 
 
+@pytest.mark.parametrize("gap, starts", [(0.0, True), (0.15, True), (-0.15, True), (0.25, False), (-0.3, False)])
+def test_a_manoeuvre_starts_only_near_its_own_phase_of_the_beat(gap, starts):
+    """``trigger`` starts the manoeuvre whose phase is nearest the beat's only within ``START_PHASE_GAP_RAD`` of it
+    (started an eighth of a beat off, the phase-0 manoeuvre came down at 0.5-0.9 m/s on a tenth of its landings): a
+    body at bin 2's start distance, on the final at the approach's height, flying at the flower."""
+    lm, ls, lu, lk, lc = DK.landing_tables(SPEC["landing"])
+    j = 2
+    task = np.zeros(DK.L.T_ROW0 + 8)
+    qpos = np.zeros(7)
+    qpos[0], qpos[2], qpos[3] = -lm[j, 0], lc[0], 1.0
+    qvel = np.zeros(6)
+    qvel[0] = 1.5
+    st = np.zeros(len(DK.ST_NAMES))
+    assert DK.trigger(st, task, qpos, qvel, lm[j, 2] + gap, lm, lc) is starts
+    assert (st[DK.ST_LAND], st[DK.ST_LAND + 1]) == ((1.0, j) if starts else (0.0, 0.0))
+
+
 def test_a_landing_file_is_checked():
     """A controller file's landing with arrays of the wrong shapes, or not numbers, gets one sentence."""
     t = 3
