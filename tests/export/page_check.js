@@ -18,6 +18,10 @@ const path = require("path");
     args: ["--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-sandbox"],
   });
   const page = await browser.newPage({ viewport: { width: 640, height: 480 } });
+  // a screenshot of a page that draws every frame in software WebGL waits for a frame: on a loaded machine (the full
+  // suite on 2 cores) that took over Playwright's default 30 s once, so each wait may take up to 2 minutes
+  const SLOW_MS = 120000;
+  page.setDefaultTimeout(SLOW_MS);
   if (process.env.THROTTLE) { // a slow machine, for trying this script: the page's CPU slowed this many times
     const cdp = await page.context().newCDPSession(page);
     await cdp.send("Emulation.setCPUThrottlingRate", { rate: Number(process.env.THROTTLE) });
@@ -61,6 +65,7 @@ const path = require("path");
       const pages = [page];
       if (empty) {
         const other = await browser.newPage({ viewport: { width: 640, height: 480 } });
+        other.setDefaultTimeout(SLOW_MS);
         other.on("console", (m) => { if (m.type() === "error") errors.push("empty: " + m.text()); });
         other.on("pageerror", (e) => errors.push("empty: " + String(e)));
         pages.push(other);
