@@ -525,7 +525,8 @@ def network_controller3d(layers: list[tuple[np.ndarray, np.ndarray]], template: 
     """A 3D controller from a trained network's layers ``[(W, b), ...]`` (``W`` of shape (outputs, inputs), as
     ``torch.nn.Linear`` keeps it; ``tanh`` hidden layers) that reads :class:`NetworkInputs3D`'s observation and acts
     through :class:`NetworkActions3D`: the same network in the controller file's form (per neuron: its input
-    weights, then its bias), with ``template``'s base command, scales, rate and inputs. ``fly3d`` flies it."""
+    weights, then its bias), with ``template``'s base command, scales, rate, inputs, butterfly and wing-force law
+    (``animal``, ``force_law``). ``fly3d`` flies it."""
     sizes = [int(np.asarray(layers[0][0]).shape[1])] + [int(np.asarray(w).shape[0]) for w, _ in layers]
     flat = []
     for w, b in layers:
@@ -535,4 +536,4 @@ def network_controller3d(layers: list[tuple[np.ndarray, np.ndarray]], template: 
             flat.append(float(b[j]))
     t = template or _still_controller()
     return flight3d.Controller3D(sizes, flat, t.base, dict(zip(flight3d.ACTION_NAMES, t.scale)), t.every,
-                                 t.omega_c_rad_s, provenance, "", t.inputs)
+                                 t.omega_c_rad_s, provenance, "", t.inputs, animal=t.animal, force_law=t.force_law)

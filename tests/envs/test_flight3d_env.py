@@ -113,6 +113,19 @@ def test_a_trained_network_leaves_the_env_as_a_controller_file_fly3d_flies(tmp_p
     assert flight.reward == pytest.approx(total * 1.0, rel=1e-12)
 
 
+def test_a_network_written_out_keeps_the_butterfly_and_wing_law_it_was_trained_on():
+    """A policy trained on the calibrated monarch is written out for the calibrated monarch (it once came out as
+    the default swallowtail on the exact law, a butterfly it never flew)."""
+    template = flight3d.Controller3D([flight3d.N_OBS, flight3d.N_ACT],
+                                     np.zeros(flight3d.n_weights([flight3d.N_OBS, flight3d.N_ACT])),
+                                     animal="monarch", force_law="calibrated", every=12)
+    env = ButterflyFlight3DEnv(task="level", duration_s=0.1, controller=template)
+    layers = [(np.zeros((flight3d.N_ACT, flight3d.N_OBS)), np.zeros(flight3d.N_ACT))]
+    ctl = network_controller3d(layers, env.controller)
+    assert (ctl.animal, ctl.force_law, ctl.every) == ("monarch", "calibrated", 12)
+    assert flight3d.controller_from_dict(ctl.to_dict()).force_law == "calibrated"
+
+
 def test_rgb_array_draws_the_butterfly():
     env = gym.make("lifelike_mj/ButterflyFlight3D-v0", render_mode="rgb_array", width=160, height=120)
     env.reset(seed=0)
