@@ -16,10 +16,10 @@ searches the next ``--horizon`` segments by CMA-ES (``--population``, ``--genera
 last plan shifted by one segment, and the designed controller alone, zero corrections, is always among the
 candidates) and flies the first segment of the best. The cost over the horizon: the distance to the waypoint aimed
 at after it, less 1.5 m per waypoint passed in it, plus 10 per decision with roll or pitch beyond 60 deg (an upset),
-plus 100 for a tumble (``--attitude-weight`` adds the mean square roll and pitch; at 2, in a first run with 0.1 s
-segments searched three ahead, the search traded height for a level body: course 103 passed no waypoint and sank 3
-m). With ``--causal`` the search has no foresight: its copies fly in the air of now, the gust held at its present
-value (the true one: a perfect estimate of the present).
+plus 100 for a tumble (``--action-cost`` adds the corrections' mean square, ``--attitude-weight`` the mean square
+roll and pitch; at 2, in a first run with 0.1 s segments searched three ahead, the search traded height for a level
+body: course 103 passed no waypoint and sank 3 m). With ``--causal`` the search has no foresight: its copies fly in
+the air of now, the gust held at its present value (the true one: a perfect estimate of the present).
 
 Each seed is flown from the same start for ``--seconds``, by the designed controller alone and with the oracle;
 reported: waypoints passed, the upsets (entries into roll or pitch beyond 60 deg, checked at each 10 ms decision),
@@ -79,6 +79,7 @@ class Oracle:
                         designed=self.ctl)
         self.rq = self.f._root_q
         self.w_att = 0.0
+        self.w_act = 0.0
         self.causal = False
 
     def load(self) -> None:
@@ -124,6 +125,7 @@ class Oracle:
             passed = int(rec[R_PASSED])
             dist = float(np.linalg.norm(d.qpos[self.rq:self.rq + 3] - self._aim(passed)))
             c[i] = dist - 1.5 * (passed - p0) + self.w_att * att[i] / n + 10.0 * ups[i] + 100.0 * (rec[R_TUMBLED] >= 0)
+            c[i] += self.w_act * float(np.mean(np.square(plans[i])))
         return c
 
     def plan(self, warm: np.ndarray, generations: int, sigma: float, rng) -> np.ndarray:
@@ -152,6 +154,7 @@ def fly(seed: int, seconds: float, oracle: bool, args) -> dict:
     o = Oracle(seed, args.population, args.horizon, args.decisions, args.reach)
     o.w_att = args.attitude_weight
     o.causal = args.causal
+    o.w_act = args.action_cost
     acts = []
     f, rq = o.f, o.rq
     rng = np.random.default_rng(seed)
@@ -197,6 +200,7 @@ def main(argv=None) -> int:
     ap.add_argument("--reach", type=float, default=3.0, help="the corrections' reach in Bryson scales")
     ap.add_argument("--sigma", type=float, default=0.4)
     ap.add_argument("--causal", action="store_true", help="no foresight: the searched flights hold the gust of now")
+    ap.add_argument("--action-cost", type=float, default=0.0, help="weight of the corrections' mean square")
     ap.add_argument("--attitude-weight", type=float, default=0.0, help="weight of the mean square roll and pitch")
     ap.add_argument("--out", default=str(HERE / "results" / "gust_oracle.json"))
     args = ap.parse_args(argv)
