@@ -1,9 +1,10 @@
 """What the monarch's wings could do in gusts on every axis, given the future: an oracle on the designed controller.
 
 Run: ``NUMBA_NUM_THREADS=1 python benchmarks/gust_oracle.py --seeds 103,109,112,113 --seconds 30`` (with foresight;
-``--causal --oracle-only`` without). About 17 s of compute per second flown on one core (2026-11-29, beside another
-job). Writes ``benchmarks/results/gust_oracle.json`` (``--out``); the runs quoted in ``docs/results.md`` are
-``gust_oracle_foresight.json`` and ``gust_oracle_causal.json`` there.
+``--causal --oracle-only`` without). About 17 s of compute per second flown on one core (42 s re-planning every 0.1
+s) (2026-11-29, beside another job). Writes ``benchmarks/results/gust_oracle.json`` (``--out``); the runs quoted in
+``docs/results.md`` are ``gust_oracle_foresight.json``, ``gust_oracle_causal.json`` and
+``gust_oracle_causal_fast.json`` there.
 
 Issue 42 asks 8 of 10 courses in 1 m/s wind with 0.5 m/s gusts on every axis; the designed controller completes
 about half. Is it the controller, or are the wings, inside the natural envelope, unable to hold a course in such air?
