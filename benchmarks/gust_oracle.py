@@ -44,33 +44,29 @@ EA = {"wind_to_m_s": [1.0, 0.0, 0.0], "gust_m_s": 0.5, "gust_vertical_m_s": 0.5}
 UPSET_RAD = math.radians(60.0)
 
 
-def _roll_pitch(q: np.ndarray) -> tuple[float, float]:
-    w, x, y, z = q
-    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
-    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
-    return roll, pitch
+def _roll_pitch(qpos: np.ndarray, rq: int) -> np.ndarray:
+    """Roll and pitch (rad) of the body whose free joint's position starts at ``qpos[rq]``."""
+    from lifelike_mj.butterfly.flight3d.flight import euler_from_quat
+
+    return euler_from_quat(qpos[rq + 3 : rq + 7])[:2]
 
 
 class Oracle:
     def __init__(self, seed: int, population: int, horizon: int, decisions_per_segment: int, reach: float) -> None:
         import mujoco
+        from designed_courses import _flight  # the designed controller as the side-by-side courses fly it
 
         from lifelike_mj.butterfly.flight3d import designed as D
-        from lifelike_mj.butterfly.flight3d import designed_kernel as DK
         from lifelike_mj.butterfly.flight3d import tasks
         from lifelike_mj.butterfly.flight3d.flight import Flight3D
-        from lifelike_mj.butterfly.flight3d.kinematics import KinematicsCommand
         from lifelike_mj.butterfly.flight3d.loop import Batch
-        from lifelike_mj.butterfly.flight3d.parts import Butterfly
 
         D.RESIDUAL_SCALE = D.R_SCALES * reach  # read at each decision (Batch.decide)
         self.mujoco = mujoco
-        spec = json.loads((HERE.parent / "controllers" / "butterfly3d" / "designed.json").read_text())
-        self.ctl = DK.CompiledDesigned(spec)
+        self.ctl, flight = _flight(json.loads((HERE.parent / "controllers" / "butterfly3d" / "designed.json").read_text()))
         self.task = tasks.course(seed, 10).with_weather(**EA)
-        self.waypoints = np.array([r[:3] for r in self.task.rows]) if self.task.rows else None
-        self.f = Flight3D(controller=self.ctl, task=self.task, butterfly=Butterfly("monarch", force_law="calibrated"),
-                          command=KinematicsCommand(*D._interp(spec["schedule"], 1.5, "command")))
+        self.waypoints = np.array([r[:3] for r in self.task.rows])
+        self.f = Flight3D(controller=self.ctl, task=self.task, **flight)
         self.f.decide(None)
         m, mb = self.f.model, self.f._batch
         self.P, self.H, self.K = population, horizon, decisions_per_segment
@@ -108,7 +104,7 @@ class Oracle:
         from lifelike_mj.butterfly.flight3d.tasks import R_PASSED, R_TUMBLED
 
         self.load()
-        p0 = int(self.f._batch.records[0][R_PASSED])
+        p0 = self.f.waypoints_passed
         att = np.zeros(self.P)
         ups = np.zeros(self.P)
         n = 0
@@ -117,9 +113,9 @@ class Oracle:
                 self.cb.decide(plans[:, h, :], 10**9)
                 n += 1
                 for i, d in enumerate(self.cd):
-                    r, p = _roll_pitch(d.qpos[self.rq + 3:self.rq + 7])
-                    att[i] += r * r + p * p
-                    ups[i] += (abs(r) > UPSET_RAD) or (abs(p) > UPSET_RAD)
+                    rp = _roll_pitch(d.qpos, self.rq)
+                    att[i] += float(rp @ rp)
+                    ups[i] += bool(np.any(np.abs(rp) > UPSET_RAD))
         c = np.zeros(self.P)
         for i, d in enumerate(self.cd):
             rec = self.cb.records[i]
@@ -150,8 +146,6 @@ class Oracle:
 
 
 def fly(seed: int, seconds: float, oracle: bool, args) -> dict:
-    from lifelike_mj.butterfly.flight3d.tasks import R_PASSED
-
     o = Oracle(seed, args.population, args.horizon, args.decisions, args.reach)
     o.w_att = args.attitude_weight
     o.causal = args.causal
@@ -163,7 +157,7 @@ def fly(seed: int, seconds: float, oracle: bool, args) -> dict:
     upsets, was_up, low = 0, False, math.inf
     floor = float(o.waypoints[:, 2].min())
     t0 = time.perf_counter()
-    while f.time < seconds and int(f._batch.records[0][R_PASSED]) < 10 and not f.tumbled:
+    while f.time < seconds and f.waypoints_passed < 10 and not f.tumbled:
         if oracle:
             best = o.plan(warm, args.generations, args.sigma, rng)
             act, warm = best[0], np.vstack([best[1:], np.zeros((1, 9))])
@@ -172,12 +166,11 @@ def fly(seed: int, seconds: float, oracle: bool, args) -> dict:
         acts.append(act)
         for _ in range(o.K):
             f.decide(act)
-            r, p = _roll_pitch(f.data.qpos[rq + 3:rq + 7])
-            up = abs(r) > UPSET_RAD or abs(p) > UPSET_RAD
+            up = bool(np.any(np.abs(_roll_pitch(f.data.qpos, rq)) > UPSET_RAD))
             upsets += up and not was_up
             was_up = up
             low = min(low, float(f.data.qpos[rq + 2]) - floor)
-    return {"seed": seed, "oracle": oracle, "passed": int(f._batch.records[0][R_PASSED]), "time_s": round(f.time, 3),
+    return {"seed": seed, "oracle": oracle, "passed": f.waypoints_passed, "time_s": round(f.time, 3),
             "upsets": upsets, "lowest_above_floor_m": round(low, 3), "tumbled": f.tumbled,
             "wall_s": round(time.perf_counter() - t0, 1), "causal": args.causal,
             "corrections_mean": [round(float(v), 3) for v in np.mean(acts, axis=0)],
