@@ -6,14 +6,15 @@ Run: ``python benchmarks/ppo_monarch3d.py --minutes 85 --seed 1`` (4.2 million d
 flights: ``python benchmarks/designed_courses.py --controller benchmarks/results/ppo_monarch3d_controller.json``.
 
 Stable-baselines3's PPO (CPU, one torch thread, 8 copies of ``ButterflyFlight3D-v0`` in one process) trains a
-network with one tanh hidden layer of 32 (as issue 26's) through ``examples/gym_sb3_flight3d.py``'s wrappers, from
-random weights, on ``evolve3d``'s ``fast`` task set (``--tasks``; level flight from 1 to 3 m/s, a 90 deg turn, a
-calm course, a course in 1 m/s wind with 0.5 m/s gusts on every axis and one in a steady 1.5 m/s wind; one drawn per
-4 s episode). The butterfly is the monarch on the calibrated wing law (the designed controller's), acting every 12
-time steps of 1/800 s (67 Hz) around the filmed monarch's gait (10.2 Hz, 120 deg) with the evolved ``monarch``'s
-action scales. Training stops after ``--steps`` decisions or ``--minutes`` of wall time, whichever comes first; the
-actor is written out every ``--every-minutes`` and at the end as a 3D controller file (``--controller-out``), and
-the run's record (provenance, machine, the mean return of each update) to ``--out``.
+network with one tanh hidden layer of 32 (as issue 26's) through ``examples/gym_sb3_flight3d.py``'s ``train`` (its
+PPO settings and wrappers), from random weights, on ``evolve3d``'s ``fast`` task set (``--tasks``; level flight from
+1 to 3 m/s, a 90 deg turn, a calm course, a course in 1 m/s wind with 0.5 m/s gusts on every axis and one in a
+steady 1.5 m/s wind; one drawn per 4 s episode). The butterfly is the monarch on the calibrated wing law (the
+designed controller's), acting every 12 time steps of 1/800 s (67 Hz) around the filmed monarch's gait (10.2 Hz, 120
+deg) with the evolved ``monarch``'s action scales. Training stops after ``--steps`` decisions or ``--minutes`` of
+wall time, whichever comes first; the actor is written out every ``--every-minutes`` and at the end as a 3D
+controller file (``--controller-out``), and the run's record (provenance, machine, the mean return of each update)
+to ``--out``.
 """
 
 from __future__ import annotations
@@ -53,13 +54,10 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     ex = _example()  # the rl extra, or one sentence and status 2
     import torch
-    from stable_baselines3 import PPO
     from stable_baselines3.common.callbacks import BaseCallback
-    from stable_baselines3.common.env_util import make_vec_env
 
     from lifelike_mj.butterfly import flight3d
     from lifelike_mj.butterfly.flight3d.controllers import load_controller
-    from lifelike_mj.envs.butterfly3d import ButterflyFlight3DEnv, NetworkActions3D, NetworkInputs3D
     from lifelike_mj.io import write_json
     from lifelike_mj.machine import machine_info
     from lifelike_mj.provenance import provenance
@@ -70,24 +68,12 @@ def main(argv=None) -> int:
     template = flight3d.Controller3D(layers, np.zeros(flight3d.n_weights(layers)), animal="monarch",
                                      force_law="calibrated", every=12,
                                      scale=dict(zip(flight3d.ACTION_NAMES, monarch.scale)))
-    tasks = flight3d.TASK_SETS[args.tasks]()
-
-    def make_env():
-        return NetworkActions3D(NetworkInputs3D(ButterflyFlight3DEnv(task=tasks, duration_s=ex.DURATION_S,
-                                                                     controller=template)))
-
-    torch.manual_seed(args.seed)
-    venv = make_vec_env(make_env, n_envs=8, seed=args.seed)
-    model = PPO("MlpPolicy", venv, n_steps=400, batch_size=400, gamma=0.995, gae_lambda=0.95, learning_rate=3e-4,
-                ent_coef=0.0, seed=args.seed, verbose=0, device="cpu",
-                policy_kwargs={"activation_fn": torch.nn.Tanh, "log_std_init": -1.0,
-                               "net_arch": {"pi": [32], "vf": [64, 64]}})
     record = {"provenance": provenance(**vars(args)), "machine": machine_info(), "hidden": [32], "n_envs": 8,
               "every_time_steps": 12, "animal": "monarch", "force_law": "calibrated", "history": []}
     t0 = time.perf_counter()
     last_write = [t0]
 
-    def write_out(final: bool) -> None:
+    def write_out(model, final: bool) -> None:
         wall = time.perf_counter() - t0
         prov = {"source": "benchmarks/ppo_monarch3d.py (stable-baselines3 PPO through ButterflyFlight3D-v0)",
                 "command": "python " + " ".join(sys.argv), "decisions": int(model.num_timesteps),
@@ -108,11 +94,12 @@ def main(argv=None) -> int:
                                       float(np.mean(ep)) if ep else None])
             if time.perf_counter() - last_write[0] > 60.0 * args.every_minutes:
                 last_write[0] = time.perf_counter()
-                write_out(False)
+                write_out(self.model, False)
                 print(f"{record['history'][-1]}", flush=True)
 
-    model.learn(total_timesteps=args.steps, callback=Clock())
-    write_out(True)
+    # the example's PPO (its hyperparameters, seeding and vector of 8 environments), on this butterfly and task set
+    model, _ = ex.train(args.steps, args.seed, 12, task_set=args.tasks, controller=template, callback=Clock())
+    write_out(model, True)
     print(f"PPO: {model.num_timesteps} decisions in {time.perf_counter() - t0:.0f} s; controller written to "
           f"{args.controller_out}")
     return 0

@@ -63,23 +63,27 @@ except ImportError as exc:  # the rl extra is optional
 DURATION_S = 4.0
 
 
-def make_env(every: int, task_set: str = "steer") -> NetworkActions3D:
+def make_env(every: int, task_set: str = "steer", controller: flight3d.Controller3D | None = None) -> NetworkActions3D:
     """The environment on ``task_set``'s tasks (one drawn per episode), acting every ``every`` steps, seen and
-    acted on as a controller's network."""
+    acted on as a controller's network; ``controller``: the template whose butterfly, wing law, base command and
+    scales it flies (default a new controller's)."""
     return NetworkActions3D(NetworkInputs3D(ButterflyFlight3DEnv(task=flight3d.TASK_SETS[task_set](),
-                                                                 duration_s=DURATION_S, every=every)))
+                                                                 duration_s=DURATION_S, every=every,
+                                                                 controller=controller)))
 
 
-def train(steps: int, seed: int, every: int = 12, hidden=(32,), n_envs: int = 8, verbose: int = 0):
-    """PPO for ``steps`` environment steps (each ``every`` time steps); returns the model and the wall time (s)."""
+def train(steps: int, seed: int, every: int = 12, hidden=(32,), n_envs: int = 8, verbose: int = 0,
+          task_set: str = "steer", controller: flight3d.Controller3D | None = None, callback=None):
+    """PPO for ``steps`` environment steps (each ``every`` time steps) on :func:`make_env`'s environment; returns
+    the model and the wall time (s). ``callback``: stable-baselines3's, to watch or stop the training."""
     torch.manual_seed(seed)
-    venv = make_vec_env(lambda: make_env(every), n_envs=n_envs, seed=seed)
+    venv = make_vec_env(lambda: make_env(every, task_set, controller), n_envs=n_envs, seed=seed)
     model = PPO("MlpPolicy", venv, n_steps=400, batch_size=400, gamma=0.995, gae_lambda=0.95, learning_rate=3e-4,
                 ent_coef=0.0, seed=seed, verbose=verbose, device="cpu",
                 policy_kwargs={"activation_fn": torch.nn.Tanh, "log_std_init": -1.0,
                                "net_arch": {"pi": list(hidden), "vf": [64, 64]}})
     t = time.perf_counter()
-    model.learn(total_timesteps=steps)
+    model.learn(total_timesteps=steps, callback=callback)
     return model, time.perf_counter() - t
 
 
