@@ -565,7 +565,8 @@ class CompiledDesigned:
 
     def decide(self, batch, actions: np.ndarray, n_max: int, act: np.ndarray) -> np.ndarray:
         """Fly every flight of ``batch`` to the controller's next command with a residual policy's ``actions`` (one
-        row of nine per flight, in ``[-1, 1]``, times :data:`~lifelike_mj.butterfly.flight3d.designed.RESIDUAL_SCALE`)
+        row of nine per flight, in ``[-1, 1]``, times :data:`~lifelike_mj.butterfly.flight3d.designed.RESIDUAL_SCALE`, or
+        the batch's ``residual_scale`` when set)
         added to this command (:func:`decide_designed`); ``act``: which flights act (the others fly on to their next
         command). The designed commands reached are then in ``batch.baselines``, the observations in
         ``batch.observations``. Returns whether each flight goes on."""
@@ -574,7 +575,7 @@ class CompiledDesigned:
         m = batch.model
         sts, bufs, tmpls = batch.designed_states
         args = (*self.tables, self.constants, D.N_BINS, *self.landing)
-        scale = D.RESIDUAL_SCALE
+        scale = D.RESIDUAL_SCALE if batch.residual_scale is None else batch.residual_scale
         going = np.zeros(batch.n, dtype=np.bool_)
         if batch.n == 1:
             going[0] = decide_designed(m._address, int(batch.ptrs[0]), mjabi.offsets_tuple(), m.nq, m.nv, int(n_max),

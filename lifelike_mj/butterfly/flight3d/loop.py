@@ -627,6 +627,9 @@ class Batch:
             self.reach = controller.mode_reach()
         #: A designed controller flown in the loop (``designed_kernel.CompiledDesigned``), with each flight's state.
         self.designed = designed
+        #: A residual policy's reach per control on the designed controller (:meth:`decide`; ``None``: the module's
+        #: :data:`~lifelike_mj.butterfly.flight3d.designed.RESIDUAL_SCALE`).
+        self.residual_scale: np.ndarray | None = None
         if designed is not None:
             self.every = designed.every
             self.designed_states = designed.states(self.n)
