@@ -39,6 +39,8 @@ from pathlib import Path
 
 import numpy as np
 
+from lifelike_mj.butterfly.flight3d.predictive import Planner
+
 HERE = Path(__file__).parent
 EA = {"wind_to_m_s": [1.0, 0.0, 0.0], "gust_m_s": 0.5, "gust_vertical_m_s": 0.5}
 UPSET_RAD = math.radians(60.0)
@@ -51,81 +53,43 @@ def _roll_pitch(qpos: np.ndarray, rq: int) -> np.ndarray:
     return euler_from_quat(qpos[rq + 3 : rq + 7])[:2]
 
 
-class Oracle:
+class Oracle(Planner):
+    """The search's copies and cost are the predictive planner's (``predictive.Planner``: its copies of the flight,
+    its cost); only the air they fly in differs: with foresight the gusts to come (the course's own gust process),
+    with ``causal`` the air of now, its true present gust held."""
+
     def __init__(self, seed: int, population: int, horizon: int, decisions_per_segment: int, reach: float) -> None:
-        import mujoco
         from designed_courses import _flight  # the designed controller as the side-by-side courses fly it
 
-        from lifelike_mj.butterfly.flight3d import designed as D
         from lifelike_mj.butterfly.flight3d import tasks
         from lifelike_mj.butterfly.flight3d.flight import Flight3D
-        from lifelike_mj.butterfly.flight3d.loop import Batch
 
-        D.RESIDUAL_SCALE = D.R_SCALES * reach  # read at each decision (Batch.decide)
-        self.mujoco = mujoco
-        self.ctl, flight = _flight(json.loads((HERE.parent / "controllers" / "butterfly3d" / "designed.json").read_text()))
+        self.ctl, flight = _flight(json.loads((HERE.parent / "controllers" / "butterfly3d" / "designed.json")
+                                              .read_text()))
         self.task = tasks.course(seed, 10).with_weather(**EA)
-        self.waypoints = np.array([r[:3] for r in self.task.rows])
         self.f = Flight3D(controller=self.ctl, task=self.task, **flight)
-        self.f.decide(None)
-        m, mb = self.f.model, self.f._batch
+        decision_s = self.f._batch.every * self.f._batch.dt
+        super().__init__(self.f, samples=population, horizon_s=horizon * decisions_per_segment * decision_s,
+                         replan_s=decisions_per_segment * decision_s, reach=reach, action_cost=0.0, seed=seed)
         self.P, self.H, self.K = population, horizon, decisions_per_segment
-        self.cd = [mujoco.MjData(m) for _ in range(population)]
-        self.cb = Batch(m, self.cd, np.repeat(mb.tasks, population, 0), None, dt_s=mb.dt,
-                        records=np.repeat(mb.records, population, 0), tumble_rad=mb.tumble_rad, base=mb.base,
-                        designed=self.ctl)
         self.rq = self.f._root_q
-        self.w_att = 0.0
-        self.w_act = 0.0
         self.causal = False
+        self.estimate = False
 
-    def load(self) -> None:
-        """Every candidate at the main flight's state."""
-        mb, cb = self.f._batch, self.cb
-        for d in self.cd:
-            self.mujoco.mj_copyData(d, self.f.model, self.f.data)
-        cb.tasks[:] = mb.tasks[0]
-        cb.records[:] = mb.records[0]
-        for a, b in zip(cb.designed_states, mb.designed_states):
-            a[:] = b[0]
-        cb.baselines[:] = mb.baselines[0]
-        cb.observations[:] = mb.observations[0]
+    def _set_air(self) -> None:
+        from lifelike_mj.butterfly.flight3d.designed_kernel import ST_NAMES
+        from lifelike_mj.butterfly.flight3d.tasks import R_GUST, T_GUST, T_GUST_W, T_WIND
+
         if self.causal:  # no foresight: the candidates fly in the air of now, its gust held as it is
-            from lifelike_mj.butterfly.flight3d.tasks import T_GUST, T_GUST_W
+            self.batch.tasks[:, T_GUST] = 0.0
+            self.batch.tasks[:, T_GUST_W] = 0.0
+        if self.estimate:  # nor the air of now: the controller's own wind estimate, steady, no gust
+            w = ST_NAMES.index("w_hat_x")
+            self.batch.tasks[:, T_WIND : T_WIND + 3] = self.f._batch.designed_states[0][0][w : w + 3]
+            self.batch.records[:, R_GUST : R_GUST + 3] = 0.0
 
-            cb.tasks[:, T_GUST] = 0.0
-            cb.tasks[:, T_GUST_W] = 0.0
-
-    def _aim(self, passed: int) -> np.ndarray:
-        return self.waypoints[min(passed, len(self.waypoints) - 1)]
-
-    def costs(self, plans: np.ndarray) -> np.ndarray:
-        """``plans``: (P, H, 9) corrections in [-1, 1]; each candidate flown from the main state."""
-        from lifelike_mj.butterfly.flight3d.tasks import R_PASSED, R_TUMBLED
-
-        self.load()
-        p0 = self.f.waypoints_passed
-        att = np.zeros(self.P)
-        ups = np.zeros(self.P)
-        n = 0
-        for h in range(self.H):
-            for _ in range(self.K):
-                self.cb.decide(plans[:, h, :], 10**9)
-                n += 1
-                for i, d in enumerate(self.cd):
-                    rp = _roll_pitch(d.qpos, self.rq)
-                    att[i] += float(rp @ rp)
-                    ups[i] += bool(np.any(np.abs(rp) > UPSET_RAD))
-        c = np.zeros(self.P)
-        for i, d in enumerate(self.cd):
-            rec = self.cb.records[i]
-            passed = int(rec[R_PASSED])
-            dist = float(np.linalg.norm(d.qpos[self.rq:self.rq + 3] - self._aim(passed)))
-            c[i] = dist - 1.5 * (passed - p0) + self.w_att * att[i] / n + 10.0 * ups[i] + 100.0 * (rec[R_TUMBLED] >= 0)
-            c[i] += self.w_act * float(np.mean(np.square(plans[i])))
-        return c
-
-    def plan(self, warm: np.ndarray, generations: int, sigma: float, rng) -> np.ndarray:
+    def search(self, warm: np.ndarray, generations: int, sigma: float, rng) -> np.ndarray:
+        """CMA-ES over the next ``H`` segments' corrections from ``warm`` (the last plan shifted)."""
         import cma
 
         dim = self.H * 9
@@ -147,19 +111,24 @@ class Oracle:
 
 def fly(seed: int, seconds: float, oracle: bool, args) -> dict:
     o = Oracle(seed, args.population, args.horizon, args.decisions, args.reach)
-    o.w_att = args.attitude_weight
-    o.causal = args.causal
-    o.w_act = args.action_cost
+    o.attitude_weight = args.attitude_weight
+    o.causal = args.causal or args.estimate
+    o.estimate = args.estimate
+    o.action_cost = args.action_cost
     acts = []
     f, rq = o.f, o.rq
     rng = np.random.default_rng(seed)
     warm = np.zeros((o.H, 9))
     upsets, was_up, low = 0, False, math.inf
+    from lifelike_mj.butterfly.flight3d.designed_kernel import ST_NAMES
+    from lifelike_mj.butterfly.flight3d.tasks import R_GUST, T_WIND
+
+    w, wind_errors = ST_NAMES.index("w_hat_x"), []
     floor = float(o.waypoints[:, 2].min())
     t0 = time.perf_counter()
     while f.time < seconds and f.waypoints_passed < 10 and not f.tumbled:
         if oracle:
-            best = o.plan(warm, args.generations, args.sigma, rng)
+            best = o.search(warm, args.generations, args.sigma, rng)
             act, warm = best[0], np.vstack([best[1:], np.zeros((1, 9))])
         else:
             act = np.zeros(9)
@@ -170,9 +139,13 @@ def fly(seed: int, seconds: float, oracle: bool, args) -> dict:
             upsets += up and not was_up
             was_up = up
             low = min(low, float(f.data.qpos[rq + 2]) - floor)
+        mb = f._batch  # the controller's wind estimate against the air at the body
+        wind_errors.append(mb.designed_states[0][0][w : w + 3] - mb.tasks[0][T_WIND : T_WIND + 3]
+                           - mb.records[0][R_GUST : R_GUST + 3])
     return {"seed": seed, "oracle": oracle, "passed": f.waypoints_passed, "time_s": round(f.time, 3),
             "upsets": upsets, "lowest_above_floor_m": round(low, 3), "tumbled": f.tumbled,
-            "wall_s": round(time.perf_counter() - t0, 1), "causal": args.causal,
+            "wall_s": round(time.perf_counter() - t0, 1), "causal": args.causal, "estimate": args.estimate,
+            "wind_estimate_error_rms_m_s": [round(float(v), 3) for v in np.sqrt(np.mean(np.square(wind_errors), 0))],
             "corrections_mean": [round(float(v), 3) for v in np.mean(acts, axis=0)],
             "corrections_rms": [round(float(v), 3) for v in np.sqrt(np.mean(np.square(acts), axis=0))],
             "corrections_at_limit": [round(float(v), 3) for v in np.mean(np.abs(acts) > 0.99, axis=0)]}
@@ -194,6 +167,8 @@ def main(argv=None) -> int:
     ap.add_argument("--reach", type=float, default=3.0, help="the corrections' reach in Bryson scales")
     ap.add_argument("--sigma", type=float, default=0.4)
     ap.add_argument("--causal", action="store_true", help="no foresight: the searched flights hold the gust of now")
+    ap.add_argument("--estimate", action="store_true",
+                    help="nor the air of now: the searched flights fly in the controller's own wind estimate, steady")
     ap.add_argument("--action-cost", type=float, default=0.0, help="weight of the corrections' mean square")
     ap.add_argument("--attitude-weight", type=float, default=0.0, help="weight of the mean square roll and pitch")
     ap.add_argument("--out", default=str(HERE / "results" / "gust_oracle.json"))
