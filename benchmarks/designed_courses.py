@@ -66,18 +66,23 @@ def _flight(spec) -> tuple[object, dict]:
                                        "butterfly": Butterfly("monarch", force_law="calibrated")}
 
 
-def fly(job: tuple[dict | str, int]) -> dict:
-    """One seed's four courses (module docstring)."""
+def fly(job: tuple) -> dict:
+    """One seed's courses (module docstring): ``(spec, seed)``, or ``(spec, seed, weathers, planner)`` for some of
+    them (names of :data:`WEATHER` and ``steady_1_5``) and predictive sampling on top (``Planner``'s keywords, or
+    ``None``: the controller alone)."""
     from lifelike_mj.butterfly.flight3d.validate import course_check
 
-    spec, seed = job
+    spec, seed, names, planner = (*job, None, None)[:4]
     dx, dy = DIRECTIONS[seed % 4]
     weather = dict(WEATHER, steady_1_5={"wind_to_m_s": [1.5 * dx, 1.5 * dy, 0.0]})
     out = {"seed": seed}
     ctl, kw = _flight(spec)  # read once: a controller keeps no state between flights
     for name, w in weather.items():
-        r = course_check(ctl, seed, weather=w, **kw)
-        out[name] = {"passed": r["passed"], "time_s": r["time_s"]}
+        if names and name not in names:
+            continue
+        t0 = time.perf_counter()
+        r = course_check(ctl, seed, weather=w, planner=None if planner is None else dict(planner, seed=seed), **kw)
+        out[name] = {"passed": r["passed"], "time_s": r["time_s"], "wall_s": round(time.perf_counter() - t0, 1)}
     return out
 
 
@@ -167,6 +172,12 @@ def main(argv=None) -> None:
     ap.add_argument("--picture", default=None, help="also draw one course in gusts (Dryden's ratio) here (.png)")
     ap.add_argument("--picture-seed", type=int, default=200)
     ap.add_argument("--calm", type=int, default=100, help="random calm courses from seed 1000 on (0: none)")
+    ap.add_argument("--weathers", default="calm,gusts_dryden,gusts_every_axis,steady_1_5",
+                    help="which of the four courses each seed flies (comma-separated)")
+    ap.add_argument("--no-level", action="store_true", help="skip level flight at 1, 1.5 and 2 m/s")
+    ap.add_argument("--predictive", action="store_true",
+                    help="fly the courses with predictive sampling on the designed controller (predictive.Planner, "
+                         "its defaults, the course's seed); about 12 s of compute per second flown on one core")
     args = ap.parse_args(argv)
     if args.picture:
         picture(args.model, args.picture_seed, args.picture)
@@ -174,17 +185,23 @@ def main(argv=None) -> None:
     start = time.perf_counter()
     designed = args.controller == "designed"
     spec = _spec(args.model) if designed else args.controller
-    out = args.out or str(HERE / "results" / ("designed_courses.json" if designed else
+    names = [w.strip() for w in args.weathers.split(",") if w.strip()]
+    if args.predictive and not designed:
+        ap.error("--predictive flies the designed controller (--controller designed)")
+    default = "designed_courses_predictive.json" if args.predictive else "designed_courses.json"
+    out = args.out or str(HERE / "results" / (default if designed else
                                               f"designed_courses_{Path(args.controller).stem}.json"))
+    planner = {} if args.predictive else None
     with Pool(2) as pool:
-        rows = pool.map(fly, [(spec, s) for s in range(lo, hi + 1)])
-        levels = pool.map(level, [(spec, v) for v in (1.0, 1.5, 2.0)])
+        rows = pool.map(fly, [(spec, s, names, planner) for s in range(lo, hi + 1)], chunksize=1)
+        levels = [] if args.no_level else pool.map(level, [(spec, v) for v in (1.0, 1.5, 2.0)])
         calms = pool.map(calm, [(spec, s) for s in range(1000, 1000 + args.calm)])
     summary = {name: {"completed": sum(r[name]["passed"] == 10 for r in rows), "of": len(rows),
                       "waypoints": [r[name]["passed"] for r in rows]}
-               for name in ("calm", "gusts_dryden", "gusts_every_axis", "steady_1_5")}
+               for name in ("calm", "gusts_dryden", "gusts_every_axis", "steady_1_5") if name in names}
     write_json(out, {"provenance": provenance(benchmark="designed_courses", controller=args.controller,
-                                              model=args.model if designed else None, seeds=[lo, hi], calm=args.calm),
+                                              model=args.model if designed else None, seeds=[lo, hi], calm=args.calm,
+                                              weathers=names, predictive=args.predictive, level=not args.no_level),
                           "machine": machine_info(), "wall_time_s": time.perf_counter() - start,
                           "summary": summary, "courses": rows, "level": levels,
                           "calm_courses": {"completed": sum(r["passed"] == 10 for r in calms),

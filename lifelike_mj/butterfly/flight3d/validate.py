@@ -149,12 +149,13 @@ def turn_check(controller, angle_deg: float, at_s: float = 2.0, hold_s: float = 
 
 
 def course_check(controller, seed: int, n: int = 10, max_s: float = 60.0, weather: dict | None = None,
-                 **flight) -> dict:
+                 planner: dict | None = None, **flight) -> dict:
     """Fly ``controller`` along the course of ``n`` waypoints drawn by ``seed``
     (:func:`~lifelike_mj.butterfly.flight3d.tasks.course`) for at most ``max_s``; report the waypoints passed (in
     order, within the course's 0.3 m) and the closest approach to each (m). ``weather``: the wind, gusts and
     flutter (:meth:`~lifelike_mj.butterfly.flight3d.tasks.Task3D.with_weather`'s arguments; the seed defaults to
-    the course's)."""
+    the course's). ``planner``: fly a designed controller with predictive sampling on top
+    (:class:`~lifelike_mj.butterfly.flight3d.predictive.Planner`'s keywords; ``{}``: its defaults)."""
     from lifelike_mj.butterfly.flight3d import tasks
     from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
@@ -164,7 +165,11 @@ def course_check(controller, seed: int, n: int = 10, max_s: float = 60.0, weathe
     if weather:
         task = task.with_weather(**weather)
     f = Flight3D(controller=controller, task=task, **flight)
-    while f.time < max_s and f.waypoints_passed < n:
+    if planner is not None:
+        from lifelike_mj.butterfly.flight3d.predictive import Planner
+
+        Planner(f, **planner).fly(max_s)
+    while f.time < max_s and f.waypoints_passed < n and not f.tumbled:
         f.step(120)
     closest = f.closest_approach_m
     return {"seed": seed, "waypoints": n, "passed": f.waypoints_passed, "time_s": f.time,
