@@ -89,10 +89,20 @@ def cmd_fly3d(args) -> None:
     from lifelike_mj.butterfly.flight3d.flight import Flight3D
 
     ctrl = _flown(args.controller)
+    if args.predictive and (args.task != "course" or getattr(ctrl, "start_command", None) is None):
+        raise UserError("--predictive flies a designed controller (design3d, or the shipped 'designed') on a course "
+                        "(--task course).")
     check_outputs(args, folders={"--out": FLY3D_FILES})
     flight = Flight3D(controller=ctrl, task=_task(args), dt_s=args.dt)
-    with stage(f"3D flight, {args.duration:g} s"):
-        rec = flight.record(duration_s=args.duration, every=max(1, round(0.01 / args.dt)))  # every 10 ms
+    if args.predictive:
+        from lifelike_mj.butterfly.flight3d.predictive import Planner
+
+        planner = Planner(flight, seed=args.seed)
+        with stage(f"3D flight with predictive sampling, {args.duration:g} s (about 12 s of compute a second)"):
+            rec = planner.record(args.duration)
+    else:
+        with stage(f"3D flight, {args.duration:g} s"):
+            rec = flight.record(duration_s=args.duration, every=max(1, round(0.01 / args.dt)))  # every 10 ms
     pos, att = rec["position_m"], rec["attitude_rad"]
     s = {"controller": ctrl.name or args.controller, "task": flight.task.name, "duration_s": float(rec["t_s"][-1]),
          "end_m": [float(v) for v in pos[-1]], "distance_m": float(np.linalg.norm(pos[-1, :2] - pos[0, :2])),
@@ -100,7 +110,8 @@ def cmd_fly3d(args) -> None:
          "altitude_min_m": float(pos[:, 2].min()), "altitude_max_m": float(pos[:, 2].max()),
          "roll_max_deg": float(np.degrees(np.abs(att[:, 0]).max())),
          "pitch_range_deg": [float(np.degrees(att[:, 1].min())), float(np.degrees(att[:, 1].max()))],
-         "mean_reward": flight.reward / max(flight.time, 1e-12), "waypoints_passed": flight.waypoints_passed}
+         "mean_reward": flight.reward / max(flight.time, 1e-12), "waypoints_passed": flight.waypoints_passed,
+         "predictive": bool(args.predictive)}
     if args.out:
         from lifelike_mj.butterfly.flight3d.figures import write_flight
 
@@ -471,6 +482,10 @@ def add_commands(bf) -> None:
     p.add_argument("--flutter", type=num(0, 1), default=0.0, help="the butterfly's flutter, 0 to 1 (drawn from --seed)")
     p.add_argument("--duration", type=num(0, MAX_DURATION_S, lo_open=True, unit="s"), default=20.0,
                    help=f"seconds of flight, at most {MAX_DURATION_S:g}")
+    p.add_argument("--predictive", action="store_true",
+                   help="a designed controller on a course looks ahead: predictive sampling in copies of the flight, "
+                        "in the air its antennae sense (holds courses in gusts on every axis; about 12 s of compute "
+                        "per second flown)")
     _add_dt(p)
     p.add_argument("--out", help="folder for path.npz/.csv, paths.png (top and side views), summary.json")
     add_overwrite(p)
