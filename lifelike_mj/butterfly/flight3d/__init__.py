@@ -44,6 +44,8 @@ What is here, one layer on the next:
   modes (:mod:`~lifelike_mj.butterfly.flight3d.controls`: its states, controls and natural envelope);
   :mod:`~lifelike_mj.butterfly.flight3d.designed`: a controller designed from them (shipped as ``designed``, the
   default; :func:`load_compiled` reads a controller of either kind ready to fly);
+  :mod:`~lifelike_mj.butterfly.flight3d.predictive`: :class:`Planner`, predictive sampling on top of it, for courses
+  in gusts;
 * :mod:`~lifelike_mj.butterfly.flight3d.parts`: :class:`Butterfly` and :class:`World`, what a :class:`Flight3D` is
   made of besides its controller and task;
 * :mod:`~lifelike_mj.butterfly.flight3d.validate`: the checks of a controller (level, turn, course, the
@@ -72,6 +74,7 @@ __getattr__, __dir__, __all__ = attach(__name__, {
     "flowers": ".", "landing": ".", "land": "tasks", "visit_flowers": "landing", "place_flowers": "flowers",
     "calibrate": ".", "averaged": ".", "controls": ".", "designed": ".", "designed_kernel": ".",
     "load_compiled": "designed_kernel", "perching": ".", "perch_layout": ".", "design_landing": "perching",
+    "predictive": ".", "Planner": "predictive",
     "parts": ".", "Butterfly": "parts",
     "World": "parts",
 }, globals())
