@@ -20,7 +20,11 @@ at after it, less 1.5 m per waypoint passed in it, plus 10 per decision with rol
 plus 100 for a tumble (``--action-cost`` adds the corrections' mean square, ``--attitude-weight`` the mean square
 roll and pitch; at 2, in a first run with 0.1 s segments searched three ahead, the search traded height for a level
 body: course 103 passed no waypoint and sank 3 m). With ``--causal`` the search has no foresight: its copies fly in
-the air of now, the gust held at its present value (the true one: a perfect estimate of the present).
+the air of now, the gust held at its present value (the true one: a perfect estimate of the present). With
+``--estimate`` not even that: the copies fly in the designed controller's own wind estimate, held steady (the run
+quoted in ``docs/results.md``: ``--causal --estimate --oracle-only --decisions 10 --horizon 6 --seeds 103,109``; each
+flight reports the estimate's rms error against the air at the body). The searched flights and their cost are
+``predictive.Planner``'s, the planner shipped for such courses: it senses the air of now 20 ms late, as antennae do.
 
 Each seed is flown from the same start for ``--seconds``, by the designed controller alone and with the oracle;
 reported: waypoints passed, the upsets (entries into roll or pitch beyond 60 deg, checked at each 10 ms decision),
