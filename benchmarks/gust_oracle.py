@@ -43,11 +43,11 @@ from pathlib import Path
 
 import numpy as np
 
-from lifelike_mj.butterfly.flight3d.predictive import Planner
+from lifelike_mj.butterfly.flight3d.predictive import UPSET_DEG, Planner
 
 HERE = Path(__file__).parent
 EA = {"wind_to_m_s": [1.0, 0.0, 0.0], "gust_m_s": 0.5, "gust_vertical_m_s": 0.5}
-UPSET_RAD = math.radians(60.0)
+UPSET_RAD = math.radians(UPSET_DEG)  # the planner's, in its cost and here in the report
 
 
 def _roll_pitch(qpos: np.ndarray, rq: int) -> np.ndarray:
@@ -114,6 +114,9 @@ class Oracle(Planner):
 
 
 def fly(seed: int, seconds: float, oracle: bool, args) -> dict:
+    from lifelike_mj.butterfly.flight3d.designed_kernel import ST_NAMES
+    from lifelike_mj.butterfly.flight3d.tasks import R_GUST, T_WIND
+
     o = Oracle(seed, args.population, args.horizon, args.decisions, args.reach)
     o.attitude_weight = args.attitude_weight
     o.causal = args.causal or args.estimate
@@ -124,9 +127,6 @@ def fly(seed: int, seconds: float, oracle: bool, args) -> dict:
     rng = np.random.default_rng(seed)
     warm = np.zeros((o.H, 9))
     upsets, was_up, low = 0, False, math.inf
-    from lifelike_mj.butterfly.flight3d.designed_kernel import ST_NAMES
-    from lifelike_mj.butterfly.flight3d.tasks import R_GUST, T_WIND
-
     w, wind_errors = ST_NAMES.index("w_hat_x"), []
     floor = float(o.waypoints[:, 2].min())
     t0 = time.perf_counter()

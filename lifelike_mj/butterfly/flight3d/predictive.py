@@ -75,6 +75,7 @@ class Planner:
 
         from lifelike_mj.butterfly.flight3d import designed as D
         from lifelike_mj.butterfly.flight3d.loop import Batch
+        from lifelike_mj.butterfly.flight3d.tasks import R_STEPS
 
         if getattr(flight, "designed", None) is None:
             raise UserError("the predictive planner needs a flight with a designed controller (design3d), flown "
@@ -94,7 +95,6 @@ class Planner:
         self.replan_s, self.horizon_s = self.decisions * decision_s, self.horizon * decision_s
         self.delay = int(round(SENSE_DELAY_S / decision_s))
         self.rng = np.random.default_rng(seed)
-        self.seed = seed
         self.scale = D.R_SCALES * self.reach
         mb.residual_scale = self.scale
         self.waypoints = np.array([r[:3] for r in flight.task.rows], float)
@@ -109,7 +109,7 @@ class Planner:
         self.nominal = np.zeros(9)
         #: The weight of the mean square roll and pitch in :meth:`costs` (0: none).
         self.attitude_weight = 0.0
-        if int(mb.records[0][_steps()]) == 0:
+        if int(mb.records[0][R_STEPS]) == 0:
             flight.decide(None)
         self._air: deque = deque(maxlen=self.delay + 1)
         self._sense()
@@ -234,9 +234,3 @@ class Planner:
         out = {k: np.array([r[k] for r in rows]) for k in rows[0]}
         out["t_s"] = np.array(times)
         return out
-
-
-def _steps() -> int:
-    from lifelike_mj.butterfly.flight3d.tasks import R_STEPS
-
-    return R_STEPS
