@@ -32,8 +32,6 @@ def envs() -> None:
     import numpy as np
 
     import lifelike_mj.envs  # noqa: F401  (registers the environments)
-    from lifelike_mj.butterfly import flight3d
-    from lifelike_mj.butterfly.flight3d.loop import network
     from lifelike_mj.envs.policies import controller_policy
     from lifelike_mj.render.video import write_png
 
@@ -44,14 +42,13 @@ def envs() -> None:
     for _ in range(6000):  # 5 s: settled flight
         obs, *_ = env.step(policy(obs))
     write_png(OUT / "env_butterfly_pitch.png", env.render())
-    ctl = flight3d.load_controller("monarch")
-    env = gym.make("lifelike_mj/ButterflyFlight3D-v0", controller=ctl, task="turn", duration_s=10.0,
+    # the shipped default as the baseline, a residual policy of zeros on top: the designed controller's own flight
+    env = gym.make("lifelike_mj/ButterflyFlight3D-v0", controller="designed", task="turn", duration_s=10.0,
                    render_mode="rgb_array", width=480, height=320)
-    obs, _ = env.reset(seed=0)
-    u, scratch = np.zeros(flight3d.N_ACT), np.zeros(64)
-    for _ in range(int(round(2.6 / flight3d.DT_S))):  # in the turn
-        network(ctl.layers, ctl.weights, obs, u, scratch)
-        obs, *_ = env.step(u.copy())
+    env.reset(seed=0)
+    zeros = np.zeros(env.action_space.shape)
+    while env.unwrapped.flight.time < 2.6:  # in the turn
+        env.step(zeros)
     write_png(OUT / "env_butterfly_flight3d.png", env.render())
 
 

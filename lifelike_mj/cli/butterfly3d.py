@@ -550,7 +550,7 @@ def add_commands(bf) -> None:
     p = bf.add_parser("garden", help="a garden of 3D butterflies visiting flowers, filmed")
     p.add_argument("--n", type=count(1, 500), default=20, help="butterflies, 1 to 500")
     p.add_argument("--controller", default=DEFAULT_CONTROLLER, help=CONTROLLER_HELP + f" (default: {DEFAULT_CONTROLLER}; "
-                   "a network that lands lands on the flowers, the others pass them by)")
+                   "designed lands on the flowers, as does a network with a landing; the others pass them by)")
     add_seed(p)
     p.add_argument("--flutter", type=num(0, 1), default=0.1, help="each butterfly's flutter, 0 to 1")
     _add_weather(p, "", "each butterfly's seed")

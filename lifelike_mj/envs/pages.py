@@ -187,10 +187,10 @@ obs, reward, terminated, truncated, info = env.step(env.action_space.sample())''
         variants=(),
         vector="lifelike_mj.envs.butterfly3d:ButterflyFlight3DVectorEnv",
         module="lifelike_mj.envs.butterfly3d",
-        picture="![A 3D butterfly in the middle of a 90° turn, flown through the environment by the shipped `monarch` "
+        picture="![A 3D butterfly in the middle of a 90° turn, flown through the environment by the shipped `designed` "
                 "controller](../figures/env_butterfly_flight3d.png)",
-        caption="*The environment's `rgb_array` frame 2.6 s into a 90° turn, the shipped `monarch` controller acting as "
-                "the policy (`python docs/make_pictures.py`).*",
+        caption="*The environment's `rgb_array` frame 2.6 s into a 90° turn, the shipped `designed` controller flying as "
+                "the baseline (`controller=\"designed\"`) under a residual policy of zeros (`python docs/make_pictures.py`).*",
         example='''import gymnasium as gym
 import lifelike_mj.envs                      # registers the environments (pip install "lifelike-mj[gym]")
 
