@@ -58,6 +58,7 @@ def tail_beats(rig, t):
 
 def main() -> None:
     from lifelike_mj.boids import Flock
+    from lifelike_mj.boids.look import agent_length
     from lifelike_mj.boids.look import rigs as bird_rigs
     from lifelike_mj.boids.presets import load_preset
     from lifelike_mj.butterfly import flight3d
@@ -86,24 +87,25 @@ def main() -> None:
                       "largest_bend_deg": {"median": float(np.median(bend)), "max": float(max(bend))}}
     poses = record_poses(Flock(load_preset("5b"), n=300, seed=3), 1500, fps=0.2, time_scale=1 / 150)
     birds = bird_rigs(poses)
-    err, banks, flap, glide = [], [], [], []
+    err, banks = [], []
     for r in birds:
-        b = next(x for x in r.bones if x.name.endswith("/flight"))
+        b = r.bones[0]  # the drawn bird
         fwd = qrot(b.quat_wxyz, np.array([1.0, 0.0, 0.0]))
         right = qrot(b.quat_wxyz, np.array([0.0, -1.0, 0.0]))
         level = np.cross(fwd, [0.0, 0.0, 1.0])
         level /= np.linalg.norm(level, axis=1, keepdims=True)
         roll = np.arctan2(np.sum(np.cross(right, level) * fwd, axis=1), np.sum(level * right, axis=1))
         s = r.secondary
-        want = np.arctan(s["horizontal_m_s"] * s["yaw_rate_rad_s"] / 9.81)
+        want = np.arctan(s["lateral_m_s2"] / 9.81)
         err.append(float(np.degrees(np.max(np.abs(roll - want)))))
         banks.append(np.degrees(np.abs(roll)))
-        flap.append(float(np.median(s["flap_hz"][~s["glide"]])) if np.any(~s["glide"]) else math.nan)
-        glide.append(float(np.mean(s["glide"])))
+    length = agent_length(poses)
+    off = np.array([r.secondary["off_path"] for r in birds]) / length
     result["birds"] = {"pattern": "5b", "bank_error_deg_max": float(max(err)),
                        "bank_deg": {"median": float(np.median(np.concatenate(banks))),
                                     "p90": float(np.percentile(np.concatenate(banks), 90))},
-                       "flap_hz_median": float(np.nanmedian(flap)), "glide_share_median": float(np.median(glide))}
+                       "flap_hz": birds[0].cycle.period_s ** -1, "phase_groups": len({r.group for r in birds}),
+                       "off_path_body_lengths": {"rms": float(np.sqrt(np.mean(off ** 2))), "max": float(off.max())}}
     flight = Flight3D(controller=flight3d.withdrawn_file("steer"), task=flight3d.course(103))
     bp = record_poses(flight, 3.0)
     misses = {}

@@ -1,24 +1,31 @@
-"""How a bird of the flock looks when its motion leaves the project: a rig (:mod:`lifelike_mj.export.rig`) per
-agent, a textured bird (body, head, beak, two-segment wings, tail) made here, with wing beats and banking
-computed from the flock's recorded motion afterwards (the flock itself is untouched).
+"""How a bird of the flock looks when its motion leaves the project: a crowd (:mod:`lifelike_mj.export.rig`),
+each agent a textured bird (body, head, beak, two-segment wings, tail) on a small skeleton, drawn along a path
+smoothed from the flock's recorded motion afterwards (the flock itself is untouched), its wings playing one wing
+beat that every bird shares, each at its own phase.
 
-Bones of agent ``boidN``:
+**The render path** (bone ``boidN``, the drawn bird; the simulated agent is not a bone): the paper's agents
+zigzag, their heading turning a median 105-113 degrees from one step to the next, so the bird is drawn along
 
-* ``boidN``: the MuJoCo body, exactly as the flock has it (the paper's agent: its drawn heading is its velocity
-  at that step, which in many patterns turns by tens of degrees from one step to the next);
-* ``boidN/flight``: the bird as it flies, which the mesh follows: at the agent's path smoothed over
-  :data:`SMOOTH_STEPS` steps (a Gaussian), heading along that path, pitched with its climb, and banked into
-  turns by the coordinated-turn relation ``tan(bank) = v * yaw rate / g`` (v and the yaw rate of the smoothed
-  path in the file's units: box units as metres and playback seconds; g = 9.81 m/s^2);
-* ``boidN/wing_left_inner``, ``.../wing_left_outer`` (and right): the wing beat, a flap about the body's
-  long axis at the shoulder, the outer wing lagging and folding on the upstroke;
-* ``boidN/tail``: spread and lifted a little in turns and climbs.
+* the agent's positions smoothed by a Gaussian of :data:`PATH_SIGMA_STEPS` steps (sigma; :func:`drawn_flight`
+  reports the largest and rms distance from the simulated positions);
+* its heading and climb from the drawn velocity, averaged by a Gaussian of :data:`TURN_SIGMA_STEPS` steps (the
+  slow stretches weigh less, so the bird does not spin where it hovers);
+* its bank from the drawn lateral acceleration, averaged alike: ``tan(bank) = a_lat / g``, the coordinated
+  turn (Reynolds 1987 banks a boid the same way), which for a steady turn is ``v * yaw rate / g`` (g =
+  9.81 m/s^2; lengths in the file's units as metres, times in playback seconds).
 
-The wing beat follows the flight's effort: frequency :data:`FLAP_HZ` (about 10 Hz: Pennycuick's 1996 formula
-for a starling, derived) rising to :data:`FLAP_HZ_MAX` with climb and acceleration, amplitude from
-:data:`FLAP_DEG` to :data:`FLAP_DEG_MAX`; when the bird slows or sinks the wings stop spread in a glide (flap
-and glide: Tobalske 1995, J Exp Biol 198:1259). How effort maps to frequency and amplitude is a look: no
-starling figure gives it.
+The paper's box has reflecting walls, not periodic ones: an agent never leaves it through one side and enters
+through the other, so there is no wrap to hide; at a wall the drawn path rounds the agent's reflection.
+
+**The wing beat** (bones ``boidN/wing_left_inner``, ``.../wing_left_outer`` and the right ones): one cycle of
+:data:`FLAP_HZ` (about 10 Hz: Pennycuick's 1996 formula for a starling, derived), a flap of :data:`FLAP_DEG`
+each side about the body's long axis at the shoulder, the outer wing folding on the upstroke. Every bird plays
+the same cycle (:func:`wing_cycle`, a :class:`~lifelike_mj.export.rig.Cycle`), stored once in a file, at one of
+:data:`PHASES` phases, spread over the flock by the golden ratio so that neighbours do not beat in step.
+
+What a flock file cannot carry: each bird's own flap and glide, or a frequency that follows its effort. Those
+change along each bird's flight, so they cannot be one cycle shared by all; a bird of the flock flaps steadily.
+``boidN/tail`` (keyed per bird): spread and lifted a little in turns and climbs.
 """
 
 from __future__ import annotations
@@ -28,45 +35,68 @@ import math
 import numpy as np
 
 from lifelike_mj.export.meshes import Piece, assemble, loft, rigid, sheet, sphere
-from lifelike_mj.export.rig import Bone, Look, Rig, body_bone, continuous, creatures, extra_bone, qaxis, qmul, smooth
+from lifelike_mj.export.rig import Bone, Cycle, Look, Rig, continuous, creatures, extra_bone, qaxis, qmul, smooth
 
-#: The path is smoothed over this many steps (a Gaussian's sigma) for the flight bone.
-SMOOTH_STEPS = 10.0
-#: Wing beat: frequency (Hz) and amplitude (deg, each side of the mid stroke) at rest effort and at full effort.
-FLAP_HZ, FLAP_HZ_MAX, FLAP_DEG, FLAP_DEG_MAX = 9.0, 13.0, 35.0, 55.0
-#: Below this effort (0-1) the bird glides, wings spread.
-GLIDE_BELOW = 0.25
+#: The drawn path: the agent's positions smoothed by a Gaussian of this many steps (sigma).
+PATH_SIGMA_STEPS = 15.0
+#: The drawn heading, climb and bank: the drawn velocity and lateral acceleration averaged over this many steps.
+TURN_SIGMA_STEPS = 30.0
+#: The shared wing beat: frequency (Hz), flap amplitude each side of the mid stroke (deg), the outer wing's fold on
+#: the upstroke (deg) and a little dihedral (deg).
+FLAP_HZ, FLAP_DEG, FOLD_DEG, DIHEDRAL_DEG = 10.0, 45.0, 25.0, 8.0
+#: The cycle's samples per beat and the phases birds play it at (the samples a multiple of them).
+CYCLE_SAMPLES, PHASES = 48, 16
 G = 9.81
+#: The golden ratio's conjugate: bird i plays phase group floor(frac(i * GOLDEN) * PHASES).
+GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 
 
-def flight_frame(t: np.ndarray, pos: np.ndarray, sigma: float = SMOOTH_STEPS, metres_per_unit: float = 1.0):
-    """The flight bone's world pose at every sample (module docstring) and what it came from: ``(position,
-    quat_wxyz, series)`` with ``series`` holding speed (m/s), yaw rate (rad/s), bank (rad), climb (m/s) and
-    acceleration (m/s^2) along the path; ``pos`` in units of ``metres_per_unit`` metres (the series in m/s)."""
-    p = smooth(pos, sigma)
+def drawn_flight(t: np.ndarray, pos: np.ndarray, metres_per_unit: float = 1.0, path_sigma: float = PATH_SIGMA_STEPS,
+                 turn_sigma: float = TURN_SIGMA_STEPS):
+    """The drawn bird's world pose at every sample (module docstring) and what it came from: ``(position,
+    quat_wxyz, series)`` with ``series`` holding speed (m/s), yaw rate (rad/s), lateral acceleration (m/s^2), bank
+    (rad), climb (m/s) along the drawn path, and the distance from the simulated positions (the file's units);
+    ``pos`` in units of ``metres_per_unit`` metres (the series in m/s)."""
+    p = smooth(pos, path_sigma)
     n = len(t)
-    v = metres_per_unit * np.gradient(p, t, axis=0) if n > 2 else np.tile(np.array([1e-9, 0.0, 0.0]), (n, 1))
-    speed = np.linalg.norm(v, axis=1)
-    horiz = np.linalg.norm(v[:, :2], axis=1)
-    yaw = np.unwrap(np.arctan2(v[:, 1], v[:, 0]))
-    pitch = np.arctan2(v[:, 2], np.maximum(horiz, 1e-12))
-    yaw_rate = np.gradient(yaw, t) if n > 2 else np.zeros(n)
-    bank = np.arctan(horiz * yaw_rate / G)  # coordinated turn: tan(bank) = v * yaw rate / g
-    accel = np.gradient(speed, t) if n > 2 else np.zeros(n)
-    # heading, then climb (nose up: a negative turn about y), then bank (into a left turn, a positive yaw rate,
-    # the left wing goes down: a negative turn about the forward axis)
+    if n > 2:
+        v = metres_per_unit * np.gradient(p, t, axis=0)
+        acc = np.gradient(v, t, axis=0)
+    else:
+        v, acc = np.tile(np.array([1e-9, 0.0, 0.0]), (n, 1)), np.zeros((n, 3))
+    h = smooth(v, turn_sigma)  # the heading: the drawn velocity, averaged
+    horiz = np.linalg.norm(h[:, :2], axis=1)
+    yaw = np.unwrap(np.arctan2(h[:, 1], h[:, 0]))
+    pitch = np.arctan2(h[:, 2], np.maximum(horiz, 1e-12))
+    left = np.stack([-np.sin(yaw), np.cos(yaw), np.zeros(n)], axis=1)
+    a_lat = smooth(np.sum(acc * left, axis=1)[:, None], turn_sigma)[:, 0]
+    bank = np.arctan(a_lat / G)  # coordinated turn: tan(bank) = a_lat / g
+    # heading, then climb (nose up: a negative turn about y), then bank (into a left turn, a positive lateral
+    # acceleration, the left wing goes down: a negative turn about the forward axis)
     q = qmul(qmul(qaxis((0.0, 0.0, 1.0), yaw), qaxis((0.0, 1.0, 0.0), -pitch)), qaxis((1.0, 0.0, 0.0), -bank))
-    series = {"speed_m_s": speed, "yaw_rate_rad_s": yaw_rate, "bank_rad": bank, "climb_m_s": v[:, 2],
-              "accel_m_s2": accel, "horizontal_m_s": horiz}
+    speed = np.linalg.norm(v, axis=1)
+    series = {"speed_m_s": speed, "horizontal_m_s": np.linalg.norm(v[:, :2], axis=1),
+              "yaw_rate_rad_s": np.gradient(yaw, t) if n > 2 else np.zeros(n), "lateral_m_s2": a_lat,
+              "bank_rad": bank, "climb_m_s": v[:, 2], "off_path": np.linalg.norm(p - pos, axis=1)}
     return p, continuous(q), series
 
 
-def effort(series: dict) -> np.ndarray:
-    """How hard the bird works its wings (0 glide .. 1 full): half at level, steady flight, more with climb
-    (per unit of speed) and acceleration (per g), less when slowing or sinking."""
-    v = np.maximum(series["speed_m_s"], 1e-9)
-    e = 0.5 + 1.5 * series["climb_m_s"] / v + 2.0 * series["accel_m_s2"] / G
-    return np.clip(smooth(e[:, None], 4.0)[:, 0], 0.0, 1.0)
+def wing_cycle(hz: float = FLAP_HZ, samples: int = CYCLE_SAMPLES, phases: int = PHASES) -> Cycle:
+    """The shared wing beat (module docstring): each wing's inner and outer bone over one beat."""
+    phase = 2.0 * np.pi * np.arange(samples + 1) / samples
+    stroke = math.radians(FLAP_DEG) * np.sin(phase) + math.radians(DIHEDRAL_DEG)
+    fold = math.radians(FOLD_DEG) * np.clip(np.cos(phase), 0.0, None)  # the outer wing folds going up
+    x = (1.0, 0.0, 0.0)
+    quats = {}
+    for side, sign in (("left", 1.0), ("right", -1.0)):
+        quats[f"wing_{side}_inner"] = continuous(qaxis(x, sign * stroke))
+        quats[f"wing_{side}_outer"] = continuous(qaxis(x, -sign * fold))
+    return Cycle("bird wingbeat", 1.0 / hz, quats, phases)
+
+
+def phase_group(i: int, phases: int = PHASES) -> int:
+    """The phase group of the flock's ``i``-th bird: spread by the golden ratio (module docstring)."""
+    return int(math.floor(((i * GOLDEN) % 1.0) * phases)) % phases
 
 
 def _plumage(px: int = 128) -> np.ndarray:
@@ -118,38 +148,32 @@ def bird_mesh(length: float, looks: dict, flight: int, wings: dict, tail: int) -
     return pieces
 
 
-def bird_rig(poses, i: int, length: float, looks: dict, meshes: dict, sigma: float = SMOOTH_STEPS,
-             metres_per_unit: float = 1.0) -> Rig:
+def bird_rig(poses, i: int, length: float, looks: dict, meshes: dict, cycle: Cycle, metres_per_unit: float = 1.0
+             ) -> Rig:
     """The rig of the flock's ``i``-th body (module docstring); ``metres_per_unit``: the flock's unit in metres
-    (its speeds, climbs and accelerations in m/s for the turn relation and the effort)."""
+    (its speeds, climbs and accelerations in m/s for the turn relation)."""
     t = poses.t_s
-    body = body_bone(poses, i, -1)
-    p, q, series = flight_frame(t, body.position_m, sigma, metres_per_unit)
-    bones: list[Bone] = [body, Bone(f"{body.name}/flight", -1, np.eye(4), p, q)]
-    e = effort(series)
-    glide = e < GLIDE_BELOW
-    f = FLAP_HZ + (FLAP_HZ_MAX - FLAP_HZ) * e
-    phase = 2 * np.pi * np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(t))]) if len(t) > 1 \
-        else np.zeros(len(t))
-    amp = np.radians(FLAP_DEG + (FLAP_DEG_MAX - FLAP_DEG) * e) * np.where(glide, 0.0, 1.0)
-    amp = smooth(amp[:, None], 3.0)[:, 0]  # into and out of a glide smoothly
-    stroke = amp * np.sin(phase) + math.radians(8.0)  # a little dihedral
-    fold = np.radians(25.0) * np.clip(np.cos(phase), 0.0, None) * (amp > 0.05)  # the outer wing folds going up
+    body = poses.body_names[i]
+    p, q, series = drawn_flight(t, poses.position_m[:, i], metres_per_unit)
+    bones: list[Bone] = [Bone(body, -1, np.eye(4), p, q, body, drawn=True)]
+    group = phase_group(list(poses.body_names).index(body))
     wings = {}
-    x = (1.0, 0.0, 0.0)
     for side, sign in (("left", 1.0), ("right", -1.0)):
-        bones.append(extra_bone(f"{body.name}/wing_{side}_inner", 1, bones, (0.15 * length, sign * 0.1 * length,
-                                                                             0.06 * length), qaxis(x, sign * stroke)))
-        inner = len(bones) - 1
-        bones.append(extra_bone(f"{body.name}/wing_{side}_outer", inner, bones, (0.0, sign * 0.405 * length, 0.0),
-                                qaxis(x, -sign * fold)))
-        wings[side] = (inner, len(bones) - 1)
+        inner = cycle.play(f"wing_{side}_inner", group, t - t[0])
+        bones.append(extra_bone(f"{body}/wing_{side}_inner", 0, bones, (0.15 * length, sign * 0.1 * length,
+                                                                         0.06 * length), inner))
+        k = len(bones) - 1
+        bones.append(extra_bone(f"{body}/wing_{side}_outer", k, bones, (0.0, sign * 0.405 * length, 0.0),
+                                cycle.play(f"wing_{side}_outer", group, t - t[0])))
+        wings[side] = (k, len(bones) - 1)
     lift = np.radians(10.0) * np.clip(np.abs(series["bank_rad"]) + series["climb_m_s"] /
                                       np.maximum(series["speed_m_s"], 1e-9), 0.0, 1.0)
-    bones.append(extra_bone(f"{body.name}/tail", 1, bones, (-0.3 * length, 0.0, 0.0), qaxis((0.0, 1.0, 0.0), -lift)))
+    bones.append(extra_bone(f"{body}/tail", 0, bones, (-0.3 * length, 0.0, 0.0), qaxis((0.0, 1.0, 0.0), -lift)))
     if "mesh" not in meshes:
-        meshes["mesh"] = assemble("bird", bird_mesh(length, looks, 1, wings, len(bones) - 1))
-    return Rig(body.name, bones, meshes["mesh"], {}, {**series, "effort": e, "flap_hz": f, "glide": glide})
+        meshes["mesh"] = assemble("bird", bird_mesh(length, looks, 0, wings, len(bones) - 1))
+    # phase: where in the beat (a fraction) the bird is at the clip's start; rate: the beat's speed against the cycle's
+    extras = {"cycle": {"name": cycle.name, "period_s": cycle.period_s, "phase": group / cycle.groups, "rate": 1.0}}
+    return Rig(body, bones, meshes["mesh"], extras, series, cycle=cycle, group=group)
 
 
 def agent_length(poses) -> float:
@@ -160,7 +184,7 @@ def agent_length(poses) -> float:
 
 
 def rigs(poses, length: float | None = None, metres_per_unit: float = 1.0) -> list[Rig]:
-    """One rig per agent of the flock, all sharing one bird mesh (``length``: the bird's, default the agents'
+    """One rig per agent of the flock, all sharing one bird mesh and one wing beat (``length``: the bird's, default the agents'
     drawn body length, :func:`agent_length`); ``metres_per_unit``: the flock's unit in metres, 1 unless the flock
     is scaled to a bird size (a scene), for the turn relation and the effort, which are in m/s."""
     if length is None:
@@ -169,6 +193,7 @@ def rigs(poses, length: float | None = None, metres_per_unit: float = 1.0) -> li
              "wing": Look("wing", (1, 1, 1, 1), _plumage(), double_sided=True, roughness=0.6),
              "beak": Look("beak", (0.85, 0.7, 0.2, 1.0), roughness=0.4)}
     meshes: dict = {}
-    return [bird_rig(poses, idx[0], length, looks, meshes, metres_per_unit=metres_per_unit)
+    cycle = wing_cycle()
+    return [bird_rig(poses, idx[0], length, looks, meshes, cycle, metres_per_unit)
             for idx in creatures(poses).values()]
 

@@ -36,7 +36,7 @@ from lifelike_mj.errors import UserError
 from lifelike_mj.export.cameras import FOV_DEG, framing
 from lifelike_mj.export.keys import DEFAULT_TOLERANCE, Track, body_tracks, key_counts, tolerance_of
 from lifelike_mj.export.poses import Poses, drawn_geoms, geom_looks, geom_rgba
-from lifelike_mj.export.rig import Look, Mesh, Rig
+from lifelike_mj.export.rig import Cycle, Look, Mesh, Rig
 from lifelike_mj.export.shapes import geom_shape, geom_texture, geom_uv, shape_key
 from lifelike_mj.io import atomic_path, strict
 from lifelike_mj.provenance import provenance
@@ -133,6 +133,7 @@ class Doc:
         self.gl.nodes.append(self.root)
         self.buf = _Buffer(self.gl)
         self.anim = g.Animation(name=name, samplers=[], channels=[])
+        self._cycles: dict[str, dict] = {}  # a shared cycle's animation, its key times and its values per phase
         self._inputs: dict[tuple, int] = {}
         self._times: dict[int, tuple] = {}  # the sample times seen (kept alive), by id, with their digest
 
@@ -163,11 +164,33 @@ class Doc:
         self.anim.channels.append(g.AnimationChannel(sampler=len(self.anim.samplers) - 1,
                                                      target=g.AnimationChannelTarget(node=node, path=path)))
 
+    def cycle_channel(self, cycle: Cycle, part: str, group: int, node: int) -> None:
+        """Animate ``node``'s rotation by ``part`` of the shared ``cycle`` in phase ``group``: a channel of the
+        cycle's own animation (named as the cycle, one period long, to be looped), whose key times are stored once
+        and whose values once per part and phase, however many nodes play them."""
+        c = self._cycles.get(cycle.name)
+        if c is None:
+            m = cycle.samples
+            times = (np.arange(m + 1) * (cycle.period_s / m)).astype(np.float32)
+            c = {"anim": g.Animation(name=cycle.name, samplers=[], channels=[], extras={
+                     "lifelike_mj_cycle": {"period_s": cycle.period_s, "phases": cycle.groups, "loop": True}}),
+                 "input": self.buf.add(times, g.SCALAR, minmax=True), "outputs": {}}
+            self._cycles[cycle.name] = c
+        if (part, group) not in c["outputs"]:
+            q = cycle.shifted(part, group)[:, [1, 2, 3, 0]]
+            c["outputs"][part, group] = self.buf.add(
+                quantize_rotations(q) if self.rotations == "short" else q.astype(np.float32), g.VEC4)
+        anim = c["anim"]
+        anim.samplers.append(g.AnimationSampler(input=c["input"], output=c["outputs"][part, group],
+                                                interpolation="LINEAR"))
+        anim.channels.append(g.AnimationChannel(sampler=len(anim.samplers) - 1,
+                                                target=g.AnimationChannelTarget(node=node, path="rotation")))
+
     def finish(self, provenance_record: dict) -> g.GLTF2:
         """The document, with ``provenance_record`` as the asset's extras (strict JSON)."""
         gl = self.gl
         gl.asset.extras = strict(provenance_record)
-        gl.animations = [self.anim] if self.anim.channels else []
+        gl.animations = ([self.anim] if self.anim.channels else []) + [c["anim"] for c in self._cycles.values()]
         gl.buffers = [g.Buffer(byteLength=len(self.buf.data))]
         gl.set_binary_blob(bytes(self.buf.data))
         return gl
@@ -331,13 +354,16 @@ def _add_rigs(doc: Doc, parent: g.Node, poses: Poses, rigs: list[Rig], tolerance
         doc.node(arm, parent)
         first = len(gl.nodes)
         for i, (bone, k) in enumerate(zip(rig.bones, keys)):
-            extras = {"mujoco_body": bone.body} if bone.body is not None else {"secondary_motion": True}
+            extras = ({"secondary_motion": True} if bone.body is None else
+                      {"drawn_from_body": bone.body} if bone.drawn else {"mujoco_body": bone.body})
             gl.nodes.append(g.Node(name=bone.name, translation=[float(v) for v in k.still_translation],
                                    rotation=_xyzw(k.still_rotation), children=[], extras=extras))
             (arm if bone.parent < 0 else gl.nodes[first + bone.parent]).children.append(first + i)
             if k.translation is not None:
                 doc.channel(poses.t_s, first + i, "translation", k.translation, k.translation_values)
-            if k.rotation is not None:
+            if k.cycle is not None:
+                doc.cycle_channel(rig.cycle, rig.cycle_part(bone), rig.group, first + i)
+            elif k.rotation is not None:
                 doc.channel(poses.t_s, first + i, "rotation", k.rotation, k.rotation_values[:, [1, 2, 3, 0]])
         ibm = np.stack([np.linalg.inv(R @ b.bind).T for b in rig.bones]).astype(np.float32)  # column-major
         if ibm.tobytes() not in binds:

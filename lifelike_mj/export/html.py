@@ -95,7 +95,13 @@ _PAGE = """<!doctype html>
   document.addEventListener("keydown", (e) => {{ if (e.code === "Space") {{ e.preventDefault(); toggle(); }} }});
   run.addEventListener("play", () => {{ play.textContent = "Pause"; }});
   run.addEventListener("pause", () => {{ play.textContent = "Play"; }});
-  run.addEventListener("load", () => {{ scrub.max = run.duration; document.body.dataset.loaded = "yes"; }});
+  run.addEventListener("load", () => {{
+    // a crowd's shared cycles (a flock's wing beat): each its own animation, looped on top of the run's; every
+    // bird plays it at the phase its channels were stored in
+    for (const name of frame.cycles) run.appendAnimation(name, {{repetitions: Infinity, fade: false, weight: 1}});
+    scrub.max = run.duration;
+    document.body.dataset.loaded = "yes";
+  }});
   scrub.addEventListener("pointerdown", () => {{ dragging = true; }});
   scrub.addEventListener("pointerup", () => {{ dragging = false; }});
   scrub.addEventListener("input", () => {{ run.currentTime = Number(scrub.value); }});
@@ -145,7 +151,8 @@ def page(gl, name: str, view: dict) -> str:
     frame = {"theta": round(theta, 3), "phi": round(phi, 3), "overview_m": overview_m,
              "follow_m": float(follow["distance_m"]) if follow else 0.0,
              "centre": [float(v) for v in centre], "span_s": float(view["span_s"]),
-             "follow_path": (np.round(np.asarray(follow["path_m"]) @ y_up.T, 5).tolist() if follow else None)}
+             "follow_path": (np.round(np.asarray(follow["path_m"]) @ y_up.T, 5).tolist() if follow else None),
+             "cycles": [a.name for a in gl.animations[1:]]}
     glb = b"".join(gl.save_to_bytes())
     prov = json.dumps(gl.asset.extras, allow_nan=False)
     target = (y_up @ np.asarray(follow["path_m"][0], dtype=float)) if follow else centre

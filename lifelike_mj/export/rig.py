@@ -70,10 +70,10 @@ def lerp_at(t: np.ndarray, keys: np.ndarray, x: np.ndarray) -> np.ndarray:
     return np.stack([np.interp(t, tk, x[:, j]) for j in range(x.shape[1])], axis=1)
 
 
-def slerp_at(t: np.ndarray, keys: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Spherical interpolation of the unit key quaternions ``q`` (at the sample indices ``keys``) at every
-    time of ``t``."""
-    tk = t[keys]
+def slerp_at(t: np.ndarray, keys: np.ndarray, q: np.ndarray, key_times: np.ndarray | None = None) -> np.ndarray:
+    """Spherical interpolation of the unit key quaternions ``q`` (at the sample indices ``keys`` of ``t``, or at
+    ``key_times``) at every time of ``t``."""
+    tk = t[keys] if key_times is None else np.asarray(key_times, dtype=float)
     k = np.clip(np.searchsorted(tk, t, side="right") - 1, 0, len(tk) - 2)
     u = np.clip((t - tk[k]) / (tk[k + 1] - tk[k]), 0.0, 1.0)[:, None]
     a, b = q[k], q[k + 1].copy()
@@ -140,6 +140,41 @@ class Bone:
     position_m: np.ndarray
     quat_wxyz: np.ndarray
     body: str | None = None
+    #: The bone follows a path drawn from ``body`` (smoothed: a crowd's agent), not the body itself.
+    drawn: bool = False
+
+
+@dataclass
+class Cycle:
+    """A looping motion that rigs share (a flock's wing beat): ``name``; ``period_s`` (s); ``quat_wxyz``: per
+    part (a bone's name after its creature's, ``wing_left_inner``), the bone's rotation in its parent's frame at
+    ``samples`` instants evenly spread over one period, and the first again at the end (``(samples + 1, 4)``);
+    ``groups``: the phases a rig may play it at, ``k / groups`` of a period (``samples`` a multiple of it, so
+    that each phase's values are the same samples, shifted).
+
+    A player plays it as glTF does: slerp between neighbouring samples, looping (:meth:`play`)."""
+
+    name: str
+    period_s: float
+    quat_wxyz: dict[str, np.ndarray]
+    groups: int
+
+    @property
+    def samples(self) -> int:
+        return len(next(iter(self.quat_wxyz.values()))) - 1
+
+    def shifted(self, part: str, group: int) -> np.ndarray:
+        """The samples of ``part`` as phase ``group`` plays them (one period, the first again at the end)."""
+        q = self.quat_wxyz[part][:-1]
+        q = np.roll(q, -group * (self.samples // self.groups), axis=0)
+        return continuous(np.concatenate([q, q[:1]]))
+
+    def play(self, part: str, group: int, t_s: np.ndarray) -> np.ndarray:
+        """``part``'s local rotation at the times ``t_s`` (s from the clip's start) in phase ``group``."""
+        m = self.samples
+        times = np.arange(m + 1) * (self.period_s / m)
+        return slerp_at(np.mod(np.asarray(t_s, dtype=float), self.period_s), np.arange(m + 1), self.shifted(part, group),
+                        times)
 
 
 @dataclass
@@ -153,20 +188,39 @@ class Rig:
     mesh: Mesh
     extras: dict = field(default_factory=dict)
     secondary: dict = field(default_factory=dict)
+    #: A crowd's agent: the bones that ``cycle`` names play it (in phase ``group``) instead of keys of their own,
+    #: and every bone's keys are taken against its parent's pose as drawn (not as the parent's keys play it), so
+    #: that a child needs no keys to absorb its parent's interpolation (:func:`bone_keys`).
+    cycle: Cycle | None = None
+    group: int = 0
 
-    def keys(self, t: np.ndarray, tolerance=(0.0005, 0.5), rotations: str = "short") -> list[BoneKeys]:
-        """The bones' keys (:func:`bone_keys`), computed once per tolerance and storage."""
-        key = (tolerance_of(tolerance), rotations, len(t))
+    def cycle_part(self, bone: Bone) -> str | None:
+        """The part of :attr:`cycle` that ``bone`` plays, or None."""
+        if self.cycle is None:
+            return None
+        part = bone.name.rsplit("/", 1)[-1]
+        return part if part in self.cycle.quat_wxyz else None
+
+    def keys(self, t: np.ndarray, tolerance=(0.0005, 0.5), rotations: str = "short", cycles: bool = True
+             ) -> list[BoneKeys]:
+        """The bones' keys (:func:`bone_keys`), computed once per tolerance, storage and ``cycles``."""
+        key = (tolerance_of(tolerance), rotations, len(t), cycles)
         cache = self.__dict__.setdefault("_keys", {})
         if key not in cache:
-            cache[key] = bone_keys(t, self, key[0], rotations)
+            cache[key] = bone_keys(t, self, key[0], rotations, cycles)
         return cache[key]
 
-    def key_counts(self, t: np.ndarray, tolerance=(0.0005, 0.5), rotations: str = "short") -> dict:
-        """Keys kept per bone and channel (a still channel has 1: its node's value)."""
-        return {b.name: {"translation": 1 if k.translation is None else len(k.translation),
-                         "rotation": 1 if k.rotation is None else len(k.rotation)}
-                for b, k in zip(self.bones, self.keys(t, tolerance, rotations))}
+    def key_counts(self, t: np.ndarray, tolerance=(0.0005, 0.5), rotations: str = "short", cycles: bool = True
+                   ) -> dict:
+        """Keys kept per bone and channel (a still channel has 1: its node's value; a bone's rotation that plays the
+        shared cycle has none of its own, 0, and ``cycle``: the cycle's name and the phase group)."""
+        out: dict = {}
+        for b, k in zip(self.bones, self.keys(t, tolerance, rotations, cycles)):
+            out[b.name] = {"translation": 1 if k.translation is None else len(k.translation),
+                           "rotation": 0 if k.cycle is not None else 1 if k.rotation is None else len(k.rotation)}
+            if k.cycle is not None:
+                out[b.name]["cycle"] = {"name": k.cycle, "group": self.group}
+        return out
 
     def check(self) -> None:
         for i, b in enumerate(self.bones):
@@ -190,6 +244,8 @@ class BoneKeys:
     rotation_values: np.ndarray
     still_translation: np.ndarray
     still_rotation: np.ndarray
+    #: The shared cycle whose part this bone's rotation plays (its rig's ``cycle``), or None.
+    cycle: str | None = None
 
 
 def _stored(q: np.ndarray, rotations: str) -> np.ndarray:
@@ -201,9 +257,15 @@ def _stored(q: np.ndarray, rotations: str) -> np.ndarray:
     return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
-def bone_keys(t: np.ndarray, rig: Rig, tolerance=(0.0005, 0.5), rotations: str = "short") -> list[BoneKeys]:
+def bone_keys(t: np.ndarray, rig: Rig, tolerance=(0.0005, 0.5), rotations: str = "short", cycles: bool = True
+              ) -> list[BoneKeys]:
     """Each bone's local keys (module docstring): within ``tolerance`` (m, deg) of its world pose at every
-    sample of ``t``, less what storing costs (``rotations``: ``"short"`` 16-bit or ``"float"``)."""
+    sample of ``t``, less what storing costs (``rotations``: ``"short"`` 16-bit or ``"float"``).
+
+    A crowd's agent (a rig with a ``cycle``) is keyed channel by channel instead: its root within the tolerance
+    of its world pose, every other bone within it of its pose in its parent's frame as drawn; the bones that play
+    the cycle get no keys (``cycles``; with ``cycles=False``, for a writer that cannot share a cycle, they are
+    keyed as the others, and every bone as a rig's that has no cycle, within the tolerance in the world)."""
     tol_m, tol_deg = tolerance_of(tolerance)
     span = max(float(np.max(np.abs(b.position_m))) for b in rig.bones)
     tol_m -= 6e-8 * span + 1e-9
@@ -213,13 +275,22 @@ def bone_keys(t: np.ndarray, rig: Rig, tolerance=(0.0005, 0.5), rotations: str =
                         f"{span:g} m from the origin can hold; give a larger one.")
     played: list[tuple[np.ndarray, np.ndarray]] = []  # each bone's world pose as its keys play it
     out = []
+    crowd = rig.cycle is not None and cycles
     for b in rig.bones:
         if b.parent < 0:
             p_local, q_local = b.position_m, continuous(b.quat_wxyz)
         else:
-            pp, pq = played[b.parent]
+            pb = rig.bones[b.parent]
+            pp, pq = (pb.position_m, pb.quat_wxyz) if crowd else played[b.parent]
             p_local = qrot(qconj(pq), b.position_m - pp)
             q_local = continuous(qmul(qconj(pq), b.quat_wxyz))
+        part = rig.cycle_part(b) if cycles else None
+        if part is not None:  # plays the shared cycle: its still values are where the cycle starts
+            tv = p_local[:1].astype(np.float32).astype(float)
+            rv = _stored(rig.cycle.shifted(part, rig.group)[:1], "float")
+            played.append((b.position_m, b.quat_wxyz))
+            out.append(BoneKeys(None, None, tv, rv, tv[0], rv[0], rig.cycle.name))
+            continue
         # translation: still where every sample is within a quarter of the tolerance of the first
         if np.max(np.linalg.norm(p_local - p_local[0], axis=1)) <= tol_m / 4:
             tk, tv = None, p_local[:1].astype(np.float32).astype(float)
@@ -244,22 +315,43 @@ def bone_keys(t: np.ndarray, rig: Rig, tolerance=(0.0005, 0.5), rotations: str =
     return out
 
 
-def check_bone_keys(t: np.ndarray, rig: Rig, keys: list[BoneKeys]) -> tuple[float, float]:
-    """The largest miss (m, rad) of the keys' world poses, as a player composes them, against the rig's
-    world poses over every sample: what the tolerance bounds."""
-    worst_m, worst_rad = 0.0, 0.0
-    played: list[tuple[np.ndarray, np.ndarray]] = []
+def bone_play(t: np.ndarray, rig: Rig, keys: list[BoneKeys]) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Each bone's pose in its parent's frame (its root's: the world's) as a player plays ``keys`` at the samples
+    ``t``: ``(position (n, 3), quat_wxyz (n, 4))``; a bone of the shared cycle as the cycle plays, looping from
+    the file's start."""
+    out = []
     for b, k in zip(rig.bones, keys):
         p = np.repeat(k.still_translation[None], len(t), axis=0) if k.translation is None else \
             lerp_at(t, k.translation, k.translation_values)
-        q = np.repeat(k.still_rotation[None], len(t), axis=0) if k.rotation is None else \
-            slerp_at(t, k.rotation, k.rotation_values)
-        if b.parent >= 0:
+        if k.cycle is not None:
+            q = rig.cycle.play(rig.cycle_part(b), rig.group, t - t[0])
+        elif k.rotation is None:
+            q = np.repeat(k.still_rotation[None], len(t), axis=0)
+        else:
+            q = slerp_at(t, k.rotation, k.rotation_values)
+        out.append((p, q))
+    return out
+
+
+def check_bone_keys(t: np.ndarray, rig: Rig, keys: list[BoneKeys]) -> tuple[float, float]:
+    """The largest miss (m, rad) of the keys over every sample, what the tolerance bounds: the bones' world poses
+    as a player composes them against the rig's; for a crowd's agent keyed with its ``cycle``, channel by channel,
+    each bone's pose in its parent's frame against the same as drawn (:func:`bone_keys`)."""
+    worst_m, worst_rad = 0.0, 0.0
+    played: list[tuple[np.ndarray, np.ndarray]] = []
+    crowd = any(k.cycle is not None for k in keys)  # keyed as a crowd (bone_keys with its cycle)
+    for b, (p, q) in zip(rig.bones, bone_play(t, rig, keys)):
+        want_p, want_q = b.position_m, b.quat_wxyz
+        if b.parent >= 0 and crowd:
+            pb = rig.bones[b.parent]
+            want_p = qrot(qconj(pb.quat_wxyz), b.position_m - pb.position_m)
+            want_q = qmul(qconj(pb.quat_wxyz), b.quat_wxyz)
+        elif b.parent >= 0:
             pp, pq = played[b.parent]
             p, q = pp + qrot(pq, p), qmul(pq, q)
         played.append((p, q))
-        worst_m = max(worst_m, float(np.max(np.linalg.norm(p - b.position_m, axis=1))))
-        d = np.clip(np.abs(np.sum(q * b.quat_wxyz, axis=1)), 0.0, 1.0)
+        worst_m = max(worst_m, float(np.max(np.linalg.norm(p - want_p, axis=1))))
+        d = np.clip(np.abs(np.sum(q * want_q, axis=1)), 0.0, 1.0)
         worst_rad = max(worst_rad, float(np.max(2.0 * np.arccos(d))))
     return worst_m, worst_rad
 

@@ -239,7 +239,7 @@ def _add_rigs(stage, world_path, rigs, t, fps, tolerance, used, looks_of):
     report = {}
     for rig in rigs:
         rig.check()
-        keys = rig.keys(t, tolerance, "float")
+        keys = rig.keys(t, tolerance, "float", cycles=False)  # each bone keyed: a shared cycle is not written yet
         root = UsdSkel.Root.Define(stage, Sdf.Path(world_path).AppendChild(_ident(f"{rig.name} rig", used)))
         root.GetPrim().SetCustomDataByKey("lifelike_mj_rig", rig.name)
         skel = UsdSkel.Skeleton.Define(stage, root.GetPath().AppendChild("Skeleton"))
@@ -304,7 +304,7 @@ def _add_rigs(stage, world_path, rigs, t, fps, tolerance, used, looks_of):
                 start += len(tr)
             UsdShade.MaterialBindingAPI.Apply(geom.GetPrim())
             UsdGeom.Subset.SetFamilyType(geom, UsdShade.Tokens.materialBind, UsdGeom.Tokens.partition)
-        report[rig.name] = rig.key_counts(t, tolerance, "float")
+        report[rig.name] = rig.key_counts(t, tolerance, "float", cycles=False)
     return report
 
 

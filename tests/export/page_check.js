@@ -46,6 +46,7 @@ const path = require("path");
       await page.click("#play"); // pause
       result.paused = await page.$eval("#run", (e) => e.paused);
       result.duration = await page.$eval("#run", (e) => e.duration);
+      result.appended = await page.$eval("#run", (e) => e.appendedAnimations || []); // a crowd's shared cycles
       for (const t of times) {
         await page.$eval("#scrub", (e, v) => { e.value = v; e.dispatchEvent(new Event("input")); }, t);
         await page.waitForTimeout(1500);

@@ -90,11 +90,13 @@ def test_blender_imports_an_armature_per_creature_whose_bones_follow_the_simulat
         assert sorted(got["armatures"][f"{r.name} rig"]) == sorted(b.name for b in r.bones)
     assert {b.body for r in rigs for b in r.bones} - {None} >= {n for n in poses.body_names
                                                                if any(n == b.name for r in rigs for b in r.bones)}
+    # a flock's wings play the shared wing beat, a glTF animation of its own: Blender's importer plays one
+    # animation at a time (the run's), so only the birds' other bones are followed here
     first = None
     for k in samples:
         seen = got["bones"][times[k]]
         for r in rigs:
-            for b in r.bones:
+            for b in (b for b in r.bones if r.cycle_part(b) is None):
                 M = np.array(seen[b.name])
                 np.testing.assert_allclose(M[:3, 3], b.position_m[k], atol=1e-4)
         if first is None:
@@ -102,7 +104,7 @@ def test_blender_imports_an_armature_per_creature_whose_bones_follow_the_simulat
             continue
         k0, seen0 = first
         for r in rigs:
-            for b in r.bones:  # the turn from the first time to this one, in the world
+            for b in (b for b in r.bones if r.cycle_part(b) is None):  # the turn from the first time, in the world
                 turn = np.array(seen[b.name])[:3, :3] @ np.array(seen0[b.name])[:3, :3].T
                 R1, R0 = np.empty(9), np.empty(9)
                 mujoco.mju_quat2Mat(R1, b.quat_wxyz[k])

@@ -54,6 +54,8 @@ def test_the_page_plays_each_rigged_creature_offline(runs, creature, tmp_path, c
     r = chromium.check("html", str(page), str(empty), str(tmp_path), str(t1), str(t2))
     assert r["errors"] == [] and r["network"] == [], r
     assert r["paused"] is True and r["duration"] == pytest.approx(span, abs=1e-3)
+    # a flock's wing beat: one shared cycle, looped on top of the run (the birds' phases are in its channels)
+    assert r["appended"] == (["bird wingbeat"] if creature == "boids" else []), r["appended"]
     assert r[f"time_{t1}"] == pytest.approx(t1, abs=1e-3) and r[f"time_{t2}"] == pytest.approx(t2, abs=1e-3)
     first, later, empty = r["shots"]
     assert chromium.changed_pixels(first, empty) > 50  # the creature is drawn (ten fish in a 5 m tank are small)
