@@ -36,7 +36,8 @@ from lifelike_mj.provenance import provenance
 
 ROOT = Path(__file__).resolve().parents[1]
 BPY = ROOT / ".ci" / "bpy" / "bin" / "python"
-IMPORT = ("import sys, time, bpy\n"
+IMPORT = ("import sys, time, bpy, numpy\n"
+          "numpy.bool = getattr(numpy, 'bool', bool)  # Debian's Blender 3.4 glTF importer asks numpy for np.bool\n"
           "t = time.perf_counter()\n"
           "bpy.ops.import_scene.gltf(filepath=sys.argv[-1])\n"
           "print('IMPORT_S', time.perf_counter() - t, flush=True)\n")

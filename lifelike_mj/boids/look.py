@@ -6,8 +6,10 @@ beat that every bird shares, each at its own phase.
 **The render path** (bone ``boidN``, the drawn bird; the simulated agent is not a bone): the paper's agents
 zigzag, their heading turning a median 105-113 degrees from one step to the next, so the bird is drawn along
 
-* the agent's positions smoothed by a Gaussian of :data:`PATH_SIGMA_STEPS` steps (sigma; :func:`drawn_flight`
-  reports the largest and rms distance from the simulated positions);
+* the agent's positions smoothed by a Gaussian of :data:`PATH_SIGMA_STEPS` steps (sigma), narrowed in proportion
+  where the agent moves faster than :data:`FAST_BL_PER_STEP` body lengths a step (some patterns, 5b among them,
+  have spells of agents crossing the box in a few steps, bouncing off its walls: a wide smoothing would draw the
+  bird metres from its agent there); :func:`drawn_flight` reports the distance from the simulated positions;
 * its heading and climb from the drawn velocity, averaged by a Gaussian of :data:`TURN_SIGMA_STEPS` steps (the
   slow stretches weigh less, so the bird does not spin where it hovers);
 * its bank from the drawn lateral acceleration, averaged alike: ``tan(bank) = a_lat / g``, the coordinated
@@ -37,8 +39,12 @@ import numpy as np
 from lifelike_mj.export.meshes import Piece, assemble, loft, rigid, sheet, sphere
 from lifelike_mj.export.rig import Bone, Cycle, Look, Rig, continuous, creatures, extra_bone, qaxis, qmul, smooth
 
-#: The drawn path: the agent's positions smoothed by a Gaussian of this many steps (sigma).
-PATH_SIGMA_STEPS = 15.0
+#: The drawn path: the agent's positions smoothed by a Gaussian of this many steps (sigma), narrowed where the agent
+#: moves faster than :data:`FAST_BL_PER_STEP` (in proportion), so that a fast agent is drawn near where it is.
+PATH_SIGMA_STEPS = 10.0
+#: An agent's speed (body lengths per step, over 5 steps) above which its path's smoothing narrows (the paper's 5a
+#: moves a median 0.05).
+FAST_BL_PER_STEP = 0.05
 #: The drawn heading, climb and bank: the drawn velocity and lateral acceleration averaged over this many steps.
 TURN_SIGMA_STEPS = 30.0
 #: The shared wing beat: frequency (Hz), flap amplitude each side of the mid stroke (deg), the outer wing's fold on
@@ -51,13 +57,35 @@ G = 9.81
 GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 
 
+def adaptive_smooth(x: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+    """``x`` ``(n, k)`` smoothed by a Gaussian whose sigma (samples) is ``sigma[i]`` at sample ``i`` (its weights
+    normalised there; the ends held): where sigma is under half a sample, ``x`` as it is."""
+    n = len(x)
+    r = int(math.ceil(3.0 * float(np.max(sigma, initial=0.0))))
+    if r < 1 or n < 3:
+        return np.array(x, dtype=float)
+    j = np.arange(-r, r + 1)
+    idx = np.clip(np.arange(n)[:, None] + j[None, :], 0, n - 1)
+    s = np.maximum(sigma, 1e-9)[:, None]
+    w = np.exp(-0.5 * (j[None, :] / s) ** 2)
+    w[np.abs(j)[None, :] > np.ceil(3.0 * s)] = 0.0
+    w /= w.sum(axis=1, keepdims=True)
+    return np.einsum("ij,ijk->ik", w, np.asarray(x, dtype=float)[idx])
+
+
 def drawn_flight(t: np.ndarray, pos: np.ndarray, metres_per_unit: float = 1.0, path_sigma: float = PATH_SIGMA_STEPS,
-                 turn_sigma: float = TURN_SIGMA_STEPS):
+                 turn_sigma: float = TURN_SIGMA_STEPS, length: float | None = None):
     """The drawn bird's world pose at every sample (module docstring) and what it came from: ``(position,
     quat_wxyz, series)`` with ``series`` holding speed (m/s), yaw rate (rad/s), lateral acceleration (m/s^2), bank
     (rad), climb (m/s) along the drawn path, and the distance from the simulated positions (the file's units);
-    ``pos`` in units of ``metres_per_unit`` metres (the series in m/s)."""
-    p = smooth(pos, path_sigma)
+    ``pos`` in units of ``metres_per_unit`` metres (the series in m/s); ``length``: the agent's body length (the
+    file's units), which narrows the path's smoothing where the agent is fast (:data:`FAST_BL_PER_STEP`; None: a
+    fixed ``path_sigma``)."""
+    if length is None or len(pos) < 3:
+        p = smooth(pos, path_sigma)
+    else:
+        step = smooth(np.linalg.norm(np.gradient(pos, axis=0), axis=1)[:, None], 5.0)[:, 0] / length
+        p = adaptive_smooth(pos, path_sigma * np.minimum(1.0, FAST_BL_PER_STEP / np.maximum(step, 1e-12)))
     n = len(t)
     if n > 2:
         v = metres_per_unit * np.gradient(p, t, axis=0)
@@ -154,7 +182,7 @@ def bird_rig(poses, i: int, length: float, looks: dict, meshes: dict, cycle: Cyc
     (its speeds, climbs and accelerations in m/s for the turn relation)."""
     t = poses.t_s
     body = poses.body_names[i]
-    p, q, series = drawn_flight(t, poses.position_m[:, i], metres_per_unit)
+    p, q, series = drawn_flight(t, poses.position_m[:, i], metres_per_unit, length=length)
     bones: list[Bone] = [Bone(body, -1, np.eye(4), p, q, body, drawn=True)]
     group = phase_group(list(poses.body_names).index(body))
     wings = {}

@@ -276,6 +276,7 @@ def bone_keys(t: np.ndarray, rig: Rig, tolerance=(0.0005, 0.5), rotations: str =
     played: list[tuple[np.ndarray, np.ndarray]] = []  # each bone's world pose as its keys play it
     out = []
     crowd = rig.cycle is not None and cycles
+    margin = 1.0 if crowd else 0.75  # a chain's keys leave a quarter for what a child absorbs of its parent's
     for b in rig.bones:
         if b.parent < 0:
             p_local, q_local = b.position_m, continuous(b.quat_wxyz)
@@ -296,14 +297,14 @@ def bone_keys(t: np.ndarray, rig: Rig, tolerance=(0.0005, 0.5), rotations: str =
             tk, tv = None, p_local[:1].astype(np.float32).astype(float)
             p_play = np.repeat(tv, len(t), axis=0)
         else:
-            tk = lerp_keys(t, p_local, tol_m * 0.75)
+            tk = lerp_keys(t, p_local, tol_m * margin)
             tv = p_local[tk].astype(np.float32).astype(float)
             p_play = lerp_at(t, tk, tv)
         if np.max(2.0 * np.arccos(np.clip(np.abs(q_local @ q_local[0]), 0.0, 1.0))) <= tol_rad / 4:
             rk, rv = None, _stored(q_local[:1], "float")
             q_play = np.repeat(rv, len(t), axis=0)
         else:
-            rk = slerp_keys(t, q_local, tol_rad * 0.75)
+            rk = slerp_keys(t, q_local, tol_rad * margin)
             rv = _stored(q_local[rk], rotations)
             q_play = slerp_at(t, rk, rv)
         if b.parent < 0:
