@@ -232,16 +232,20 @@ def _add_rigs(stage, world_path, rigs, t, fps, tolerance, used, looks_of):
     sampled at every key time of any of its bones, between frames where they fall; each bone's value there is its
     keys' interpolation, so within the tolerance), and the skinned mesh (``skel:jointIndices``/``jointWeights``,
     ``primvars:st``) with one material per look. Returns each rig's keys per bone."""
-    from pxr import Gf, Sdf, UsdGeom, UsdShade, UsdSkel, Vt
+    from pxr import Gf, Sdf, UsdGeom, UsdSkel, Vt
 
     from lifelike_mj.export.rig import lerp_at, slerp_at
 
     report = {}
+    shared: dict[str, Sdf.Path] = {}  # a crowd's cycle: its one SkelAnimation, which each agent's references
     for rig in rigs:
         rig.check()
-        keys = rig.keys(t, tolerance, "float", cycles=False)  # each bone keyed: a shared cycle is not written yet
+        crowd = rig.cycle is not None
+        keys = rig.keys(t, tolerance, "float")
         root = UsdSkel.Root.Define(stage, Sdf.Path(world_path).AppendChild(_ident(f"{rig.name} rig", used)))
         root.GetPrim().SetCustomDataByKey("lifelike_mj_rig", rig.name)
+        if crowd:  # the agent's drawn motion moves its SkelRoot; its skeleton's root joint rests
+            _key_xform(UsdGeom.Xformable(root), keys[0], t, fps)
         skel = UsdSkel.Skeleton.Define(stage, root.GetPath().AppendChild("Skeleton"))
         paths, inner = [], {}
         for b in rig.bones:
@@ -257,6 +261,12 @@ def _add_rigs(stage, world_path, rigs, t, fps, tolerance, used, looks_of):
         skel.CreateBindTransformsAttr(Vt.Matrix4dArray([m4(b.bind) for b in rig.bones]))
         rest = [b.bind if b.parent < 0 else np.linalg.inv(rig.bones[b.parent].bind) @ b.bind for b in rig.bones]
         skel.CreateRestTransformsAttr(Vt.Matrix4dArray([m4(M) for M in rest]))
+        if crowd:
+            anim = _crowd_animation(stage, world_path, rig, keys, paths, t, fps, shared, skel.GetPath())
+            UsdSkel.BindingAPI.Apply(skel.GetPrim()).CreateAnimationSourceRel().SetTargets([anim.GetPath()])
+            _skinned_mesh(stage, root, skel, rig, looks_of)
+            report[rig.name] = rig.key_counts(t, tolerance, "float")
+            continue
         anim = UsdSkel.Animation.Define(stage, skel.GetPath().AppendChild("Animation"))
         anim.CreateJointsAttr(Vt.TokenArray(paths))
         codes = (t - t[0]) * fps
@@ -273,39 +283,93 @@ def _add_rigs(stage, world_path, rigs, t, fps, tolerance, used, looks_of):
             ra.Set(Vt.QuatfArray([Gf.Quatf(*map(float, q)) for q in rots[i]]), float(codes[i]))
         anim.CreateScalesAttr().Set(Vt.Vec3hArray([Gf.Vec3h(1.0, 1.0, 1.0)] * len(paths)))
         UsdSkel.BindingAPI.Apply(skel.GetPrim()).CreateAnimationSourceRel().SetTargets([anim.GetPath()])
-        mesh = rig.mesh
-        geom = UsdGeom.Mesh.Define(stage, root.GetPath().AppendChild("Mesh"))
-        tris = np.concatenate([tr for _, tr in mesh.parts])
-        geom.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(mesh.positions.astype(np.float32)))
-        geom.CreateNormalsAttr(Vt.Vec3fArray.FromNumpy(mesh.normals.astype(np.float32)))
-        geom.SetNormalsInterpolation(UsdGeom.Tokens.vertex)
-        geom.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(len(tris), 3, dtype=np.int32)))
-        geom.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(tris.reshape(-1).astype(np.int32)))
-        geom.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
-        geom.CreateDoubleSidedAttr(True)
-        lo, hi = mesh.positions.min(axis=0), mesh.positions.max(axis=0)
-        geom.CreateExtentAttr(Vt.Vec3fArray([Gf.Vec3f(*map(float, lo)), Gf.Vec3f(*map(float, hi))]))
-        st = UsdGeom.PrimvarsAPI(geom).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.vertex)
-        st.Set(Vt.Vec2fArray.FromNumpy(np.column_stack([mesh.uv[:, 0], 1.0 - mesh.uv[:, 1]]).astype(np.float32)))
-        binding = UsdSkel.BindingAPI.Apply(geom.GetPrim())
-        binding.CreateSkeletonRel().SetTargets([skel.GetPath()])
-        binding.CreateJointIndicesPrimvar(False, 4).Set(Vt.IntArray.FromNumpy(mesh.joints.reshape(-1).astype(np.int32)))
-        binding.CreateJointWeightsPrimvar(False, 4).Set(Vt.FloatArray.FromNumpy(mesh.weights.reshape(-1).astype(np.float32)))
-        binding.CreateGeomBindTransformAttr(Gf.Matrix4d(1.0))
-        start = 0
-        if len(mesh.parts) == 1:
-            UsdShade.MaterialBindingAPI.Apply(geom.GetPrim()).Bind(looks_of(mesh.parts[0][0]))
-        else:
-            for n, (look, tr) in enumerate(mesh.parts):
-                subset = UsdGeom.Subset.CreateGeomSubset(geom, _ident(look.name, set()) + f"_{n}", UsdGeom.Tokens.face,
-                                                         Vt.IntArray(list(range(start, start + len(tr)))),
-                                                         UsdShade.Tokens.materialBind)
-                UsdShade.MaterialBindingAPI.Apply(subset.GetPrim()).Bind(looks_of(look))
-                start += len(tr)
-            UsdShade.MaterialBindingAPI.Apply(geom.GetPrim())
-            UsdGeom.Subset.SetFamilyType(geom, UsdShade.Tokens.materialBind, UsdGeom.Tokens.partition)
+        _skinned_mesh(stage, root, skel, rig, looks_of)
         report[rig.name] = rig.key_counts(t, tolerance, "float", cycles=False)
     return report
+
+
+def _key_xform(xf, k, t, fps) -> None:
+    """Key a prim's translate and orient ops from a bone's world keys ``k`` (:class:`~lifelike_mj.export.rig.BoneKeys`)
+    at their time codes (a still channel: one value)."""
+    from pxr import Gf, Usd, UsdGeom
+
+    codes = (t - t[0]) * fps
+    for op, idx, values, still, kind in (
+            (xf.AddTranslateOp(UsdGeom.XformOp.PrecisionFloat), k.translation, k.translation_values,
+             k.still_translation, Gf.Vec3f),
+            (xf.AddOrientOp(UsdGeom.XformOp.PrecisionFloat), k.rotation, k.rotation_values, k.still_rotation, Gf.Quatf)):
+        if idx is None:
+            op.Set(kind(*map(float, still)))
+            continue
+        for i, v in zip(idx, values):
+            op.Set(kind(*map(float, v)), Usd.TimeCode(float(codes[i])))
+
+
+def _crowd_animation(stage, world_path, rig, keys, paths, t, fps, shared: dict, skel_path):
+    """A crowd agent's SkelAnimation: an internal reference to its cycle's one shared animation (made on first use,
+    under ``/World/Cycles``: the cycle's bones over the whole run and a period either side, group 0), offset in
+    time by the agent's phase, with the agent's own joint paths; the bones outside the cycle rest."""
+    from pxr import Gf, Sdf, UsdSkel, Vt
+
+    cyc = rig.cycle
+    parts = [(j, rig.cycle_part(b)) for j, b in enumerate(rig.bones) if rig.cycle_part(b) is not None]
+    if cyc.name not in shared:
+        path = Sdf.Path(world_path).AppendChild("Cycles").AppendChild(_ident(cyc.name, set()))
+        base = UsdSkel.Animation.Define(stage, path)
+        base.GetPrim().SetCustomDataByKey("lifelike_mj_cycle", {"period_s": cyc.period_s, "phases": cyc.groups})
+        base.CreateJointsAttr(Vt.TokenArray([paths[j].rsplit("/", 1)[-1] for j, _ in parts]))
+        base.CreateTranslationsAttr().Set(Vt.Vec3fArray([Gf.Vec3f(*map(float, keys[j].still_translation))
+                                                         for j, _ in parts]))
+        base.CreateScalesAttr().Set(Vt.Vec3hArray([Gf.Vec3h(1.0, 1.0, 1.0)] * len(parts)))
+        rot = base.CreateRotationsAttr()
+        m = cyc.samples
+        span = float(t[-1] - t[0])
+        for i in range(-m, int(np.ceil(span / cyc.period_s)) * m + 2 * m + 1):
+            values = [cyc.quat_wxyz[part][i % m] for _, part in parts]
+            rot.Set(Vt.QuatfArray([Gf.Quatf(*map(float, q)) for q in values]), i * cyc.period_s / m * fps)
+        shared[cyc.name] = path
+    anim = UsdSkel.Animation.Define(stage, skel_path.AppendChild("Animation"))
+    offset = -rig.group / cyc.groups * cyc.period_s * fps  # the agent's phase, in time codes
+    anim.GetPrim().GetReferences().AddInternalReference(shared[cyc.name], Sdf.LayerOffset(offset, 1.0))
+    anim.CreateJointsAttr(Vt.TokenArray([paths[j] for j, _ in parts]))
+    return anim
+
+
+def _skinned_mesh(stage, root, skel, rig, looks_of) -> None:
+    """The rig's skinned mesh under its SkelRoot ``root``, bound to ``skel``, with one material per look."""
+    from pxr import Gf, Sdf, UsdGeom, UsdShade, UsdSkel, Vt
+
+    mesh = rig.mesh
+    geom = UsdGeom.Mesh.Define(stage, root.GetPath().AppendChild("Mesh"))
+    tris = np.concatenate([tr for _, tr in mesh.parts])
+    geom.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(mesh.positions.astype(np.float32)))
+    geom.CreateNormalsAttr(Vt.Vec3fArray.FromNumpy(mesh.normals.astype(np.float32)))
+    geom.SetNormalsInterpolation(UsdGeom.Tokens.vertex)
+    geom.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(len(tris), 3, dtype=np.int32)))
+    geom.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(tris.reshape(-1).astype(np.int32)))
+    geom.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+    geom.CreateDoubleSidedAttr(True)
+    lo, hi = mesh.positions.min(axis=0), mesh.positions.max(axis=0)
+    geom.CreateExtentAttr(Vt.Vec3fArray([Gf.Vec3f(*map(float, lo)), Gf.Vec3f(*map(float, hi))]))
+    st = UsdGeom.PrimvarsAPI(geom).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.vertex)
+    st.Set(Vt.Vec2fArray.FromNumpy(np.column_stack([mesh.uv[:, 0], 1.0 - mesh.uv[:, 1]]).astype(np.float32)))
+    binding = UsdSkel.BindingAPI.Apply(geom.GetPrim())
+    binding.CreateSkeletonRel().SetTargets([skel.GetPath()])
+    binding.CreateJointIndicesPrimvar(False, 4).Set(Vt.IntArray.FromNumpy(mesh.joints.reshape(-1).astype(np.int32)))
+    binding.CreateJointWeightsPrimvar(False, 4).Set(Vt.FloatArray.FromNumpy(mesh.weights.reshape(-1).astype(np.float32)))
+    binding.CreateGeomBindTransformAttr(Gf.Matrix4d(1.0))
+    start = 0
+    if len(mesh.parts) == 1:
+        UsdShade.MaterialBindingAPI.Apply(geom.GetPrim()).Bind(looks_of(mesh.parts[0][0]))
+    else:
+        for n, (look, tr) in enumerate(mesh.parts):
+            subset = UsdGeom.Subset.CreateGeomSubset(geom, _ident(look.name, set()) + f"_{n}", UsdGeom.Tokens.face,
+                                                     Vt.IntArray(list(range(start, start + len(tr)))),
+                                                     UsdShade.Tokens.materialBind)
+            UsdShade.MaterialBindingAPI.Apply(subset.GetPrim()).Bind(looks_of(look))
+            start += len(tr)
+        UsdShade.MaterialBindingAPI.Apply(geom.GetPrim())
+        UsdGeom.Subset.SetFamilyType(geom, UsdShade.Tokens.materialBind, UsdGeom.Tokens.partition)
 
 
 def write_usd(poses: Poses, path: str | Path, name: str = "lifelike-mj run", parameters: dict | None = None,
