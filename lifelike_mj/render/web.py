@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import ipaddress
+import logging
 import socket
 import sys
 import threading
@@ -178,6 +179,22 @@ def _buttons(controls, pending, shown: _Shown) -> list:
     return [Buttons()]
 
 
+class _ClosedNormally(logging.Filter):
+    """Leaves out asyncio's report of a websocket that a browser closed normally (``ConnectionClosedOK``: a tab
+    closed or reloaded) while MuJoCo's web server was still sending to it. Nothing went wrong, yet asyncio logs it
+    with a traceback ("Task exception was never retrieved"), seen at Ctrl+C under load."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        exc = record.exc_info[1] if record.exc_info else None
+        return not (exc is not None and type(exc).__name__ == "ConnectionClosedOK")
+
+
+def _quiet_normal_closes() -> None:
+    log = logging.getLogger("asyncio")
+    if not any(isinstance(f, _ClosedNormally) for f in log.filters):
+        log.addFilter(_ClosedNormally())
+
+
 def launch_web(model: Any, data: Any, options: WebOptions | None = None, title: str = "lifelike-mj",
                setup: Callable[[Any], None] | None = None, controls=(), pending=None):
     """Start MuJoCo's web viewer on ``model`` and ``data`` (module docstring), print its address, and return a
@@ -186,6 +203,7 @@ def launch_web(model: Any, data: Any, options: WebOptions | None = None, title: 
     ``pending`` (:func:`_buttons`). A port that is taken, or a MuJoCo without the web viewer,
     is a :class:`UserError`."""
     options = (options or WebOptions()).check()
+    _quiet_normal_closes()
     try:
         from mujoco.studio import launch_web as lw
         from mujoco.studio import viewer_protocol, web_viewer

@@ -177,3 +177,23 @@ def test_host_and_port_need_web_and_only_the_loopback_goes_unwarned(capsys):
     assert "--host" in capsys.readouterr().err
     assert all(WebOptions(h).is_loopback for h in ("localhost", "127.0.0.1", "::1"))
     assert not any(WebOptions(h).is_loopback for h in ("0.0.0.0", "::", "192.168.1.5"))  # these get the warning
+
+
+def test_a_tab_closed_normally_is_not_reported_as_an_error():
+    """asyncio logs a websocket that a browser closed normally while MuJoCo's server was sending to it ("Task
+    exception was never retrieved", with a traceback): the viewer leaves that one out, and only that one."""
+    import logging
+
+    from websockets.exceptions import ConnectionClosedError, ConnectionClosedOK
+    from websockets.frames import Close
+
+    from lifelike_mj.render.web import _ClosedNormally
+
+    def record(exc):
+        return logging.LogRecord("asyncio", logging.ERROR, __file__, 1, "Task exception was never retrieved", None,
+                                 (type(exc), exc, None))
+
+    keep = _ClosedNormally().filter
+    assert not keep(record(ConnectionClosedOK(Close(1001, ""), Close(1001, ""), True)))
+    assert keep(record(ConnectionClosedError(Close(1011, "boom"), None, None)))
+    assert keep(record(RuntimeError("a real error")))
