@@ -37,7 +37,7 @@ import math
 import numpy as np
 
 from lifelike_mj.export.meshes import Piece, assemble, loft, rigid, sheet, sphere
-from lifelike_mj.export.rig import Bone, Cycle, Look, Rig, continuous, creatures, extra_bone, qaxis, qmul, smooth
+from lifelike_mj.export.rig import Bone, Cycle, Look, Rig, adaptive_smooth, continuous, creatures, extra_bone, qaxis, qmul, smooth
 
 #: The drawn path: the agent's positions smoothed by a Gaussian of this many steps (sigma), narrowed where the agent
 #: moves faster than :data:`FAST_BL_PER_STEP` (in proportion), so that a fast agent is drawn near where it is.
@@ -55,22 +55,6 @@ CYCLE_SAMPLES, PHASES = 48, 16
 G = 9.81
 #: The golden ratio's conjugate: bird i plays phase group floor(frac(i * GOLDEN) * PHASES).
 GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
-
-
-def adaptive_smooth(x: np.ndarray, sigma: np.ndarray) -> np.ndarray:
-    """``x`` ``(n, k)`` smoothed by a Gaussian whose sigma (samples) is ``sigma[i]`` at sample ``i`` (its weights
-    normalised there; the ends held): where sigma is under half a sample, ``x`` as it is."""
-    n = len(x)
-    r = int(math.ceil(3.0 * float(np.max(sigma, initial=0.0))))
-    if r < 1 or n < 3:
-        return np.array(x, dtype=float)
-    j = np.arange(-r, r + 1)
-    idx = np.clip(np.arange(n)[:, None] + j[None, :], 0, n - 1)
-    s = np.maximum(sigma, 1e-9)[:, None]
-    w = np.exp(-0.5 * (j[None, :] / s) ** 2)
-    w[np.abs(j)[None, :] > np.ceil(3.0 * s)] = 0.0
-    w /= w.sum(axis=1, keepdims=True)
-    return np.einsum("ij,ijk->ik", w, np.asarray(x, dtype=float)[idx])
 
 
 def drawn_flight(t: np.ndarray, pos: np.ndarray, metres_per_unit: float = 1.0, path_sigma: float = PATH_SIGMA_STEPS,
@@ -184,7 +168,7 @@ def bird_rig(poses, i: int, length: float, looks: dict, meshes: dict, cycle: Cyc
     body = poses.body_names[i]
     p, q, series = drawn_flight(t, poses.position_m[:, i], metres_per_unit, length=length)
     bones: list[Bone] = [Bone(body, -1, np.eye(4), p, q, body, drawn=True)]
-    group = phase_group(list(poses.body_names).index(body))
+    group = phase_group(i)
     wings = {}
     for side, sign in (("left", 1.0), ("right", -1.0)):
         inner = cycle.play(f"wing_{side}_inner", group, t - t[0])

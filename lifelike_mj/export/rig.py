@@ -418,6 +418,22 @@ def smooth(x: np.ndarray, sigma: float) -> np.ndarray:
     return out.reshape(x.shape)
 
 
+def adaptive_smooth(x: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+    """``x`` ``(n, k)`` smoothed by a Gaussian whose sigma (samples) is ``sigma[i]`` at sample ``i`` (its weights
+    normalised there; the ends held): where sigma is under half a sample, ``x`` as it is."""
+    n = len(x)
+    r = int(math.ceil(3.0 * float(np.max(sigma, initial=0.0))))
+    if r < 1 or n < 3:
+        return np.array(x, dtype=float)
+    j = np.arange(-r, r + 1)
+    idx = np.clip(np.arange(n)[:, None] + j[None, :], 0, n - 1)
+    s = np.maximum(sigma, 1e-9)[:, None]
+    w = np.exp(-0.5 * (j[None, :] / s) ** 2)
+    w[np.abs(j)[None, :] > np.ceil(3.0 * s)] = 0.0
+    w /= w.sum(axis=1, keepdims=True)
+    return np.einsum("ij,ijk->ik", w, np.asarray(x, dtype=float)[idx])
+
+
 def damped(signal: np.ndarray, dt: float, hz: float, zeta: float) -> np.ndarray:
     """The response of a damped oscillator (natural frequency ``hz``, damping ratio ``zeta``, unit static gain)
     to ``signal`` ``(n, k)`` sampled every ``dt`` s, from rest at the first sample's value: a lagging follower

@@ -187,11 +187,8 @@ def build_stage(poses: Poses, name: str = "lifelike-mj run", parameters: dict | 
             track = tracks[b]
             for op, keys, values, kind in ((translate, track.translation, pos[:, b], Gf.Vec3f),
                                            (orient, track.rotation, quat[:, b], Gf.Quatf)):
-                if keys is None:  # still over the whole run: one value, no samples
-                    op.Set(kind(*values[0]))
-                    continue
-                for k in keys:
-                    op.Set(kind(*values[k]), Usd.TimeCode(float(codes[k])))
+                # still over the whole run: one value, no samples
+                _set_samples(op, kind, codes, keys, values if keys is None else values[keys], values[0])
     if rigs:  # prims are defined: outside the change block
         prov["rigs"] = _add_rigs(stage, world.GetPath(), rigs, poses.t_s, fps, tolerance, used, look_of_rig)
         stage.GetRootLayer().customLayerData = {"lifelike_mj": json.dumps(strict(prov), allow_nan=False)}
@@ -234,7 +231,7 @@ def _add_rigs(stage, world_path, rigs, t, fps, tolerance, used, looks_of):
     ``primvars:st``) with one material per look. Returns each rig's keys per bone."""
     from pxr import Gf, Sdf, UsdGeom, UsdSkel, Vt
 
-    from lifelike_mj.export.rig import lerp_at, slerp_at
+    from lifelike_mj.export.rig import bone_play
 
     report = {}
     shared: dict[str, Sdf.Path] = {}  # a crowd's cycle: its one SkelAnimation, which each agent's references
@@ -263,46 +260,49 @@ def _add_rigs(stage, world_path, rigs, t, fps, tolerance, used, looks_of):
         skel.CreateRestTransformsAttr(Vt.Matrix4dArray([m4(M) for M in rest]))
         if crowd:
             anim = _crowd_animation(stage, world_path, rig, keys, paths, t, fps, shared, skel.GetPath())
-            UsdSkel.BindingAPI.Apply(skel.GetPrim()).CreateAnimationSourceRel().SetTargets([anim.GetPath()])
-            _skinned_mesh(stage, root, skel, rig, looks_of)
-            report[rig.name] = rig.key_counts(t, tolerance, "float")
-            continue
-        anim = UsdSkel.Animation.Define(stage, skel.GetPath().AppendChild("Animation"))
-        anim.CreateJointsAttr(Vt.TokenArray(paths))
-        codes = (t - t[0]) * fps
-        tk = sorted({int(i) for k in keys if k.translation is not None for i in k.translation} | {0, len(t) - 1})
-        rk = sorted({int(i) for k in keys if k.rotation is not None for i in k.rotation} | {0, len(t) - 1})
-        trans = np.stack([np.repeat(k.still_translation[None], len(t), 0) if k.translation is None
-                          else lerp_at(t, k.translation, k.translation_values) for k in keys], axis=1)
-        rots = np.stack([np.repeat(k.still_rotation[None], len(t), 0) if k.rotation is None
-                         else slerp_at(t, k.rotation, k.rotation_values) for k in keys], axis=1)
-        ta, ra = anim.CreateTranslationsAttr(), anim.CreateRotationsAttr()
-        for i in tk:
-            ta.Set(Vt.Vec3fArray.FromNumpy(trans[i].astype(np.float32)), float(codes[i]))
-        for i in rk:
-            ra.Set(Vt.QuatfArray([Gf.Quatf(*map(float, q)) for q in rots[i]]), float(codes[i]))
-        anim.CreateScalesAttr().Set(Vt.Vec3hArray([Gf.Vec3h(1.0, 1.0, 1.0)] * len(paths)))
+        else:
+            anim = UsdSkel.Animation.Define(stage, skel.GetPath().AppendChild("Animation"))
+            anim.CreateJointsAttr(Vt.TokenArray(paths))
+            codes = (t - t[0]) * fps
+            tk = sorted({int(i) for k in keys if k.translation is not None for i in k.translation} | {0, len(t) - 1})
+            rk = sorted({int(i) for k in keys if k.rotation is not None for i in k.rotation} | {0, len(t) - 1})
+            played = bone_play(t, rig, keys)
+            trans = np.stack([p for p, _ in played], axis=1)
+            rots = np.stack([q for _, q in played], axis=1)
+            ta, ra = anim.CreateTranslationsAttr(), anim.CreateRotationsAttr()
+            for i in tk:
+                ta.Set(Vt.Vec3fArray.FromNumpy(trans[i].astype(np.float32)), float(codes[i]))
+            for i in rk:
+                ra.Set(Vt.QuatfArray([Gf.Quatf(*map(float, q)) for q in rots[i]]), float(codes[i]))
+            anim.CreateScalesAttr().Set(Vt.Vec3hArray([Gf.Vec3h(1.0, 1.0, 1.0)] * len(paths)))
         UsdSkel.BindingAPI.Apply(skel.GetPrim()).CreateAnimationSourceRel().SetTargets([anim.GetPath()])
         _skinned_mesh(stage, root, skel, rig, looks_of)
-        report[rig.name] = rig.key_counts(t, tolerance, "float", cycles=False)
+        report[rig.name] = rig.key_counts(t, tolerance, "float")
     return report
+
+
+def _set_samples(op, kind, codes, idx, values, still) -> None:
+    """Set an xform op's time samples: ``values`` (each a ``kind``) at the time codes ``codes[idx]``; with ``idx``
+    None, one value ``still`` and no samples."""
+    from pxr import Usd
+
+    if idx is None:
+        op.Set(kind(*map(float, still)))
+        return
+    for i, v in zip(idx, values):
+        op.Set(kind(*map(float, v)), Usd.TimeCode(float(codes[i])))
 
 
 def _key_xform(xf, k, t, fps) -> None:
     """Key a prim's translate and orient ops from a bone's world keys ``k`` (:class:`~lifelike_mj.export.rig.BoneKeys`)
     at their time codes (a still channel: one value)."""
-    from pxr import Gf, Usd, UsdGeom
+    from pxr import Gf, UsdGeom
 
     codes = (t - t[0]) * fps
-    for op, idx, values, still, kind in (
-            (xf.AddTranslateOp(UsdGeom.XformOp.PrecisionFloat), k.translation, k.translation_values,
-             k.still_translation, Gf.Vec3f),
-            (xf.AddOrientOp(UsdGeom.XformOp.PrecisionFloat), k.rotation, k.rotation_values, k.still_rotation, Gf.Quatf)):
-        if idx is None:
-            op.Set(kind(*map(float, still)))
-            continue
-        for i, v in zip(idx, values):
-            op.Set(kind(*map(float, v)), Usd.TimeCode(float(codes[i])))
+    _set_samples(xf.AddTranslateOp(UsdGeom.XformOp.PrecisionFloat), Gf.Vec3f, codes, k.translation,
+                 k.translation_values, k.still_translation)
+    _set_samples(xf.AddOrientOp(UsdGeom.XformOp.PrecisionFloat), Gf.Quatf, codes, k.rotation, k.rotation_values,
+                 k.still_rotation)
 
 
 def _crowd_animation(stage, world_path, rig, keys, paths, t, fps, shared: dict, skel_path):
