@@ -152,13 +152,13 @@ def page(gl, name: str, view: dict) -> str:
              "follow_m": float(follow["distance_m"]) if follow else 0.0,
              "centre": [float(v) for v in centre], "span_s": float(view["span_s"]),
              "follow_path": (np.round(np.asarray(follow["path_m"]) @ y_up.T, 5).tolist() if follow else None),
-             "cycles": [a.name for a in gl.animations[1:]]}
+             "cycles": [a.name for a in gl.animations if "lifelike_mj_cycle" in (a.extras or {})]}
     glb = b"".join(gl.save_to_bytes())
     prov = json.dumps(gl.asset.extras, allow_nan=False)
     target = (y_up @ np.asarray(follow["path_m"][0], dtype=float)) if follow else centre
     return _PAGE.format(generator=html.escape(gl.asset.generator), title=html.escape(name),
                         viewer=_inline(viewer_js()), glb=base64.b64encode(glb).decode("ascii"),
-                        animation=html.escape(gl.animations[0].name if gl.animations else ""),
+                        animation=html.escape(next((a.name for a in gl.animations if a.name not in frame["cycles"]), "")),
                         duration=frame["span_s"], provenance=_inline(prov),
                         framing=_inline(json.dumps(frame, allow_nan=False)), fov=FOV_DEG, theta=frame["theta"],
                         phi=frame["phi"], radius=frame["follow_m"] if follow else overview_m,
